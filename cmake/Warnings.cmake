@@ -1,0 +1,13 @@
+# One shared warnings function: every first-party target calls wire_set_warnings(target).
+function(wire_set_warnings target)
+  get_target_property(type ${target} TYPE)
+  if(type STREQUAL "INTERFACE_LIBRARY")
+    set(scope INTERFACE)
+  else()
+    set(scope PRIVATE)
+  endif()
+  target_compile_options(${target} ${scope} -Wall -Wextra -Wpedantic)
+  if(WIRE_WERROR)
+    target_compile_options(${target} ${scope} -Werror)
+  endif()
+endfunction()

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Installs every system package the project needs (Debian), then configures and builds.
+# Idempotent: when every package is present it skips apt-get entirely and only builds.
+# Usage: tools/setup.sh [--no-build] [--build-dir DIR] [--type Release|Debug|RelWithDebInfo]
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build_dir="$here/build"
+build_type="Release"
+do_build=1
+
+usage() {
+  sed -n '2,4p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+}
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --no-build) do_build=0 ;;
+    --build-dir) build_dir="$2"; shift ;;
+    --type) build_type="$2"; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "setup.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+  esac
+  shift
+done
+
+# One list, used by set-up and CI alike. Keep it sorted.
+packages=(
+  build-essential
+  clang
+  cmake
+  gnuplot-nox
+  libbenchmark-dev
+  libcli11-dev
+  libegl-dev
+  libegl-mesa0
+  libepoxy-dev
+  libgl1-mesa-dri
+  libglfw3-dev
+  libglm-dev
+  libgmock-dev
+  libgtest-dev
+  libosd-dev
+  libstb-dev
+  libtbb-dev
+  libtinygltf-dev
+  ninja-build
+  nlohmann-json3-dev
+  pkg-config
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=""
+  if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "setup: all ${#packages[@]} packages present"
+fi
+
+if [ "$do_build" -eq 1 ]; then
+  generator=()
+  if command -v ninja >/dev/null 2>&1 && [ ! -f "$build_dir/Makefile" ]; then generator=(-G Ninja); fi
+  cmake -S "$here" -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE="$build_type"
+  cmake --build "$build_dir" --parallel "$(nproc)"
+fi
