@@ -1,0 +1,2 @@
+// Keeps wire_core non-empty even before any other source exists; Status itself is header-only.
+#include "wire/status.hpp"
