@@ -18,12 +18,21 @@ set_target_properties(opensubdiv::cpu PROPERTIES
   IMPORTED_LOCATION ${OSD_CPU_LIBRARY}
   INTERFACE_SYSTEM_INCLUDE_DIRECTORIES ${OSD_INCLUDE_DIR})
 
-# tinygltf (header-only) includes <stb_image.h> and <nlohmann/json.hpp>.
-find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)
+# stb: Debian's libstb ships the implementations (stb_image, stb_image_write) in libstb.so, so no
+# translation unit of ours defines STB_*_IMPLEMENTATION.
 find_path(STB_INCLUDE_DIR stb_image.h PATHS /usr/include/stb REQUIRED)
+find_library(STB_LIBRARY stb REQUIRED)
+add_library(third_party_stb INTERFACE)
+target_include_directories(third_party_stb SYSTEM INTERFACE ${STB_INCLUDE_DIR})
+target_link_libraries(third_party_stb INTERFACE ${STB_LIBRARY})
+add_library(third_party::stb ALIAS third_party_stb)
+
+# tinygltf (header-only) includes <stb_image.h> and <nlohmann/json.hpp>. Its implementation is compiled
+# once, in engine/assets.
+find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)
 add_library(tinygltf_headers INTERFACE)
-target_include_directories(tinygltf_headers SYSTEM INTERFACE ${TINYGLTF_INCLUDE_DIR} ${STB_INCLUDE_DIR})
-target_link_libraries(tinygltf_headers INTERFACE nlohmann_json::nlohmann_json)
+target_include_directories(tinygltf_headers SYSTEM INTERFACE ${TINYGLTF_INCLUDE_DIR})
+target_link_libraries(tinygltf_headers INTERFACE nlohmann_json::nlohmann_json third_party::stb)
 add_library(third_party::tinygltf ALIAS tinygltf_headers)
 
 if(WIRE_BUILD_TESTS)
