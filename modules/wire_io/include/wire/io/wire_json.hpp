@@ -1,0 +1,59 @@
+// Reader for wire description files (JSON): one wire, a list of wires, or successive frames of wires.
+// The format is a contract (README, "Wire JSON"); this reader only parses and checks the form: the
+// geometry checks (fewer than 2 distinct nodes, degenerate loops) belong to wire::build_curve.
+#pragma once
+
+#include <wire/status.hpp>
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace wire::io {
+
+/// Physics data a node may carry for the thesis' curvature-driven tension.
+struct NodePhysics {
+    double theta = 0, Iz = 0, L = 0, dL = 0, A = 0;
+};
+
+/// One wire as written in the file. Optional settings are unset when the file does not give them, so
+/// that command-line options can override the file and the file can override the defaults.
+struct WireSpec {
+    std::vector<glm::dvec3> positions;
+    std::vector<uint32_t> ids;       ///< file ids, or the node's index when the file gives none
+    std::vector<float> stretch;      ///< 1 when not given
+    std::vector<float> radius;       ///< per-node radius, -1 when not given (use the wire's)
+    std::vector<NodePhysics> physics;  ///< empty unless some node gives "physics"
+    std::vector<glm::dvec3> tcb;     ///< per-node (tension, bias, continuity); empty unless some node gives one
+
+    std::optional<double> radius_m;
+    std::optional<bool> closed;
+    std::optional<bool> caps;
+    std::optional<std::string> spline_type;  ///< uniform|centripetal|chordal|c2|auto|linear|catmull-rom
+    std::optional<double> alpha, tension, bias, continuity;
+    std::optional<bool> curvature_tension;
+    std::optional<int> sides;
+};
+
+struct FrameSpec {
+    std::vector<WireSpec> wires;
+};
+
+/// A parsed file: always one or more frames (a single wire or a wire list is one frame).
+struct SceneSpec {
+    std::vector<FrameSpec> frames;
+};
+
+/// Parses `text`. On error the message starts with `source` (a file name) and names the frame, wire and
+/// node and what is wrong, e.g. "cable.json: wire 1, node 4: coordinate z is not a number".
+/// `out` is cleared first and left empty on error.
+Status parse_wire_json(std::string_view text, const std::string& source, SceneSpec& out);
+
+/// Reads and parses a file; a missing or unreadable file is an error naming it.
+Status load_wire_json(const std::string& path, SceneSpec& out);
+
+}  // namespace wire::io
