@@ -22,7 +22,7 @@ struct ContextDesc {
   Backend backend = Backend::automatic;
   int width = 0;           // default 1280 (window: initial client size; headless: framebuffer size)
   int height = 0;          // default 720
-  std::string title;       // default "wires"
+  std::string title{};     // default "wires"
   bool vsync = true;       // window only
   bool debug = false;      // request a debug context (KHR_debug output is more complete)
   bool quiet = false;      // do not print the fallback notice

@@ -10,7 +10,7 @@
 namespace engine::platform {
 
 struct Error {
-  std::string message;
+  std::string message{};
 };
 
 // Expected<T>: holds a T or an Error. Expected<void> is a plain status.
