@@ -1,0 +1,61 @@
+// Input of the curve stage: a wire's lumped-element nodes (struct of arrays) and the spline settings.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace wire {
+
+/// One wire's nodes in struct-of-arrays form. Only `positions` is required; every other array is either
+/// empty (use the default named below) or exactly as long as `positions`.
+struct WireNodes {
+    std::vector<glm::dvec3> positions;  ///< metres, world space, ordered along the wire
+    std::vector<uint32_t> ids;          ///< stable across frames (multiresolution); empty: id = index
+    std::vector<float> stretch;         ///< L_current / L_rest of the element starting at this node; empty: 1; must be > 0
+    std::vector<float> radius_m;        ///< tube radius at this node; 0 (or empty): the wire's radius; negative: error
+
+    // Optional physics per node for the thesis' curvature-driven tension R = theta*Iz*L / (A*dL^2).
+    // Used when SplineSettings::curvature_tension is set and all five arrays are present.
+    std::vector<double> theta_rad;       ///< angle between the node's two adjacent elements
+    std::vector<double> iz_m4;           ///< second moment of inertia about the neutral axis
+    std::vector<double> length_m;        ///< length of the two adjacent elements
+    std::vector<double> delta_length_m;  ///< stretch (elongation) of the two adjacent elements; 0: no tension
+    std::vector<double> area_m2;         ///< cross-section area (> 0)
+
+    // Optional per-node Kochanek-Bartels parameters; when present they replace the wire-wide values.
+    std::vector<float> kb_tension;
+    std::vector<float> kb_bias;
+    std::vector<float> kb_continuity;
+
+    [[nodiscard]] std::size_t size() const { return positions.size(); }
+};
+
+enum class SplineKind : uint8_t {
+    catmull_rom = 0,  ///< local, C1; any alpha; cardinal tension / Kochanek-Bartels / curvature tension apply
+    c2,               ///< global C2 interpolating cubic, chordal knots (Thomas / Sherman-Morrison solve)
+    automatic,        ///< chordal Catmull-Rom on gentle sag, blending smoothly to a bend-hugging G1 form (see spline.hpp)
+    linear,           ///< straight segments (degenerate cubics), for baselines
+};
+
+/// Settings of the curve stage. Default-initialized (`SplineSettings{}` or `{.closed = true}`) is sensible:
+/// centripetal Catmull-Rom, no tension, open wire, radius 1 cm, merge epsilon 1e-9 of the scene scale.
+struct SplineSettings {
+    SplineKind kind = SplineKind::catmull_rom;
+    double alpha = 0.5;       ///< knot exponent: 0 uniform, 0.5 centripetal, 1 chordal; any finite value
+    double tension = 0.0;     ///< cardinal / Kochanek-Bartels tension, wire-wide (1 = straight segments)
+    double bias = 0.0;        ///< Kochanek-Bartels bias, wire-wide
+    double continuity = 0.0;  ///< Kochanek-Bartels continuity, wire-wide (non-zero breaks C1 on purpose)
+    bool curvature_tension = true;  ///< use R = theta*Iz*L/(A*dL^2) for nodes that carry the physics arrays
+    bool closed = false;            ///< closed loop: the last node connects back to the first
+    float radius_m = 0.01f;         ///< the wire's radius, used where a node's radius is 0; must be > 0 (0: 1 cm)
+    /// Nodes closer than merge_epsilon_rel * max(bounding-box diagonal, 1e-300) are merged (the first one is kept).
+    /// 1e-9 sits ~3 decades below any physical spacing (a 100,000-node wire spaces at 1e-5 of its diagonal, the
+    /// DESIGN spacing ratio 1e6 at 1e-6) and ~6 decades above double rounding (2.2e-16 relative), so it merges
+    /// only nodes that are coincident up to noise. 0: default 1e-9. A floor of 64 ulps of the coordinates
+    /// (far from the origin) is always applied.
+    double merge_epsilon_rel = 1e-9;
+};
+
+}  // namespace wire

@@ -1,0 +1,132 @@
+// Exact cubic Bezier operations used by the curve stage, multiresolution and the measurements.
+#include "wire/bezier.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace wire {
+namespace {
+
+// Split at t: returns the left part [0,t] (right = false) or the right part [t,1].
+CubicBezier split(const CubicBezier& c, double t, bool right) {
+    const glm::dvec3 p01 = glm::mix(c.b0, c.b1, t), p12 = glm::mix(c.b1, c.b2, t), p23 = glm::mix(c.b2, c.b3, t);
+    const glm::dvec3 p012 = glm::mix(p01, p12, t), p123 = glm::mix(p12, p23, t);
+    const glm::dvec3 p = glm::mix(p012, p123, t);
+    if (right) return {p, p123, p23, c.b3};
+    return {c.b0, p01, p012, p};
+}
+
+constexpr std::array<double, 8> kGaussX = {0.0950125098376374, 0.2816035507792589, 0.4580167776572274,
+                                           0.6178762444026438, 0.7554044083550030, 0.8656312023878318,
+                                           0.9445750230732326, 0.9894009349916499};
+constexpr std::array<double, 8> kGaussW = {0.1894506104550685, 0.1826034150449236, 0.1691565193950025,
+                                           0.1495959888165767, 0.1246289712555339, 0.0951585116824928,
+                                           0.0622535239386479, 0.0271524594117541};
+
+double gauss_length(const CubicBezier& c, double a, double b) {
+    const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < kGaussX.size(); ++i) {
+        sum += kGaussW[i] * (glm::length(derivative(c, mid + half * kGaussX[i])) +
+                             glm::length(derivative(c, mid - half * kGaussX[i])));
+    }
+    return sum * half;
+}
+
+double point_segment_distance2(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
+    const glm::dvec3 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    double t = len2 > 0.0 ? glm::dot(p - a, ab) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    const glm::dvec3 d = p - (a + t * ab);
+    return glm::dot(d, d);
+}
+
+double directed_distance(const std::vector<glm::dvec3>& from, const std::vector<glm::dvec3>& to) {
+    double worst2 = 0.0;
+    for (const glm::dvec3& p : from) {
+        double best2 = std::numeric_limits<double>::infinity();
+        if (to.size() == 1) best2 = glm::dot(p - to[0], p - to[0]);
+        for (std::size_t i = 0; i + 1 < to.size(); ++i) {
+            best2 = std::min(best2, point_segment_distance2(p, to[i], to[i + 1]));
+            if (best2 <= worst2) break;  // cannot raise the maximum any more
+        }
+        worst2 = std::max(worst2, best2);
+    }
+    return std::sqrt(worst2);
+}
+
+}  // namespace
+
+CubicBezier sub_segment(const CubicBezier& c, double t0, double t1) {
+    if (t0 <= 0.0 && t1 >= 1.0) return c;
+    if (t0 <= 0.0) return split(c, t1, false);
+    if (t1 >= 1.0) return split(c, t0, true);
+    const CubicBezier right = split(c, t0, true);
+    CubicBezier out = split(right, (t1 - t0) / (1.0 - t0), false);
+    out.b0 = position(c, t0);  // both cuts evaluate the same point bit-for-bit as the neighbours' cuts do
+    out.b3 = position(c, t1);
+    return out;
+}
+
+double arc_length_m(const CubicBezier& c) { return gauss_length(c, 0.0, 0.5) + gauss_length(c, 0.5, 1.0); }
+
+double arc_length_m(const Curve& curve) {
+    double sum = 0.0;
+    for (const CubicBezier& s : curve.segments) sum += arc_length_m(s);
+    return sum;
+}
+
+std::vector<glm::dvec3> sample_curve(const Curve& curve, int per_segment) {
+    std::vector<glm::dvec3> out;
+    per_segment = std::max(per_segment, 1);
+    out.reserve(curve.segments.size() * static_cast<std::size_t>(per_segment) + 1);
+    for (const CubicBezier& s : curve.segments) {
+        for (int i = 0; i < per_segment; ++i) out.push_back(position(s, static_cast<double>(i) / per_segment));
+    }
+    if (!curve.segments.empty()) out.push_back(curve.segments.back().b3);
+    return out;
+}
+
+double closest_parameter(const CubicBezier& c, const glm::dvec3& p) {
+    constexpr int kScan = 64;
+    double best_t = 0.0, best_d2 = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= kScan; ++i) {
+        const double t = static_cast<double>(i) / kScan;
+        const glm::dvec3 d = position(c, t) - p;
+        if (glm::dot(d, d) < best_d2) best_d2 = glm::dot(d, d), best_t = t;
+    }
+    // Newton on f(t) = (B(t)-p).B'(t) = 0, kept inside the scan cell.
+    const double lo = std::max(0.0, best_t - 1.0 / kScan), hi = std::min(1.0, best_t + 1.0 / kScan);
+    double t = best_t;
+    for (int it = 0; it < 8; ++it) {
+        const glm::dvec3 d = position(c, t) - p, d1 = derivative(c, t), d2 = second_derivative(c, t);
+        const double f = glm::dot(d, d1), fp = glm::dot(d1, d1) + glm::dot(d, d2);
+        if (!(fp > 0.0)) break;
+        const double next = std::clamp(t - f / fp, lo, hi);
+        if (std::abs(next - t) < 1e-15) break;
+        t = next;
+    }
+    const glm::dvec3 dn = position(c, t) - p;
+    return glm::dot(dn, dn) <= best_d2 ? t : best_t;
+}
+
+double distance_to_polyline(const glm::dvec3& p, const std::vector<glm::dvec3>& points) {
+    if (points.empty()) return std::numeric_limits<double>::infinity();
+    if (points.size() == 1) return glm::length(p - points[0]);
+    double best2 = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i + 1 < points.size(); ++i) best2 = std::min(best2, point_segment_distance2(p, points[i], points[i + 1]));
+    return std::sqrt(best2);
+}
+
+double curve_jump_m(const Curve& before, const Curve& after, int per_segment) {
+    const std::vector<glm::dvec3> a = sample_curve(before, per_segment), b = sample_curve(after, per_segment);
+    if (a.empty() || b.empty()) return a.empty() && b.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+    return std::max(directed_distance(b, a), directed_distance(a, b));
+}
+
+}  // namespace wire

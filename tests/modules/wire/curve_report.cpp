@@ -1,0 +1,39 @@
+// wire_curve_report: prints the numbers quoted for the curve stage (catenary accuracy per spline kind,
+// the stretched-then-bent run, pops with and without the multiresolution remedy).
+#include "curve_cases.hpp"
+
+#include <cstdio>
+
+using namespace wire;
+using namespace wire::testing;
+
+int main() {
+    const Catenary cable = hanging_cable();
+    std::printf("catenary: 20 m cable from (0,0,0) to (16,2,0), a = %.6f m, xi = %.9f\n", cable.a(), cable.xi());
+    std::printf("\n== max distance to the exact catenary (m) ==\n%-22s", "kind");
+    const int counts[] = {8, 16, 32};
+    for (int c : counts) std::printf("  n=%-2d even   n=%-2d dense", c, c);
+    std::printf("\n");
+    for (const NamedSettings& v : spline_variants()) {
+        std::printf("%-22s", v.name.c_str());
+        for (int c : counts) {
+            for (bool dense : {false, true}) {
+                Curve curve;
+                const Status st = build_curve(cable_nodes(cable, c, dense), v.settings, curve);
+                std::printf("  %11.3e", st ? catenary_error_m(curve, cable) : -1.0);
+            }
+        }
+        std::printf("\n");
+    }
+    for (float stretch : {1.0f, 1.02f}) {
+        std::printf("\n== stretched run + tight bend, stretch %.2f ==\n%-22s %14s %14s %10s\n", stretch, "kind",
+                    "straight dev m", "overshoot m", "kink deg");
+        for (const NamedSettings& v : spline_variants()) {
+            Curve curve;
+            if (!build_curve(stretched_bend_nodes(stretch), v.settings, curve)) continue;
+            const BendNumbers b = measure_bend(curve);
+            std::printf("%-22s %14.3e %14.3e %10.3f\n", v.name.c_str(), b.straight_dev_m, b.overshoot_m, b.kink_deg);
+        }
+    }
+    return 0;
+}
