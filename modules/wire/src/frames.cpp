@@ -1,0 +1,248 @@
+// Rotation-minimizing frames by double reflection, hairpin subdivision, closed-loop holonomy removal; baselines.
+#include "wire/frames.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <numbers>
+
+namespace wire {
+namespace {
+
+/// Steps whose tangent turns by more than 45 degrees are split (see Transporter::reflect).
+constexpr double kSplitCos = 0.70710678118654752;
+
+double max_abs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
+/// r made orthogonal to unit t and normalized; `fallback` (also made orthogonal) if r is (nearly) parallel to t.
+glm::dvec3 orthonormalize(const glm::dvec3& r, const glm::dvec3& t) {
+    glm::dvec3 p = r - glm::dot(r, t) * t;
+    const double len2 = glm::dot(p, p);
+    if (len2 > 1e-20) {
+        return p / std::sqrt(len2);
+    }
+    return seed_normal(t);
+}
+
+/// Minimal rotation taking unit t0 to unit t1, applied to r0 (the rotation method). Antiparallel tangents: the
+/// rotation by pi about r0's direction (keeps r, flips the binormal), the minimum the geometry allows.
+glm::dvec3 rotate_minimal(const glm::dvec3& t0, const glm::dvec3& t1, const glm::dvec3& r0) {
+    const double c = glm::dot(t0, t1);
+    if (c < -1.0 + 1e-12) {
+        return orthonormalize(r0, t1);
+    }
+    const glm::dvec3 v = glm::cross(t0, t1);  // axis * sin(angle)
+    // Rodrigues with cos = c, axis*sin = v: R r = c r + v x r + v (v.r) / (1 + c).
+    return c * r0 + glm::cross(v, r0) + v * (glm::dot(v, r0) / (1.0 + c));
+}
+
+struct Sample {
+    glm::dvec3 x;  // position relative to the origin
+    glm::dvec3 t;  // unit tangent
+};
+
+class Transporter {
+public:
+    Transporter(const FrameInput& in, const FrameSettings& s, FrameStats& stats)
+        : in_(in), method_(s.method), max_depth_(s.max_subdivision_depth ? s.max_subdivision_depth : 10),
+          stats_(stats), origin_noise_(1e-13 * max_abs(in.origin_m)) {}
+
+    /// Carries normal r0 at a (on segment seg at parameter ta) to b (at parameter tb of the same segment, or the
+    /// next ring whose position equals that point).
+    glm::dvec3 step(uint32_t seg, double ta, const Sample& a, const glm::dvec3& r0, double tb, const Sample& b) {
+        switch (method_) {
+            case FrameMethod::rotation: return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
+            case FrameMethod::projection: return orthonormalize(r0, b.t);
+            case FrameMethod::double_reflection: break;
+        }
+        return reflect(seg, ta, a, r0, tb, b, 0);
+    }
+
+private:
+    glm::dvec3 reflect(uint32_t seg, double ta, const Sample& a, const glm::dvec3& r0, double tb, const Sample& b,
+                       uint32_t depth) {
+        glm::dvec3 v1 = b.x - a.x;
+        double c1 = glm::dot(v1, v1);
+        // Below the rounding noise of the positions the chord has no direction: a repeated point. The reflection
+        // about the plane normal to t0 + t1 takes t0 to -t1 and the second one (about t1) to t1, as needed.
+        const double noise = origin_noise_ + 1e-13 * (max_abs(a.x) + max_abs(b.x));
+        if (c1 <= noise * noise * 64.0) {
+            v1 = a.t + b.t;
+            c1 = glm::dot(v1, v1);
+            if (c1 < 1e-20) {  // tangent reverses at a point (cusp on a ring): minimal rotation
+                ++stats_.fallback_steps;
+                return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
+            }
+        }
+        const glm::dvec3 rl = r0 - (2.0 / c1) * glm::dot(v1, r0) * v1;
+        const glm::dvec3 tl = a.t - (2.0 / c1) * glm::dot(v1, a.t) * v1;
+        const glm::dvec3 v2 = b.t - tl;
+        const double c2 = glm::dot(v2, v2);
+        // Hairpin guard. c2 ~ 0: the tangent turns "the wrong way" within the step (a loop), the second mirror
+        // is ill-conditioned. A turn of more than 45 degrees in one step (a hairpin under coarse sampling): the
+        // method's error grows with the turn per step. Either way split the step at its parameter midpoint; at a
+        // cusp only the half containing it keeps splitting, so the cost is O(depth), not O(2^depth).
+        if (c2 < 0.1 || glm::dot(a.t, b.t) < kSplitCos) {
+            if (depth < max_depth_ && in_.curve != nullptr && tb > ta) {
+                if (depth == 0) {
+                    ++stats_.subdivided_steps;
+                }
+                const CubicBezier& c = in_.curve->segments[seg];
+                const double tm = 0.5 * (ta + tb);
+                Sample m{position(c, tm) - in_.origin_m, unit_tangent(c, tm)};
+                if (m.t == glm::dvec3(0.0)) {
+                    m.t = a.t;
+                }
+                const glm::dvec3 rm = reflect(seg, ta, a, r0, tm, m, depth + 1);
+                return reflect(seg, tm, m, rm, tb, b, depth + 1);
+            }
+            if (c2 < 1e-20) {
+                ++stats_.fallback_steps;
+                return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
+            }
+        }
+        const glm::dvec3 r1 = rl - (2.0 / c2) * glm::dot(v2, rl) * v2;
+        // Each reflection preserves length and the pair preserves handedness; re-project against rounding drift.
+        return orthonormalize(r1, b.t);
+    }
+
+    const FrameInput& in_;
+    FrameMethod method_;
+    uint32_t max_depth_;
+    FrameStats& stats_;
+    double origin_noise_;
+};
+
+}  // namespace
+
+glm::dvec3 seed_normal(const glm::dvec3& t) {
+    const glm::dvec3 a = glm::abs(t);
+    glm::dvec3 e{0.0};
+    if (a.x <= a.y && a.x <= a.z) {
+        e.x = 1.0;
+    } else if (a.y <= a.z) {
+        e.y = 1.0;
+    } else {
+        e.z = 1.0;
+    }
+    return glm::normalize(e - glm::dot(e, t) * t);
+}
+
+glm::dvec3 unit_tangent(const CubicBezier& c, double t, bool* degenerate) {
+    const double extent = std::max({max_abs(c.b1 - c.b0), max_abs(c.b2 - c.b0), max_abs(c.b3 - c.b0)});
+    // Derivatives below this are rounding noise of the control-point differences (or exactly zero).
+    const double tiny = 1e-10 * extent + 1e-15 * max_abs(c.b0) + 1e-300;
+    const glm::dvec3 d1 = derivative(c, t);
+    const double l1 = glm::length(d1);
+    if (l1 > tiny) {
+        if (degenerate) *degenerate = false;
+        return d1 / l1;
+    }
+    if (degenerate) *degenerate = true;
+    // One-sided limits: B'(t + h) ~ h B''(t); at t = 1 only the left side exists, B'(1 - h) ~ -h B''(1).
+    const double side = t >= 1.0 ? -1.0 : 1.0;
+    const glm::dvec3 d2 = side * second_derivative(c, t);
+    const double l2 = glm::length(d2);
+    if (l2 > tiny) {
+        return d2 / l2;
+    }
+    const glm::dvec3 d3 = 6.0 * (c.b3 - 3.0 * c.b2 + 3.0 * c.b1 - c.b0);  // B'(t+h) ~ h^2/2 B'''
+    const double l3 = glm::length(d3);
+    if (l3 > tiny) {
+        return d3 / l3;
+    }
+    const glm::dvec3 chord = c.b3 - c.b0;
+    const double lc = glm::length(chord);
+    if (lc > tiny) {
+        return chord / lc;
+    }
+    return glm::dvec3(0.0);
+}
+
+FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, std::span<Frame> out) {
+    FrameStats stats;
+    const std::size_t n = in.params.size();
+    assert(out.size() == n && in.centre_m.size() == n && in.tangent.size() == n && "compute_frames: sizes");
+    if (n == 0) {
+        return stats;
+    }
+    const bool closed = in.curve != nullptr && in.curve->closed;
+
+    // Tangents: zero ones (a segment that is one point) take the previous ring's, the leading ones the first valid.
+    std::size_t first_valid = n;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (in.tangent[i] != glm::dvec3(0.0)) {
+            first_valid = i;
+            break;
+        }
+    }
+    glm::dvec3 prev_t = first_valid < n ? in.tangent[first_valid] : glm::dvec3(0.0, 0.0, 1.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (in.tangent[i] == glm::dvec3(0.0)) {
+            ++stats.degenerate_tangents;
+            out[i].t = prev_t;
+        } else {
+            out[i].t = in.tangent[i];
+            prev_t = in.tangent[i];
+        }
+    }
+
+    // First frame: carried over from the previous state when possible, else seeded from the least-aligned axis.
+    const glm::dvec3 t0 = out[0].t;
+    glm::dvec3 r0 = seed_normal(t0);
+    if (settings.has_previous_normal) {
+        const glm::dvec3 p = settings.previous_normal - glm::dot(settings.previous_normal, t0) * t0;
+        const double len = glm::length(p);
+        if (len > 1e-6 && std::isfinite(len)) {
+            r0 = p / len;
+            stats.seeded_from_previous = true;
+        }
+    }
+    out[0].r = r0;
+    out[0].s = glm::cross(t0, r0);
+
+    Transporter transport(in, settings, stats);
+    for (std::size_t i = 1; i < n; ++i) {
+        const RingParam& pa = in.params[i - 1];
+        const RingParam& pb = in.params[i];
+        const double tb = pb.segment == pa.segment ? pb.t : 1.0;
+        const glm::dvec3 r = transport.step(pa.segment, pa.t, Sample{in.centre_m[i - 1], out[i - 1].t}, out[i - 1].r,
+                                            tb, Sample{in.centre_m[i], out[i].t});
+        out[i].r = r;
+        out[i].s = glm::cross(out[i].t, r);
+    }
+
+    if (closed && n >= 1) {
+        // Transport once more, from the last ring back to ring 0 (t = 1 of the last segment), and measure the twist.
+        const RingParam& pa = in.params[n - 1];
+        const glm::dvec3 r_end = transport.step(pa.segment, pa.t, Sample{in.centre_m[n - 1], out[n - 1].t},
+                                                out[n - 1].r, 1.0, Sample{in.centre_m[0], out[0].t});
+        const double delta = std::atan2(glm::dot(glm::cross(out[0].r, r_end), out[0].t), glm::dot(out[0].r, r_end));
+        stats.holonomy_rad = delta;
+        if (!settings.keep_holonomy && delta != 0.0) {
+            // Arc length per ring; chord lengths if none were given.
+            double total = 0.0;
+            const bool have_s = in.arc_length_m.size() == n + 1;
+            if (have_s) {
+                total = in.arc_length_m[n];
+            } else {
+                for (std::size_t i = 0; i < n; ++i) {
+                    total += glm::length(in.centre_m[(i + 1) % n] - in.centre_m[i]);
+                }
+            }
+            double s = 0.0;
+            for (std::size_t i = 1; i < n; ++i) {
+                s = have_s ? in.arc_length_m[i] : s + glm::length(in.centre_m[i] - in.centre_m[i - 1]);
+                const double angle = total > 0.0 ? -delta * s / total : 0.0;
+                const double ca = std::cos(angle);
+                const double sa = std::sin(angle);
+                const glm::dvec3 r = ca * out[i].r + sa * out[i].s;  // rotation about t by angle
+                out[i].s = ca * out[i].s - sa * out[i].r;
+                out[i].r = r;
+            }
+        }
+    }
+    return stats;
+}
+
+}  // namespace wire

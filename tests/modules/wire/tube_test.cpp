@@ -1,0 +1,163 @@
+// Tube mesh: counts, watertight (welded) with caps and on closed loops, outward CCW winding, flat caps, seam and
+// uv ranges, reuse without allocation, and a reference checksum.
+#include "ring_test_curves.hpp"
+
+#include <cstdio>
+
+namespace wire::test {
+namespace {
+
+/// Every non-degenerate triangle's geometric normal points along its vertex normals (outward, CCW from outside).
+void expect_outward(const TubeMesh& mesh) {
+    std::size_t bad = 0, checked = 0;
+    for (std::size_t k = 0; k + 2 < mesh.indices.size(); k += 3) {
+        const TubeVertex& a = mesh.vertices[mesh.indices[k]];
+        const TubeVertex& b = mesh.vertices[mesh.indices[k + 1]];
+        const TubeVertex& c = mesh.vertices[mesh.indices[k + 2]];
+        const glm::vec3 face = glm::cross(b.position - a.position, c.position - a.position);
+        if (glm::length(face) < 1e-12f) continue;
+        ++checked;
+        if (glm::dot(face, a.normal + b.normal + c.normal) <= 0.0f) ++bad;
+    }
+    EXPECT_GT(checked, 0u);
+    EXPECT_EQ(bad, 0u) << "inward-facing triangles";
+}
+
+void expect_uv_ranges(const TubeMesh& mesh) {
+    for (const TubeVertex& v : mesh.vertices) {
+        ASSERT_TRUE(v.uv.y >= 0.0f && v.uv.y <= 1.0f);
+        ASSERT_TRUE(std::isfinite(v.uv.x) && finite(v.position) && finite(v.normal));
+        ASSERT_NEAR(glm::length(v.normal), 1.0f, 1e-5f);
+    }
+}
+
+TEST(Tube, OpenWithCapsIsWatertightAndOutward) {
+    Curve c = helix_curve(1.0, 0.3, 2, 8);
+    c.radius_m[3] = 0.2f;  // varying radius: tilted normals
+    const RingSet set = rings_for(c, 4);
+    for (uint32_t sides : {3u, 8u, 12u}) {
+        TubeMesh mesh;
+        build_tube(set, TubeSettings{.sides = sides}, mesh);
+        const TubeCounts counts = tube_counts(set.rings.size(), false, TubeSettings{.sides = sides});
+        EXPECT_EQ(mesh.vertices.size(), set.rings.size() * (sides + 1) + 2 * (sides + 1));
+        EXPECT_EQ(mesh.indices.size(), counts.indices);
+        const WeldReport w = weld_check(mesh);
+        EXPECT_EQ(w.bad_edges, 0u);
+        EXPECT_EQ(w.inconsistent_edges, 0u);
+        EXPECT_EQ(w.degenerate_triangles, 0u);
+        expect_outward(mesh);
+        expect_uv_ranges(mesh);
+        // Caps are flat: every cap vertex has the end tangent as normal.
+        const std::size_t cap0 = set.rings.size() * (sides + 1);
+        for (std::size_t j = 0; j <= sides; ++j) {
+            EXPECT_LT(glm::length(glm::dvec3(mesh.vertices[cap0 + j].normal) + set.frames.front().t), 1e-6);
+            EXPECT_LT(glm::length(glm::dvec3(mesh.vertices[cap0 + sides + 1 + j].normal) - set.frames.back().t), 1e-6);
+        }
+        // Seam: the duplicated vertex sits on the first one with v = 1.
+        for (std::size_t i = 0; i < set.rings.size(); ++i) {
+            const TubeVertex& first = mesh.vertices[i * (sides + 1)];
+            const TubeVertex& seam = mesh.vertices[i * (sides + 1) + sides];
+            EXPECT_EQ(first.position, seam.position);
+            EXPECT_EQ(first.uv.y, 0.0f);
+            EXPECT_EQ(seam.uv.y, 1.0f);
+            EXPECT_EQ(first.uv.x, seam.uv.x);
+        }
+    }
+}
+
+TEST(Tube, WithoutCapsHasTwoOpenEnds) {
+    const RingSet set = rings_for(helix_curve(1.0, 0.3, 1, 8), 2);
+    TubeMesh mesh;
+    build_tube(set, TubeSettings{.sides = 8, .caps = false}, mesh);
+    const WeldReport w = weld_check(mesh);
+    EXPECT_EQ(w.bad_edges, 2u * 8u);  // the two boundary loops
+    EXPECT_EQ(w.inconsistent_edges, 0u);
+}
+
+// A closed loop of 3 nodes joins its last ring to its first: no cap, watertight, u continues over the join.
+TEST(Tube, ClosedLoopJoinsWithoutSeam) {
+    const Curve loop = catmull_rom_curve({{1, 0, 0.2}, {-0.5, 0.866, -0.2}, {-0.5, -0.866, 0.3}}, 0.05f, true);
+    const RingSet set = rings_for(loop, 8);
+    expect_orthonormal(set);
+    TubeMesh mesh;
+    build_tube(set, TubeSettings{.sides = 10}, mesh);
+    EXPECT_EQ(mesh.vertices.size(), (set.rings.size() + 1) * 11u);
+    const WeldReport w = weld_check(mesh);
+    EXPECT_EQ(w.bad_edges, 0u);
+    EXPECT_EQ(w.inconsistent_edges, 0u);
+    expect_outward(mesh);
+    expect_uv_ranges(mesh);
+    const TubeVertex& last_row = mesh.vertices[set.rings.size() * 11u];
+    EXPECT_EQ(last_row.position, mesh.vertices[0].position);
+    EXPECT_FLOAT_EQ(last_row.uv.x, static_cast<float>(set.u.back()));
+    EXPECT_GT(last_row.uv.x, set.rings.back().u);
+    EXPECT_NEAR(set.u.back() - set.u[0], set.length_m / (2 * kPi * 0.05), 1e-6 * set.u.back());
+}
+
+// Straight wire, zero-length segment, radius 1e-6, far origin: finite and watertight (after welding).
+TEST(Tube, HardCasesStayWatertight) {
+    std::vector<Curve> curves;
+    curves.push_back(polyline_curve({{0, 0, 0}, {0, 0, 1}, {0, 0, 2}}, 0.1f));
+    curves.push_back(make_curve({hermite({0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}),
+                                 CubicBezier{{1, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}},
+                                 hermite({1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 1, 0})},
+                                0.05f));
+    curves.push_back(helix_curve(0.01, 0.003, 1, 8, {}, 1e-6f));
+    curves.push_back(helix_curve(1.0, 0.3, 1, 8, {1e6, 1e6, -1e6}, 0.01f));
+    for (std::size_t k = 0; k < curves.size(); ++k) {
+        const RingSet set = rings_for(curves[k], 4);
+        expect_orthonormal(set);
+        expect_u_monotonic(set);
+        TubeMesh mesh;
+        build_tube(set, TubeSettings{.sides = 8}, mesh);
+        expect_uv_ranges(mesh);
+        const WeldReport w = weld_check(mesh);
+        EXPECT_EQ(w.bad_edges, 0u) << "curve " << k;
+        EXPECT_EQ(w.inconsistent_edges, 0u) << "curve " << k;
+    }
+}
+
+TEST(Tube, ReusedBuffersAndArenaOffsets) {
+    const RingSet set = rings_for(helix_curve(1.0, 0.3, 1, 8), 4);
+    TubeMesh mesh;
+    build_tube(set, TubeSettings{}, mesh);
+    const TubeVertex* v = mesh.vertices.data();
+    const uint32_t* i = mesh.indices.data();
+    build_tube(set, TubeSettings{}, mesh);
+    EXPECT_EQ(mesh.vertices.data(), v);
+    EXPECT_EQ(mesh.indices.data(), i);
+    // Writing into an arena at a vertex offset shifts the indices only.
+    std::vector<TubeVertex> arena(mesh.vertices.size() + 100);
+    std::vector<uint32_t> idx(mesh.indices.size());
+    write_tube(set.rings, false, 0.0f, TubeSettings{}, std::span(arena).subspan(100), idx, 100);
+    for (std::size_t k = 0; k < idx.size(); ++k) ASSERT_EQ(idx[k], mesh.indices[k] + 100);
+}
+
+constexpr double kReferenceChecksum = 55651.975628;
+constexpr uint64_t kReferenceIndexChecksum = 7087155;
+
+// Reference: counts and a checksum of a fixed mesh. Regenerate (after an intended change) by running this test and
+// copying the printed values.
+TEST(Tube, ReferenceChecksum) {
+    const RingSet set = rings_for(helix_curve(1.0, 0.3, 1, 4), 3);
+    TubeMesh mesh;
+    build_tube(set, TubeSettings{.sides = 6}, mesh);
+    double sum = 0.0;
+    for (std::size_t k = 0; k < mesh.vertices.size(); ++k) {
+        const TubeVertex& v = mesh.vertices[k];
+        const double w = 1.0 + static_cast<double>(k % 7);
+        sum += w * (v.position.x + 2 * v.position.y + 3 * v.position.z + 5 * v.normal.x + 7 * v.normal.y +
+                    11 * v.normal.z + 13 * v.uv.x + 17 * v.uv.y);
+    }
+    uint64_t isum = 0;
+    for (std::size_t k = 0; k < mesh.indices.size(); ++k) isum += (k + 1) * mesh.indices[k];
+    std::printf("  reference: %zu vertices, %zu indices, checksum %.6f, index checksum %llu\n", mesh.vertices.size(),
+                mesh.indices.size(), sum, static_cast<unsigned long long>(isum));
+    EXPECT_EQ(mesh.vertices.size(), 13u * 7u + 2u * 7u);
+    EXPECT_EQ(mesh.indices.size(), 12u * 36u + 2u * 18u);
+    EXPECT_NEAR(sum, kReferenceChecksum, 1e-3);
+    EXPECT_EQ(isum, kReferenceIndexChecksum);
+}
+
+}  // namespace
+}  // namespace wire::test
