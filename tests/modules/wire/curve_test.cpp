@@ -254,3 +254,344 @@ TEST(WireCurveContinuity, CurvatureTensionFollowsTheThesis) {
     n.area_m2[1] = 0.0;
     EXPECT_EQ(build_curve(n, {}, c).message, "node 1: area_m2 is 0 (must be > 0)");
 }
+
+// ---------------------------------------------------------------------------------------------------------
+// The exact catenary reference.
+
+TEST(WireCatenary, SolvesEndsArcLengthAndDistanceForAnySag) {
+    for (double ratio : {1.0 + 1e-12, 1.0 + 1e-6, 1.05, 1.25, 3.0, 100.0}) {
+        const dvec3 p1(1e6, 2.0, -3.0), p2 = p1 + dvec3(12.0, -2.0, 5.0);
+        const double L = glm::length(p2 - p1) * ratio;
+        Catenary c;
+        ASSERT_TRUE(c.solve(p1, p2, L).ok) << ratio;
+        EXPECT_LT(glm::length(c.point_at_arc_length(L) - p2), 1e-9 * L) << ratio;
+        EXPECT_NEAR(c.arc_length_at(c.span_m()), L, 1e-12 * L) << ratio;
+        // Arc length of a dense polyline through the reference agrees with s(x).
+        if (ratio < 10.0) {
+            double poly = 0.0;
+            dvec3 prev = c.point_at_x(0.0);
+            for (int i = 1; i <= 20000; ++i) {
+                const dvec3 p = c.point_at_x(c.span_m() * i / 20000.0);
+                poly += glm::length(p - prev), prev = p;
+            }
+            EXPECT_NEAR(poly, L, 1e-6 * L) << ratio;
+        }
+        const dvec3 mid = c.point_at_arc_length(0.4 * L);
+        EXPECT_LT(c.distance(mid), 1e-9) << ratio;
+        EXPECT_LE(c.distance(mid + dvec3(0.0, 0.0, 1e-3)), 1e-3 + 1e-12) << ratio;  // at most the offset
+    }
+    Catenary c;
+    EXPECT_FALSE(c.solve(dvec3(0.0), dvec3(1.0, 0.0, 0.0), 0.5).ok);
+    EXPECT_FALSE(c.solve(dvec3(0.0), dvec3(0.0, 1.0, 0.0), 5.0).ok);
+}
+
+TEST(WireCatenary, DistanceOfAnOffsetPointIsTheOffset) {
+    const Catenary c = hanging_cable();
+    for (double s : {0.5, 5.0, 10.0, 17.0}) {
+        const dvec3 p = c.point_at_arc_length(s);
+        const double x = c.x_at_arc_length(s), slope = c.slope(x);
+        const dvec3 normal = glm::normalize(dvec3(-slope, 1.0, 0.0));
+        EXPECT_NEAR(c.distance(p + 0.01 * normal), 0.01, 1e-9) << s;
+        EXPECT_NEAR(c.distance(p + dvec3(0.0, 0.0, 0.02)), 0.02, 1e-12) << s;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Accuracy against the exact catenary, per spline kind. 20 m cable, (0,0,0) -> (16,2,0), 16 nodes.
+// Bounds are the measured values (wire_curve_report) plus ~25%. Why they are what they are:
+//  linear: the sagitta h^2/(8a) = 1.333^2/(8*6.845) = 0.0325 m (measured 0.03238);
+//  Catmull-Rom (any alpha): dominated by the end segments, whose phantom-node tangent is the chord, off by
+//  half the segment's turning: O(h^2), measured 7.47e-3 (n=32: 1.73e-3, ratio 4.3);
+//  automatic: chordal interior + quadratic end tangents: 1.41e-3 (n=32: 1.47e-4, ~h^3);
+//  c2 (not-a-knot): O(h^4): 1.006e-4 (n=32: 5.77e-6, ratio 17).
+// Dense-end spacing (s = L(1-cos)/2) has longer middle elements (pi/2 x mean) and lifts the interior error.
+
+struct CatenaryBound {
+    const char* name;
+    double even_m, dense_m;
+};
+
+TEST(WireCurveAccuracy, EverySplineKindStaysNearTheExactCatenary) {
+    const Catenary cable = hanging_cable();
+    const CatenaryBound bounds[] = {
+        {"uniform", 9.5e-3, 7.5e-3},          // measured 7.470e-3, 5.783e-3
+        {"centripetal", 9.5e-3, 6.0e-3},      // measured 7.470e-3, 4.613e-3
+        {"chordal", 9.5e-3, 4.5e-3},          // measured 7.469e-3, 3.503e-3
+        {"centripetal+tension1", 4.1e-2, 9.7e-2},  // = linear
+        {"c2", 1.3e-4, 7.0e-4},               // measured 1.006e-4, 5.588e-4
+        {"automatic", 1.8e-3, 4.5e-3},        // measured 1.412e-3, 3.503e-3
+        {"linear", 4.1e-2, 9.7e-2},           // measured 3.238e-2, 7.699e-2
+    };
+    const std::vector<NamedSettings> variants = spline_variants();
+    ASSERT_EQ(variants.size(), std::size(bounds));
+    for (std::size_t i = 0; i < variants.size(); ++i) {
+        ASSERT_EQ(variants[i].name, bounds[i].name);
+        for (bool dense : {false, true}) {
+            const WireNodes n = cable_nodes(cable, 16, dense);
+            Curve c;
+            ASSERT_TRUE(build_curve(n, variants[i].settings, c).ok);
+            expect_valid_interpolating(c, n, variants[i].name);
+            const double err = catenary_error_m(c, cable);
+            EXPECT_LT(err, dense ? bounds[i].dense_m : bounds[i].even_m) << variants[i].name << (dense ? " dense" : " even");
+            ::testing::Test::RecordProperty(variants[i].name + (dense ? "_dense_err_m" : "_even_err_m"), std::to_string(err));
+        }
+    }
+}
+
+TEST(WireCurveAccuracy, ConvergenceOrders) {
+    const Catenary cable = hanging_cable();
+    auto err = [&](SplineSettings s, int count) {
+        Curve c;
+        EXPECT_TRUE(build_curve(cable_nodes(cable, count), s, c).ok);
+        return catenary_error_m(c, cable);
+    };
+    // Halving the spacing (16 -> 32 nodes is h * 15/31): O(h^2) gives ~4.3, O(h^4) ~18.
+    EXPECT_GT(err({.alpha = 0.5}, 16) / err({.alpha = 0.5}, 32), 3.5);
+    EXPECT_GT(err({.kind = SplineKind::c2}, 16) / err({.kind = SplineKind::c2}, 32), 12.0);
+    EXPECT_GT(err({.kind = SplineKind::automatic}, 16) / err({.kind = SplineKind::automatic}, 32), 6.0);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// The thesis' open problem: a stretched straight run then a tight bend (curve_cases.hpp). The automatic kind
+// must stay on the straight line (chordal bulges 0.28 m, centripetal 0.054 m there) without overshooting the
+// corner more than centripetal, and stay G1 (tension 1 leaves a 180-degree tangent reversal, linear 90).
+
+TEST(WireCurveAutomatic, StretchedRunThenTightBendStaysOnTheLine) {
+    for (float stretch : {1.0f, 1.02f}) {
+        Curve aut, cen, cho;
+        const WireNodes n = stretched_bend_nodes(stretch);
+        ASSERT_TRUE(build_curve(n, {.kind = SplineKind::automatic}, aut).ok);
+        ASSERT_TRUE(build_curve(n, {.alpha = 0.5}, cen).ok);
+        ASSERT_TRUE(build_curve(n, {.alpha = 1.0}, cho).ok);
+        const BendNumbers a = measure_bend(aut), c = measure_bend(cen), h = measure_bend(cho);
+        EXPECT_LT(a.straight_dev_m, 5e-5);  // measured 1.85e-5 m over a 10 m run
+        EXPECT_LT(a.overshoot_m, 8e-3);     // measured 7.41e-3 = (4/27) * 0.5 * 0.1 m
+        EXPECT_LT(a.kink_deg, 1e-6);
+        EXPECT_LT(a.straight_dev_m * 100.0, c.straight_dev_m);
+        EXPECT_LT(a.straight_dev_m * 1000.0, h.straight_dev_m);
+        EXPECT_LT(a.overshoot_m, c.overshoot_m);
+    }
+}
+
+TEST(WireCurveAutomatic, SmoothSagIsExactlyChordalInTheInterior) {
+    const Catenary cable = hanging_cable();
+    const WireNodes n = cable_nodes(cable, 16);
+    Curve a, c;
+    ASSERT_TRUE(build_curve(n, {.kind = SplineKind::automatic}, a).ok);
+    ASSERT_TRUE(build_curve(n, {.alpha = 1.0}, c).ok);
+    for (std::size_t k = 1; k + 1 < a.segment_count(); ++k) {
+        EXPECT_LT(glm::length(a.segments[k].b1 - c.segments[k].b1), 1e-12);
+        EXPECT_LT(glm::length(a.segments[k].b2 - c.segments[k].b2), 1e-12);
+    }
+}
+
+TEST(WireCurveAutomatic, SharpnessMovesContinuouslyWithTheNodes) {
+    // Sweep a bend angle through the whole smoothstep range: the curve must change by a small amount per
+    // small step of the input (no jumps), while going from chordal to bend-hugging.
+    Curve prev;
+    double worst = 0.0;
+    for (int i = 0; i <= 400; ++i) {
+        const double angle = kPi * i / 400.0 * 0.9;
+        const WireNodes n = make_nodes({dvec3(-6.0, 0.0, 0.0), dvec3(-4.0, 0.0, 0.0), dvec3(-2.0, 0.0, 0.0), dvec3(0.0),
+                                        dvec3(0.3 * std::cos(angle), -0.3 * std::sin(angle), 0.0),
+                                        dvec3(2.3 * std::cos(angle), -2.3 * std::sin(angle), 0.0)});
+        Curve c;
+        ASSERT_TRUE(build_curve(n, {.kind = SplineKind::automatic}, c).ok);
+        if (i > 0) worst = std::max(worst, curve_jump_m(prev, c, 32));
+        prev = c;
+    }
+    // Node 4 moves 0.3 * 0.9 pi / 400 = 2.1 mm per step; the curve may move a few times that, never jump.
+    EXPECT_LT(worst, 0.02);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// DESIGN 5 hard cases that concern the curve: finite output, interpolation, specific errors.
+
+TEST(WireCurveHardCases, CoincidentNodesExactAnd1e9ApartAreMerged) {
+    for (double gap : {0.0, 1e-9}) {
+        const WireNodes n = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.0 + gap, 0.0, 0.0),
+                                        dvec3(2.0, 1.0, 0.0), dvec3(3.0, 1.0, 0.5)});
+        const WireNodes ref = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0), dvec3(3.0, 1.0, 0.5)});
+        for (const NamedSettings& v : spline_variants()) {
+            Curve c, r;
+            ASSERT_TRUE(build_curve(n, v.settings, c).ok) << v.name;
+            ASSERT_TRUE(build_curve(ref, v.settings, r).ok) << v.name;
+            expect_valid_interpolating(c, n, v.name);
+            ASSERT_EQ(c.node_count(), 4u) << v.name;
+            EXPECT_EQ(c.source_node, (std::vector<uint32_t>{0, 1, 3, 4})) << v.name;  // the first of the pair is kept
+            for (std::size_t k = 0; k < 3; ++k) EXPECT_LT(glm::length(c.segments[k].b1 - r.segments[k].b1), 1e-12) << v.name;
+        }
+    }
+}
+
+TEST(WireCurveHardCases, UnmergedNearCoincidentNodesGiveTheCentripetalLimit) {
+    // With merging effectively off, 1e-9-apart nodes stay: the centripetal tangent there tends to 0 (it is
+    // ~sqrt(1e-9) long), so the curve makes no loop: every sample stays within a few mm of the polyline.
+    const WireNodes n = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.0 + 1e-9, 1e-9, 0.0), dvec3(2.0, 1.0, 0.0)});
+    for (double alpha : {0.5, 1.0}) {
+        Curve c;
+        ASSERT_TRUE(build_curve(n, {.alpha = alpha, .merge_epsilon_rel = 1e-15}, c).ok);
+        ASSERT_EQ(c.node_count(), 4u);
+        expect_valid_interpolating(c, n, "near-coincident");
+        const std::vector<dvec3> poly(n.positions.begin(), n.positions.end());
+        double worst = 0.0;
+        for (const dvec3& p : sample_curve(c, 256)) worst = std::max(worst, distance_to_polyline(p, poly));
+        EXPECT_LT(worst, 0.2) << alpha;
+        // The tiny segment's tangents are tiny (centripetal limit 0), not "uniform" sized.
+        EXPECT_LT(glm::length(c.segments[1].b1 - c.segments[1].b0), alpha == 0.5 ? 1e-4 : 1e-8) << alpha;
+    }
+}
+
+TEST(WireCurveHardCases, ExactlyStraightWireStaysStraight) {
+    WireNodes n;
+    for (int i = 0; i < 9; ++i) n.positions.push_back(dvec3(1.0, 2.0, 3.0) + (i * i * 0.37 + i) * glm::normalize(dvec3(1.0, -2.0, 0.5)));
+    for (const NamedSettings& v : spline_variants()) {
+        Curve c;
+        ASSERT_TRUE(build_curve(n, v.settings, c).ok) << v.name;
+        expect_valid_interpolating(c, n, v.name);
+        const dvec3 dir = glm::normalize(dvec3(1.0, -2.0, 0.5));
+        for (const dvec3& p : sample_curve(c, 32)) EXPECT_LT(glm::length(glm::cross(p - dvec3(1.0, 2.0, 3.0), dir)), 1e-12) << v.name;
+    }
+}
+
+TEST(WireCurveHardCases, HairpinSpacingRatioAndFarFromOrigin) {
+    const std::vector<std::vector<dvec3>> cases = {
+        {dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 0.0, 0.0) + dvec3(0.0, 1e-3, 0.0), dvec3(-1.0, 1e-3, 0.0)},  // 180-degree hairpin
+        {dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0)},                             // exact reversal
+        {dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.0 + 1e-6, 1e-6, 0.0), dvec3(2.0, 1.0, 0.0), dvec3(2.0, 1.0 + 1e-6, 0.0)},  // ratio 1e6
+    };
+    for (const auto& base : cases) {
+        for (double offset : {0.0, 1e6}) {
+            WireNodes n;
+            for (const dvec3& p : base) n.positions.push_back(p + dvec3(offset, -offset, offset));
+            for (const NamedSettings& v : spline_variants()) {
+                for (bool closed : {false, true}) {
+                    SplineSettings s = v.settings;
+                    s.closed = closed;
+                    Curve c;
+                    const Status st = build_curve(n, s, c);
+                    ASSERT_TRUE(st.ok) << v.name << ": " << st.message;
+                    expect_valid_interpolating(c, n, v.name);
+                    for (const dvec3& p : sample_curve(c, 16)) ASSERT_TRUE(finite(p));
+                }
+            }
+        }
+    }
+}
+
+TEST(WireCurveHardCases, FarFromOriginMatchesTheSameWireAtTheOrigin) {
+    const Catenary cable = hanging_cable();
+    const WireNodes near_origin = cable_nodes(cable, 16, true);
+    WireNodes far = near_origin;
+    const dvec3 offset(1e6, 1e6, -1e6);
+    for (dvec3& p : far.positions) p += offset;
+    for (const NamedSettings& v : spline_variants()) {
+        Curve a, b;
+        ASSERT_TRUE(build_curve(near_origin, v.settings, a).ok);
+        ASSERT_TRUE(build_curve(far, v.settings, b).ok);
+        double worst = 0.0;
+        for (std::size_t k = 0; k < a.segment_count(); ++k) {
+            worst = std::max(worst, glm::length(b.segments[k].b1 - offset - a.segments[k].b1));
+            worst = std::max(worst, glm::length(b.segments[k].b2 - offset - a.segments[k].b2));
+        }
+        // The coordinates' own spacing at 1e6 m is 1.2e-10 m (the node positions are already rounded to it).
+        EXPECT_LT(worst, 2e-9) << v.name;
+    }
+}
+
+TEST(WireCurveHardCases, ClosedLoopOfThreeNodes) {
+    const WireNodes n = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.2, 0.9, 0.0)});
+    for (const NamedSettings& v : spline_variants()) {
+        SplineSettings s = v.settings;
+        s.closed = true;
+        Curve c;
+        ASSERT_TRUE(build_curve(n, s, c).ok) << v.name;
+        expect_valid_interpolating(c, n, v.name);
+        EXPECT_EQ(c.segment_count(), 3u);
+        EXPECT_TRUE(c.closed);
+        if (v.settings.kind == SplineKind::c2) {
+            EXPECT_LT(max_c2_mismatch(c), 1e-9);
+        }
+        if (v.settings.kind == SplineKind::catmull_rom && v.settings.tension == 0.0) {
+            EXPECT_LT(max_c1_mismatch(c, v.settings.alpha), 1e-9);
+        }
+    }
+}
+
+TEST(WireCurveHardCases, AlphaToZeroInABend) {
+    const WireNodes n = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.05, 0.05, 0.0), dvec3(1.0, 3.0, 0.0)});
+    Curve zero, tiny;
+    ASSERT_TRUE(build_curve(n, {.alpha = 0.0}, zero).ok);
+    ASSERT_TRUE(build_curve(n, {.alpha = 1e-12}, tiny).ok);
+    EXPECT_LT(curve_jump_m(zero, tiny), 1e-9);
+}
+
+TEST(WireCurveHardCases, HundredThousandNodesInLinearTime) {
+    WireNodes n;
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> g(0.0, 0.05);
+    dvec3 p(0.0), dir(1.0, 0.0, 0.0);
+    for (int i = 0; i < 100000; ++i) {
+        dir = glm::normalize(dir + dvec3(g(rng), g(rng), g(rng)));
+        p += 0.01 * dir;
+        n.positions.push_back(p);
+    }
+    for (const NamedSettings& v : spline_variants()) {
+        Curve c;
+        const auto t0 = std::chrono::steady_clock::now();
+        ASSERT_TRUE(build_curve(n, v.settings, c).ok) << v.name;
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        EXPECT_EQ(c.segment_count(), 99999u);
+        for (const CubicBezier& s : c.segments) ASSERT_TRUE(finite(s.b1) && finite(s.b2)) << v.name;
+        EXPECT_LT(ms, 2000.0) << v.name;  // O(n): ~10-30 ms in Release; generous for debug/sanitizer builds
+        ::testing::Test::RecordProperty(v.name + "_100k_ms", std::to_string(ms));
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Randomized properties (fixed seed): random and adversarial node arrays and settings never crash, never give
+// NaN, and either succeed with an interpolating curve or fail with a message.
+
+TEST(WireCurveProperties, RandomNodeArrays) {
+    std::mt19937_64 rng(20261121);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::uniform_int_distribution<int> count(0, 40), pick(0, 9);
+    int ok = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        WireNodes n;
+        const int size = count(rng);
+        const double scale = std::pow(10.0, 6.0 * unit(rng));
+        const dvec3 origin = dvec3(unit(rng), unit(rng), unit(rng)) * std::pow(10.0, 3.0 + 3.0 * unit(rng));
+        for (int i = 0; i < size; ++i) {
+            const int kind = pick(rng);
+            if (kind == 0 && !n.positions.empty()) n.positions.push_back(n.positions.back());  // exact duplicate
+            else if (kind == 1 && !n.positions.empty()) n.positions.push_back(n.positions.back() + 1e-12 * scale * dvec3(unit(rng), unit(rng), unit(rng)));
+            else if (kind == 2 && n.positions.size() >= 2) n.positions.push_back(n.positions[n.positions.size() - 2]);  // hairpin
+            else n.positions.push_back(origin + scale * dvec3(unit(rng), unit(rng), unit(rng)));
+        }
+        if (pick(rng) == 0 && size > 0) n.positions[static_cast<std::size_t>(size / 2)].x = std::numeric_limits<double>::quiet_NaN();
+        if (pick(rng) < 3) n.stretch.assign(n.positions.size(), static_cast<float>(1.0 + 0.1 * unit(rng)));
+        if (pick(rng) < 3) {
+            n.kb_tension.resize(n.positions.size());
+            for (float& t : n.kb_tension) t = static_cast<float>(unit(rng));
+        }
+        SplineSettings s;
+        s.kind = static_cast<SplineKind>(pick(rng) % 4);
+        s.alpha = 1.2 * unit(rng) + 0.6;
+        s.tension = pick(rng) < 5 ? 0.0 : unit(rng);
+        s.bias = pick(rng) < 5 ? 0.0 : unit(rng);
+        s.continuity = pick(rng) < 5 ? 0.0 : unit(rng);
+        s.closed = pick(rng) < 3;
+        Curve c;
+        const Status st = build_curve(n, s, c);
+        if (!st.ok) {
+            EXPECT_FALSE(st.message.empty());
+            EXPECT_EQ(c.segment_count(), 0u);
+            continue;
+        }
+        ++ok;
+        expect_valid_interpolating(c, n, "trial " + std::to_string(trial));
+        for (const dvec3& p : sample_curve(c, 4)) ASSERT_TRUE(finite(p)) << trial;
+    }
+    EXPECT_GT(ok, 2000);  // most random inputs are valid wires
+}
