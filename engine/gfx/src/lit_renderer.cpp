@@ -39,38 +39,39 @@ void main() {
 }  // namespace
 
 Expected<LitRenderer> LitRenderer::create() {
-  Expected<Program> program = make_program({.vertex = kVertex, .fragment = kFragment, .label = "lit"});
-  if (!program) return program.error();
-  LitRenderer r;
-  r.program_ = std::move(program).value();
-  return r;
+    Expected<Program> program = make_program({.vertex = kVertex, .fragment = kFragment, .label = "lit"});
+    if (!program) return program.error();
+    LitRenderer r;
+    r.program_ = std::move(program).value();
+    return r;
 }
 
 void LitRenderer::begin(const glm::mat4& clip_from_world, const DirectionalLight& light) const {
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glEnable(GL_CULL_FACE);
-  glCullFace(GL_BACK);
-  glFrontFace(GL_CCW);
-  program_.use();
-  program_.set("u_clip_from_world", clip_from_world);
-  program_.set("u_to_light", glm::normalize(light.to_light));
-  program_.set("u_light_color", light.color);
-  program_.set("u_ambient", light.ambient);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+    program_.use();
+    program_.set("u_clip_from_world", clip_from_world);
+    program_.set("u_to_light", glm::normalize(light.to_light));
+    program_.set("u_light_color", light.color);
+    program_.set("u_ambient", light.ambient);
 }
 
-void LitRenderer::draw(const GpuMesh& mesh, const glm::mat4& world_from_model, const glm::vec3& albedo) const {
-  program_.set("u_world_from_model", world_from_model);
-  program_.set("u_normal_matrix", glm::transpose(glm::inverse(glm::mat3(world_from_model))));
-  program_.set("u_albedo", albedo);
-  gfx::draw(mesh);
+void LitRenderer::draw(const GpuMesh& mesh, const glm::mat4& world_from_model,
+                       const glm::vec3& albedo) const {
+    program_.set("u_world_from_model", world_from_model);
+    program_.set("u_normal_matrix", glm::transpose(glm::inverse(glm::mat3(world_from_model))));
+    program_.set("u_albedo", albedo);
+    gfx::draw(mesh);
 }
 
 void clear(const glm::vec4& color) {
-  glClearColor(color.r, color.g, color.b, color.a);
-  glClearDepth(1.0);
-  glDepthMask(GL_TRUE);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glClearColor(color.r, color.g, color.b, color.a);
+    glClearDepth(1.0);
+    glDepthMask(GL_TRUE);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 }
 
 }  // namespace engine::gfx

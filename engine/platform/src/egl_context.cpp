@@ -13,196 +13,218 @@ namespace engine::platform {
 namespace {
 
 std::string egl_error_name(EGLint code) {
-  switch (code) {
-    case EGL_SUCCESS: return "EGL_SUCCESS";
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
-    default: return "EGL error 0x" + [code] {
-      char buf[16];
-      std::snprintf(buf, sizeof buf, "%x", static_cast<unsigned>(code));
-      return std::string(buf);
-    }();
-  }
+    switch (code) {
+        case EGL_SUCCESS:
+            return "EGL_SUCCESS";
+        case EGL_NOT_INITIALIZED:
+            return "EGL_NOT_INITIALIZED";
+        case EGL_BAD_ACCESS:
+            return "EGL_BAD_ACCESS";
+        case EGL_BAD_ALLOC:
+            return "EGL_BAD_ALLOC";
+        case EGL_BAD_ATTRIBUTE:
+            return "EGL_BAD_ATTRIBUTE";
+        case EGL_BAD_CONFIG:
+            return "EGL_BAD_CONFIG";
+        case EGL_BAD_CONTEXT:
+            return "EGL_BAD_CONTEXT";
+        case EGL_BAD_DISPLAY:
+            return "EGL_BAD_DISPLAY";
+        case EGL_BAD_MATCH:
+            return "EGL_BAD_MATCH";
+        case EGL_BAD_PARAMETER:
+            return "EGL_BAD_PARAMETER";
+        case EGL_BAD_SURFACE:
+            return "EGL_BAD_SURFACE";
+        default:
+            return "EGL error 0x" + [code] {
+                char buf[16];
+                std::snprintf(buf, sizeof buf, "%x", static_cast<unsigned>(code));
+                return std::string(buf);
+            }();
+    }
 }
 
-Error egl_failure(const std::string& what) { return Error{"EGL: " + what + " (" + egl_error_name(eglGetError()) + ")"}; }
+Error egl_failure(const std::string& what) {
+    return Error{"EGL: " + what + " (" + egl_error_name(eglGetError()) + ")"};
+}
 
 // Mesa hands out one EGLDisplay per platform; eglTerminate would destroy every context on it, so the
 // display is initialized once per process and terminated when the last headless context goes away.
 struct SharedDisplay {
-  std::mutex mutex;
-  EGLDisplay display = EGL_NO_DISPLAY;
-  int users = 0;
+    std::mutex mutex;
+    EGLDisplay display = EGL_NO_DISPLAY;
+    int users = 0;
 };
 SharedDisplay& shared_display() {
-  static SharedDisplay d;
-  return d;
+    static SharedDisplay d;
+    return d;
 }
 
 Expected<EGLDisplay> acquire_display() {
-  SharedDisplay& shared = shared_display();
-  std::lock_guard lock(shared.mutex);
-  if (shared.users > 0) {
-    ++shared.users;
-    return shared.display;
-  }
-  // Without any display, epoxy cannot know the EGL version yet: check the client extension string first.
-  const char* client_ext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-  if (client_ext == nullptr || std::string(client_ext).find("EGL_MESA_platform_surfaceless") == std::string::npos) {
-    return Error{"EGL: the surfaceless Mesa platform (EGL_MESA_platform_surfaceless) is not available"};
-  }
-  using GetPlatformDisplay = EGLDisplay (*)(EGLenum, void*, const EGLint*);
-  auto get_platform_display = reinterpret_cast<GetPlatformDisplay>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
-  if (get_platform_display == nullptr) return Error{"EGL: eglGetPlatformDisplayEXT is not available"};
-  EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (display == EGL_NO_DISPLAY) return egl_failure("no surfaceless display");
-  EGLint major = 0;
-  EGLint minor = 0;
-  if (eglInitialize(display, &major, &minor) != EGL_TRUE) return egl_failure("eglInitialize failed");
-  shared.display = display;
-  shared.users = 1;
-  return display;
+    SharedDisplay& shared = shared_display();
+    std::lock_guard lock(shared.mutex);
+    if (shared.users > 0) {
+        ++shared.users;
+        return shared.display;
+    }
+    // Without any display, epoxy cannot know the EGL version yet: check the client extension string first.
+    const char* client_ext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    if (client_ext == nullptr ||
+        std::string(client_ext).find("EGL_MESA_platform_surfaceless") == std::string::npos) {
+        return Error{"EGL: the surfaceless Mesa platform (EGL_MESA_platform_surfaceless) is not available"};
+    }
+    using GetPlatformDisplay = EGLDisplay (*)(EGLenum, void*, const EGLint*);
+    auto get_platform_display =
+        reinterpret_cast<GetPlatformDisplay>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (get_platform_display == nullptr) return Error{"EGL: eglGetPlatformDisplayEXT is not available"};
+    EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    if (display == EGL_NO_DISPLAY) return egl_failure("no surfaceless display");
+    EGLint major = 0;
+    EGLint minor = 0;
+    if (eglInitialize(display, &major, &minor) != EGL_TRUE) return egl_failure("eglInitialize failed");
+    shared.display = display;
+    shared.users = 1;
+    return display;
 }
 
 void release_display() {
-  SharedDisplay& shared = shared_display();
-  std::lock_guard lock(shared.mutex);
-  if (shared.users > 0 && --shared.users == 0) {
-    eglTerminate(shared.display);
-    eglReleaseThread();
-    shared.display = EGL_NO_DISPLAY;
-  }
+    SharedDisplay& shared = shared_display();
+    std::lock_guard lock(shared.mutex);
+    if (shared.users > 0 && --shared.users == 0) {
+        eglTerminate(shared.display);
+        eglReleaseThread();
+        shared.display = EGL_NO_DISPLAY;
+    }
 }
 
 class EglContext final : public Context {
- public:
-  EglContext(EGLDisplay display, EGLContext context) : display_(display), context_(context) {}
+public:
+    EglContext(EGLDisplay display, EGLContext context) : display_(display), context_(context) {}
 
-  ~EglContext() override {
-    if (eglGetCurrentContext() != context_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
-    destroy_targets();
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(display_, context_);
-    release_display();
-  }
-
-  Status create_targets(int width, int height) {
-    destroy_targets();
-    width_ = width;
-    height_ = height;
-    glCreateRenderbuffers(1, &color_);
-    glNamedRenderbufferStorage(color_, GL_RGBA8, width, height);
-    glCreateRenderbuffers(1, &depth_);
-    glNamedRenderbufferStorage(depth_, GL_DEPTH_COMPONENT24, width, height);
-    glCreateFramebuffers(1, &fbo_);
-    glNamedFramebufferRenderbuffer(fbo_, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
-    glNamedFramebufferRenderbuffer(fbo_, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
-    const GLenum status = glCheckNamedFramebufferStatus(fbo_, GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "0x%x", status);
-      return Error{"EGL: off-screen framebuffer " + std::to_string(width) + "x" + std::to_string(height) +
-                   " is incomplete (status " + buf + ")"};
+    ~EglContext() override {
+        if (eglGetCurrentContext() != context_)
+            eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
+        destroy_targets();
+        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(display_, context_);
+        release_display();
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    return {};
-  }
 
-  Backend backend() const override { return Backend::headless; }
-  Extent framebuffer_size() const override { return {width_, height_}; }
-  unsigned framebuffer() const override { return fbo_; }
-  void make_current() override { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_); }
-  bool should_close() const override { return close_requested_; }
-  void request_close() override { close_requested_ = true; }
-  void poll_events() override {}
-  const Input& input() const override { return input_; }
-  void set_resize_callback(ResizeCallback callback) override { on_resize_ = std::move(callback); }
-
-  void resize(int width_px, int height_px) override {
-    assert(width_px > 0 && height_px > 0 && "resize to an empty framebuffer");
-    if (width_px == width_ && height_px == height_) return;
-    if (Status s = create_targets(width_px, height_px); !s) {
-      std::fprintf(stderr, "%s\n", s.error().message.c_str());
-      return;
+    Status create_targets(int width, int height) {
+        destroy_targets();
+        width_ = width;
+        height_ = height;
+        glCreateRenderbuffers(1, &color_);
+        glNamedRenderbufferStorage(color_, GL_RGBA8, width, height);
+        glCreateRenderbuffers(1, &depth_);
+        glNamedRenderbufferStorage(depth_, GL_DEPTH_COMPONENT24, width, height);
+        glCreateFramebuffers(1, &fbo_);
+        glNamedFramebufferRenderbuffer(fbo_, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
+        glNamedFramebufferRenderbuffer(fbo_, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+        const GLenum status = glCheckNamedFramebufferStatus(fbo_, GL_FRAMEBUFFER);
+        if (status != GL_FRAMEBUFFER_COMPLETE) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "0x%x", status);
+            return Error{"EGL: off-screen framebuffer " + std::to_string(width) + "x" +
+                         std::to_string(height) + " is incomplete (status " + buf + ")"};
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        return {};
     }
-    if (on_resize_) on_resize_(width_, height_);
-  }
 
-  void begin_frame() override {
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glViewport(0, 0, width_, height_);
-  }
-  void end_frame() override { glFlush(); }
+    Backend backend() const override { return Backend::headless; }
+    Extent framebuffer_size() const override { return {width_, height_}; }
+    unsigned framebuffer() const override { return fbo_; }
+    void make_current() override { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_); }
+    bool should_close() const override { return close_requested_; }
+    void request_close() override { close_requested_ = true; }
+    void poll_events() override {}
+    const Input& input() const override { return input_; }
+    void set_resize_callback(ResizeCallback callback) override { on_resize_ = std::move(callback); }
 
- private:
-  void destroy_targets() {
-    if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
-    if (color_ != 0) glDeleteRenderbuffers(1, &color_);
-    if (depth_ != 0) glDeleteRenderbuffers(1, &depth_);
-    fbo_ = color_ = depth_ = 0;
-  }
+    void resize(int width_px, int height_px) override {
+        assert(width_px > 0 && height_px > 0 && "resize to an empty framebuffer");
+        if (width_px == width_ && height_px == height_) return;
+        if (Status s = create_targets(width_px, height_px); !s) {
+            std::fprintf(stderr, "%s\n", s.error().message.c_str());
+            return;
+        }
+        if (on_resize_) on_resize_(width_, height_);
+    }
 
-  EGLDisplay display_;
-  EGLContext context_;
-  GLuint fbo_ = 0;
-  GLuint color_ = 0;
-  GLuint depth_ = 0;
-  int width_ = 0;
-  int height_ = 0;
-  bool close_requested_ = false;
-  Input input_;
-  ResizeCallback on_resize_;
+    void begin_frame() override {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        glViewport(0, 0, width_, height_);
+    }
+    void end_frame() override { glFlush(); }
+
+private:
+    void destroy_targets() {
+        if (fbo_ != 0) glDeleteFramebuffers(1, &fbo_);
+        if (color_ != 0) glDeleteRenderbuffers(1, &color_);
+        if (depth_ != 0) glDeleteRenderbuffers(1, &depth_);
+        fbo_ = color_ = depth_ = 0;
+    }
+
+    EGLDisplay display_;
+    EGLContext context_;
+    GLuint fbo_ = 0;
+    GLuint color_ = 0;
+    GLuint depth_ = 0;
+    int width_ = 0;
+    int height_ = 0;
+    bool close_requested_ = false;
+    Input input_;
+    ResizeCallback on_resize_;
 };
 
 }  // namespace
 
 Expected<std::unique_ptr<Context>> create_headless_context(const ContextDesc& desc_in) {
-  const ContextDesc desc = with_defaults(desc_in);
-  Expected<EGLDisplay> display = acquire_display();
-  if (!display) return display.error();
-  EGLDisplay dpy = *display;
+    const ContextDesc desc = with_defaults(desc_in);
+    Expected<EGLDisplay> display = acquire_display();
+    if (!display) return display.error();
+    EGLDisplay dpy = *display;
 
-  if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) {
-    release_display();
-    return egl_failure("eglBindAPI(EGL_OPENGL_API) failed: desktop OpenGL not supported");
-  }
-  // Surfaceless: no surface type needed; ask for 8-bit RGBA so the config matches our FBO format.
-  const EGLint config_attribs[] = {EGL_SURFACE_TYPE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
-                                   EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_ALPHA_SIZE, 8,
-                                   EGL_NONE};
-  EGLConfig config = nullptr;
-  EGLint config_count = 0;
-  if (eglChooseConfig(dpy, config_attribs, &config, 1, &config_count) != EGL_TRUE || config_count == 0) {
-    release_display();
-    return egl_failure("no EGL config for desktop OpenGL");
-  }
-  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4,
-                                    EGL_CONTEXT_MINOR_VERSION, 5,
-                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                    EGL_CONTEXT_OPENGL_DEBUG, desc.debug ? EGL_TRUE : EGL_FALSE,
-                                    EGL_NONE};
-  EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
-  if (ctx == EGL_NO_CONTEXT) {
-    release_display();
-    return egl_failure("could not create an OpenGL 4.5 core context");
-  }
-  if (eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx) != EGL_TRUE) {
-    eglDestroyContext(dpy, ctx);
-    release_display();
-    return egl_failure("eglMakeCurrent without a surface failed");
-  }
-  auto context = std::make_unique<EglContext>(dpy, ctx);  // owns dpy reference and ctx from here on
-  if (Status s = context->create_targets(desc.width, desc.height); !s) return s.error();
-  context->begin_frame();
-  return std::unique_ptr<Context>(std::move(context));
+    if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) {
+        release_display();
+        return egl_failure("eglBindAPI(EGL_OPENGL_API) failed: desktop OpenGL not supported");
+    }
+    // Surfaceless: no surface type needed; ask for 8-bit RGBA so the config matches our FBO format.
+    const EGLint config_attribs[] = {EGL_SURFACE_TYPE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                     EGL_RED_SIZE,     8, EGL_GREEN_SIZE,      8,
+                                     EGL_BLUE_SIZE,    8, EGL_ALPHA_SIZE,      8,
+                                     EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint config_count = 0;
+    if (eglChooseConfig(dpy, config_attribs, &config, 1, &config_count) != EGL_TRUE || config_count == 0) {
+        release_display();
+        return egl_failure("no EGL config for desktop OpenGL");
+    }
+    const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                      4,
+                                      EGL_CONTEXT_MINOR_VERSION,
+                                      5,
+                                      EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                      EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                      EGL_CONTEXT_OPENGL_DEBUG,
+                                      desc.debug ? EGL_TRUE : EGL_FALSE,
+                                      EGL_NONE};
+    EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
+    if (ctx == EGL_NO_CONTEXT) {
+        release_display();
+        return egl_failure("could not create an OpenGL 4.5 core context");
+    }
+    if (eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx) != EGL_TRUE) {
+        eglDestroyContext(dpy, ctx);
+        release_display();
+        return egl_failure("eglMakeCurrent without a surface failed");
+    }
+    auto context = std::make_unique<EglContext>(dpy, ctx);  // owns dpy reference and ctx from here on
+    if (Status s = context->create_targets(desc.width, desc.height); !s) return s.error();
+    context->begin_frame();
+    return std::unique_ptr<Context>(std::move(context));
 }
 
 }  // namespace engine::platform

@@ -9,17 +9,18 @@ namespace engine::gfx {
 enum class DebugSeverity { notification, low, medium, high };
 
 struct DebugMessage {
-  DebugSeverity severity = DebugSeverity::notification;
-  unsigned id = 0;
-  std::string source{};  // "api", "shader compiler", "application", ...
-  std::string type{};    // "error", "performance", "marker", ...
-  std::string text{};
+    DebugSeverity severity = DebugSeverity::notification;
+    unsigned id = 0;
+    std::string source{};  // "api", "shader compiler", "application", ...
+    std::string type{};    // "error", "performance", "marker", ...
+    std::string text{};
 };
 
 struct DebugOutputDesc {
-  DebugSeverity min_severity = DebugSeverity::low;  // messages below are dropped
-  std::function<void(const DebugMessage&)> sink{};   // default: one line "gl <severity> <type> <id>: <text>" to stderr
-  bool synchronous = true;                          // messages arrive on the calling thread, inside the GL call
+    DebugSeverity min_severity = DebugSeverity::low;  // messages below are dropped
+    std::function<void(const DebugMessage&)>
+        sink{};               // default: one line "gl <severity> <type> <id>: <text>" to stderr
+    bool synchronous = true;  // messages arrive on the calling thread, inside the GL call
 };
 
 // Enables GL_DEBUG_OUTPUT on the current context. Replaces a previously installed sink.

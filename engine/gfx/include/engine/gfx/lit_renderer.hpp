@@ -12,22 +12,22 @@
 namespace engine::gfx {
 
 struct DirectionalLight {
-  glm::vec3 to_light{0.3f, 1.0f, 0.5f};  // direction toward the light (normalized by the renderer)
-  glm::vec3 color{1.0f};
-  float ambient = 0.15f;                 // fraction of albedo seen on the unlit side
+    glm::vec3 to_light{0.3f, 1.0f, 0.5f};  // direction toward the light (normalized by the renderer)
+    glm::vec3 color{1.0f};
+    float ambient = 0.15f;  // fraction of albedo seen on the unlit side
 };
 
 class LitRenderer {
- public:
-  // Compiles the shaders; errors carry the driver's log.
-  static Expected<LitRenderer> create();
+public:
+    // Compiles the shaders; errors carry the driver's log.
+    static Expected<LitRenderer> create();
 
-  // Sets the per-frame state: depth test on, back faces culled, program bound.
-  void begin(const glm::mat4& clip_from_world, const DirectionalLight& light) const;
-  void draw(const GpuMesh& mesh, const glm::mat4& world_from_model, const glm::vec3& albedo) const;
+    // Sets the per-frame state: depth test on, back faces culled, program bound.
+    void begin(const glm::mat4& clip_from_world, const DirectionalLight& light) const;
+    void draw(const GpuMesh& mesh, const glm::mat4& world_from_model, const glm::vec3& albedo) const;
 
- private:
-  Program program_;
+private:
+    Program program_;
 };
 
 // Clears color (RGBA in [0, 1]) and depth of the bound framebuffer.

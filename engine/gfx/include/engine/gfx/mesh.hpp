@@ -12,23 +12,23 @@
 namespace engine::gfx {
 
 struct Vertex {
-  glm::vec3 position{0.0f};
-  glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    glm::vec3 position{0.0f};
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};
 };
 
 // Counter-clockwise front faces, outward normals.
 struct MeshData {
-  std::vector<Vertex> vertices{};
-  std::vector<std::uint32_t> indices{};
+    std::vector<Vertex> vertices{};
+    std::vector<std::uint32_t> indices{};
 };
 
 // Closed cylinder along +y centered on the origin; sides and caps have separate vertices (flat cap normals).
 // The side is the polygon with `sides` corners inscribed in the circle of radius radius_m.
 struct CylinderDesc {
-  float radius_m = 0.5f;
-  float half_height_m = 0.5f;
-  int sides = 32;  // >= 3
-  bool caps = true;
+    float radius_m = 0.5f;
+    float half_height_m = 0.5f;
+    int sides = 32;  // >= 3
+    bool caps = true;
 };
 MeshData make_cylinder_mesh(const CylinderDesc& desc = {});
 
@@ -43,10 +43,10 @@ MeshData make_sphere_mesh(float radius_m = 0.5f, int slices = 32, int stacks = 1
 
 // A mesh on the GPU: vertex buffer (Vertex layout: location 0 position, 1 normal), index buffer and VAO.
 struct GpuMesh {
-  Buffer vertices;
-  Buffer indices;
-  VertexArray vertex_array;
-  int index_count = 0;
+    Buffer vertices;
+    Buffer indices;
+    VertexArray vertex_array;
+    int index_count = 0;
 };
 
 // Errors: empty mesh, or buffer allocation failed.

@@ -12,11 +12,13 @@ namespace engine::platform {
 
 // RGBA8 pixels, rows top to bottom (image order, not GL order).
 struct Image {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgba;  // width * height * 4 bytes
+    int width = 0;
+    int height = 0;
+    std::vector<std::uint8_t> rgba;  // width * height * 4 bytes
 
-  const std::uint8_t* pixel(int x, int y) const { return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4; }
+    const std::uint8_t* pixel(int x, int y) const {
+        return rgba.data() + (static_cast<std::size_t>(y) * width + x) * 4;
+    }
 };
 
 // Reads the whole framebuffer of the current frame of ctx (call after drawing, before or after end_frame()

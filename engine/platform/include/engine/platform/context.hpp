@@ -12,67 +12,67 @@
 namespace engine::platform {
 
 enum class Backend {
-  automatic,  // window if a display is available and GLFW works, else headless (with a one-line notice)
-  window,     // GLFW window only; fails if there is no display
-  headless,   // EGL surfaceless only
+    automatic,  // window if a display is available and GLFW works, else headless (with a one-line notice)
+    window,     // GLFW window only; fails if there is no display
+    headless,   // EGL surfaceless only
 };
 
 // Zero or empty fields take the defaults listed here.
 struct ContextDesc {
-  Backend backend = Backend::automatic;
-  int width = 0;           // default 1280 (window: initial client size; headless: framebuffer size)
-  int height = 0;          // default 720
-  std::string title{};     // default "wires"
-  bool vsync = true;       // window only
-  bool debug = false;      // request a debug context (KHR_debug output is more complete)
-  bool quiet = false;      // do not print the fallback notice
+    Backend backend = Backend::automatic;
+    int width = 0;        // default 1280 (window: initial client size; headless: framebuffer size)
+    int height = 0;       // default 720
+    std::string title{};  // default "wires"
+    bool vsync = true;    // window only
+    bool debug = false;   // request a debug context (KHR_debug output is more complete)
+    bool quiet = false;   // do not print the fallback notice
 };
 
 struct Extent {
-  int width = 0;
-  int height = 0;
+    int width = 0;
+    int height = 0;
 };
 
 class Context {
- public:
-  using ResizeCallback = std::function<void(int width_px, int height_px)>;
+public:
+    using ResizeCallback = std::function<void(int width_px, int height_px)>;
 
-  virtual ~Context() = default;
-  Context(const Context&) = delete;
-  Context& operator=(const Context&) = delete;
+    virtual ~Context() = default;
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
 
-  virtual Backend backend() const = 0;  // window or headless, never automatic
-  bool headless() const { return backend() == Backend::headless; }
+    virtual Backend backend() const = 0;  // window or headless, never automatic
+    bool headless() const { return backend() == Backend::headless; }
 
-  // Size of the framebuffer rendered into, in pixels.
-  virtual Extent framebuffer_size() const = 0;
-  // GL name of the framebuffer a frame renders into: 0 for a window, an FBO (RGBA8 + depth24) headless.
-  virtual unsigned framebuffer() const = 0;
+    // Size of the framebuffer rendered into, in pixels.
+    virtual Extent framebuffer_size() const = 0;
+    // GL name of the framebuffer a frame renders into: 0 for a window, an FBO (RGBA8 + depth24) headless.
+    virtual unsigned framebuffer() const = 0;
 
-  // Makes this context current on the calling thread.
-  virtual void make_current() = 0;
-  // Window: the user asked to close (or request_close() was called). Headless: only after request_close().
-  virtual bool should_close() const = 0;
-  virtual void request_close() = 0;
-  // Pumps window events and refreshes input(); no-op headless.
-  virtual void poll_events() = 0;
-  virtual const Input& input() const = 0;
-  // Called when the framebuffer size changes (window resize, or headless resize()).
-  virtual void set_resize_callback(ResizeCallback callback) = 0;
-  // Headless: reallocates the FBO. Window: resizes the window.
-  virtual void resize(int width_px, int height_px) = 0;
+    // Makes this context current on the calling thread.
+    virtual void make_current() = 0;
+    // Window: the user asked to close (or request_close() was called). Headless: only after request_close().
+    virtual bool should_close() const = 0;
+    virtual void request_close() = 0;
+    // Pumps window events and refreshes input(); no-op headless.
+    virtual void poll_events() = 0;
+    virtual const Input& input() const = 0;
+    // Called when the framebuffer size changes (window resize, or headless resize()).
+    virtual void set_resize_callback(ResizeCallback callback) = 0;
+    // Headless: reallocates the FBO. Window: resizes the window.
+    virtual void resize(int width_px, int height_px) = 0;
 
-  // Binds framebuffer() and sets the viewport to its full size.
-  virtual void begin_frame() = 0;
-  // Window: swaps buffers. Headless: glFlush (pixels stay readable until the next frame draws).
-  virtual void end_frame() = 0;
+    // Binds framebuffer() and sets the viewport to its full size.
+    virtual void begin_frame() = 0;
+    // Window: swaps buffers. Headless: glFlush (pixels stay readable until the next frame draws).
+    virtual void end_frame() = 0;
 
-  // "4.5 (Core Profile) Mesa ..." and "llvmpipe (...)" for example; valid once created.
-  std::string gl_version() const;
-  std::string gl_renderer() const;
+    // "4.5 (Core Profile) Mesa ..." and "llvmpipe (...)" for example; valid once created.
+    std::string gl_version() const;
+    std::string gl_renderer() const;
 
- protected:
-  Context() = default;
+protected:
+    Context() = default;
 };
 
 // True when DISPLAY or WAYLAND_DISPLAY is set.
