@@ -37,6 +37,7 @@ class Context {
 public:
     using ResizeCallback = std::function<void(int width_px, int height_px)>;
 
+    // Destroying a context releases its GL objects; afterwards no context is current on this thread.
     virtual ~Context() = default;
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
