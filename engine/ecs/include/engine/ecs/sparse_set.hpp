@@ -31,6 +31,13 @@ public:
         return pos != npos && dense_[pos] == e;
     }
 
+    // Dense position of e, or npos if this exact handle is not in the set. One sparse lookup: views use it
+    // to test membership and find the component at once.
+    [[nodiscard]] std::uint32_t find(Entity e) const noexcept {
+        const std::uint32_t pos = position_of_index(to_index(e));
+        return pos != npos && dense_[pos] == e ? pos : npos;
+    }
+
     // Dense position of e. Asserts that e is in the set.
     [[nodiscard]] std::size_t index_of(Entity e) const noexcept {
         ENGINE_ECS_ASSERT(contains(e), "index_of: entity is not in this set (stale handle or missing component)");

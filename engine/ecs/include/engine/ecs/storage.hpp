@@ -124,9 +124,13 @@ public:
     [[nodiscard]] T& get(Entity e) noexcept { return components_[index_of(e)]; }
     [[nodiscard]] const T& get(Entity e) const noexcept { return components_[index_of(e)]; }
     // e's T, or nullptr if e has none (or is stale).
-    [[nodiscard]] T* try_get(Entity e) noexcept { return contains(e) ? &components_[index_of(e)] : nullptr; }
+    [[nodiscard]] T* try_get(Entity e) noexcept {
+        const std::uint32_t pos = find(e);
+        return pos != npos ? &components_[pos] : nullptr;
+    }
     [[nodiscard]] const T* try_get(Entity e) const noexcept {
-        return contains(e) ? &components_[index_of(e)] : nullptr;
+        const std::uint32_t pos = find(e);
+        return pos != npos ? &components_[pos] : nullptr;
     }
 
     // Stamps e's T as changed now and returns it for writing. Asserts e has T.
@@ -155,8 +159,9 @@ public:
 
     // Removes e's T if present, swapping the last component into its place. Returns whether it was present.
     bool remove(Entity e) final {
-        if (!contains(e)) return false;
-        const std::size_t pos = index_of(e);
+        const std::uint32_t found = find(e);
+        if (found == npos) return false;
+        const std::size_t pos = found;
         if (pos + 1 != components_.size()) {
             components_[pos] = std::move(components_.back());
             ticks_[pos] = ticks_.back();
@@ -210,7 +215,8 @@ private:
         if (log_.size() >= 2 * size() + 64) compact_log();
     }
     [[nodiscard]] bool log_entry_live(const LogEntry& le) const noexcept {
-        return contains(le.entity) && ticks_[position_of_index(to_index(le.entity))] == le.tick;
+        const std::uint32_t pos = find(le.entity);
+        return pos != npos && ticks_[pos] == le.tick;
     }
     // First log position whose tick is >= tick (the log is sorted by tick).
     [[nodiscard]] std::size_t log_lower_bound(std::uint64_t tick) const noexcept {

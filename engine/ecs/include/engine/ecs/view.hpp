@@ -4,9 +4,13 @@
 
 #include <engine/ecs/storage.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <tuple>
 #include <type_traits>
+#include <utility>
 
 namespace engine::ecs {
 
@@ -29,6 +33,9 @@ class View {
     static_assert(sizeof...(Cs) > 0, "a view needs at least one component type");
 
 public:
+    // Dense positions of one entity's components in each storage, in the order of Cs.
+    using Positions = std::array<std::uint32_t, sizeof...(Cs)>;
+
     explicit View(StorageFor<Cs>&... storages) noexcept : pools_{&storages...} {}
 
     // Calls fn(Entity, Cs&...) or fn(Cs&...) for every entity that has all of Cs.
@@ -38,12 +45,10 @@ public:
         for (std::size_t i = lead->size(); i-- > 0;) {
             if (i >= lead->size()) continue;  // the callback removed more than the current entity
             const Entity e = lead->at(i);
-            if (!all_contain(e, lead)) continue;
-            if constexpr (std::is_invocable_v<Fn&, Entity, Cs&...>) {
-                fn(e, fetch<Cs>(e, i, lead)...);
-            } else {
-                fn(fetch<Cs>(e, i, lead)...);
-            }
+            // One sparse lookup per non-lead storage gives both membership and the component's position.
+            const Positions pos = locate_all(e, i, lead);
+            if (!all_found(pos)) continue;
+            invoke(fn, e, pos, std::index_sequence_for<Cs...>{});
         }
     }
 
@@ -56,7 +61,7 @@ public:
         Iterator(const View* v, const SparseSet* lead, std::size_t next) : v_{v}, lead_{lead}, next_{next} {
             settle();
         }
-        Entity operator*() const noexcept { return lead_->at(pos_); }
+        Entity operator*() const noexcept { return lead_->at(at_); }
         Iterator& operator++() noexcept {
             settle();
             return *this;
@@ -67,19 +72,19 @@ public:
             return old;
         }
         bool operator==(const Iterator& o) const noexcept {
-            return v_ == o.v_ && (v_ == nullptr || pos_ == o.pos_);
+            return v_ == o.v_ && (v_ == nullptr || at_ == o.at_);
         }
-        // Dense position of the current entity in the lead storage.
-        [[nodiscard]] std::size_t position() const noexcept { return pos_; }
-        [[nodiscard]] const SparseSet* lead() const noexcept { return lead_; }
+        // Dense positions of the current entity's components, in the order of Cs.
+        [[nodiscard]] const Positions& positions() const noexcept { return pos_; }
         [[nodiscard]] const View* view() const noexcept { return v_; }
 
     private:
         void settle() noexcept {
             while (next_-- > 0) {
                 if (next_ >= lead_->size()) continue;
-                if (v_->all_contain(lead_->at(next_), lead_)) {
-                    pos_ = next_;
+                pos_ = v_->locate_all(lead_->at(next_), next_, lead_);
+                if (all_found(pos_)) {
+                    at_ = next_;
                     return;
                 }
             }
@@ -87,8 +92,9 @@ public:
         }
         const View* v_ = nullptr;
         const SparseSet* lead_ = nullptr;
-        std::size_t next_ = 0;  // positions below this are still to visit
-        std::size_t pos_ = 0;
+        std::size_t next_ = 0;  // lead positions below this are still to visit
+        std::size_t at_ = 0;    // lead position of the current entity
+        Positions pos_{};
     };
 
     [[nodiscard]] Iterator begin() const {
@@ -107,8 +113,7 @@ public:
             Iterator() = default;
             explicit Iterator(typename View::Iterator it) : it_{it} {}
             value_type operator*() const {
-                const Entity e = *it_;
-                return value_type{e, it_.view()->template fetch<Cs>(e, it_.position(), it_.lead())...};
+                return it_.view()->tuple_at(*it_, it_.positions(), std::index_sequence_for<Cs...>{});
             }
             Iterator& operator++() noexcept {
                 ++it_;
@@ -152,18 +157,30 @@ private:
         std::apply([&best](auto*... p) { ((best = p->size() < best->size() ? p : best), ...); }, pools_);
         return best;
     }
-    [[nodiscard]] bool all_contain(Entity e, const SparseSet* lead) const noexcept {
-        return std::apply(
-            [e, lead](auto*... p) {
-                return ((static_cast<const SparseSet*>(p) == lead || p->contains(e)) && ...);
-            },
-            pools_);
-    }
-    // The lead storage's component is read by position; the others go through the sparse index.
+    // Position of e's C: the lead's is known, the others take one sparse lookup (npos if e lacks C).
     template <class C>
-    [[nodiscard]] C& fetch(Entity e, std::size_t lead_pos, const SparseSet* lead) const noexcept {
-        auto* p = std::get<StorageFor<C>*>(pools_);
-        return static_cast<const SparseSet*>(p) == lead ? p->at_position(lead_pos) : p->get(e);
+    [[nodiscard]] std::uint32_t locate(Entity e, std::size_t lead_pos, const SparseSet* lead) const noexcept {
+        const auto* p = std::get<StorageFor<C>*>(pools_);
+        return static_cast<const SparseSet*>(p) == lead ? static_cast<std::uint32_t>(lead_pos) : p->find(e);
+    }
+    [[nodiscard]] Positions locate_all(Entity e, std::size_t lead_pos, const SparseSet* lead) const noexcept {
+        return Positions{locate<Cs>(e, lead_pos, lead)...};
+    }
+    [[nodiscard]] static bool all_found(const Positions& pos) noexcept {
+        return std::find(pos.begin(), pos.end(), SparseSet::npos) == pos.end();
+    }
+    template <class Fn, std::size_t... I>
+    void invoke(Fn& fn, Entity e, const Positions& pos, std::index_sequence<I...>) const {
+        if constexpr (std::is_invocable_v<Fn&, Entity, Cs&...>) {
+            fn(e, std::get<I>(pools_)->at_position(pos[I])...);
+        } else {
+            fn(std::get<I>(pools_)->at_position(pos[I])...);
+        }
+    }
+    template <std::size_t... I>
+    [[nodiscard]] std::tuple<Entity, Cs&...> tuple_at(Entity e, const Positions& pos,
+                                                      std::index_sequence<I...>) const {
+        return {e, std::get<I>(pools_)->at_position(pos[I])...};
     }
 
     std::tuple<StorageFor<Cs>*...> pools_;
