@@ -1,0 +1,47 @@
+// One wire's whole path from nodes to tube mesh, with the state it keeps between successive states of the
+// same wire (pop-free remedy, carried-over first frame). Used by wiretool and by the ECS systems' tests.
+#pragma once
+
+#include "wire/curve.hpp"
+#include "wire/nodes.hpp"
+#include "wire/rings.hpp"
+#include "wire/status.hpp"
+#include "wire/tessellate.hpp"
+#include "wire/tube.hpp"
+
+#include <vector>
+
+namespace wire {
+
+/// Settings of every stage; zero/default-initialized is sensible (see each struct).
+struct PipelineSettings {
+    SplineSettings spline{};
+    TessellateSettings tessellate{};
+    TubeSettings tube{};
+    FrameMethod frame_method = FrameMethod::double_reflection;
+    bool pop_free = true;  ///< blend the curve over a few states when node ids appear or vanish
+};
+
+/// Stateful per wire: call update() with each new state of the wire's nodes, in order.
+class WirePipeline {
+public:
+    /// Builds curve, rings and mesh for this state. On bad input returns the curve stage's Status (naming
+    /// the input node) and keeps the previous outputs and state untouched.
+    [[nodiscard]] Status update(const WireNodes& nodes, const PipelineSettings& settings);
+
+    [[nodiscard]] const Curve& curve() const { return rendered_; }
+    [[nodiscard]] const RingSet& rings() const { return rings_; }
+    [[nodiscard]] const TubeMesh& mesh() const { return mesh_; }
+    [[nodiscard]] std::size_t states() const { return states_; }
+
+private:
+    Curve target_;    ///< the curve of the newest nodes
+    Curve rendered_;  ///< what is drawn (equals target_ unless the pop-free remedy is blending)
+    std::vector<uint32_t> counts_;
+    std::vector<RingParam> params_;
+    RingSet rings_;
+    TubeMesh mesh_;
+    std::size_t states_ = 0;
+};
+
+}  // namespace wire

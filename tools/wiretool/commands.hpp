@@ -1,0 +1,23 @@
+// wiretool subcommands: each file registers one subcommand on the CLI11 app and runs it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace wiretool {
+
+/// Exit statuses shared by every subcommand (a contract: scripts test them).
+enum Exit : int {
+    exit_ok = 0,
+    exit_failure = 1,    ///< the tool could not finish (an output could not be written, an internal error)
+    exit_bad_input = 2,  ///< the input or the command line is wrong; nothing was written
+};
+
+/// A subcommand registers its options and returns the action to run when it was chosen.
+using Action = std::function<int()>;
+
+Action add_mesh_command(CLI::App& app);
+Action add_bend_command(CLI::App& app);
+
+}  // namespace wiretool
