@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace wire {
@@ -41,11 +42,54 @@ struct Sample {
     glm::dvec3 t;  // unit tangent
 };
 
+enum class Mirrors : uint8_t { ok, split, degenerate };
+
+/// The two mirror normals of the double-reflection step a -> b, scaled by sqrt(2/c) so that each reflection is
+/// r - w (w.r). `split` (w valid) when the hairpin guard wants the step subdivided; `degenerate` (w invalid) when
+/// the tangent reverses at a repeated point or the second mirror vanishes.
+Mirrors mirrors(const Sample& a, const Sample& b, double noise, glm::dvec3& w1, glm::dvec3& w2) {
+    glm::dvec3 v1 = b.x - a.x;
+    double c1 = glm::dot(v1, v1);
+    // Below the rounding noise of the positions the chord has no direction: a repeated point. The reflection
+    // about the plane normal to t0 + t1 takes t0 to -t1 and the second one (about t1) to t1, as needed.
+    if (c1 <= noise * noise * 64.0) {
+        v1 = a.t + b.t;
+        c1 = glm::dot(v1, v1);
+        if (c1 < 1e-20) {
+            return Mirrors::degenerate;
+        }
+    }
+    const glm::dvec3 tl = a.t - (2.0 / c1) * glm::dot(v1, a.t) * v1;
+    const glm::dvec3 v2 = b.t - tl;
+    const double c2 = glm::dot(v2, v2);
+    if (c2 < 1e-20) {
+        return Mirrors::degenerate;
+    }
+    w1 = v1 * std::sqrt(2.0 / c1);
+    w2 = v2 * std::sqrt(2.0 / c2);
+    // Hairpin guard. c2 ~ 0: the tangent turns "the wrong way" within the step (a loop), the second mirror is
+    // ill-conditioned. A turn of more than 45 degrees in one step (a hairpin under coarse sampling): the
+    // method's error grows with the turn per step. Either way the step is split at its parameter midpoint; at a
+    // cusp only the half containing it keeps splitting, so the cost is O(depth), not O(2^depth).
+    return (c2 < 0.1 || glm::dot(a.t, b.t) < kSplitCos) ? Mirrors::split : Mirrors::ok;
+}
+
+glm::dvec3 reflect_pair(const glm::dvec3& w1, const glm::dvec3& w2, glm::dvec3 r) {
+    r -= glm::dot(w1, r) * w1;
+    r -= glm::dot(w2, r) * w2;
+    return r;
+}
+
 class Transporter {
 public:
     Transporter(const FrameInput& in, const FrameSettings& s, FrameStats& stats)
         : in_(in), method_(s.method), max_depth_(s.max_subdivision_depth ? s.max_subdivision_depth : 10),
           stats_(stats), origin_noise_(1e-13 * max_abs(in.origin_m)) {}
+
+    /// Rounding noise of positions near a and b (a chord below it is a repeated point).
+    [[nodiscard]] double noise(const Sample& a, const Sample& b) const {
+        return origin_noise_ + 1e-13 * (max_abs(a.x) + max_abs(b.x));
+    }
 
     /// Carries normal r0 at a (on segment seg at parameter ta) to b (at parameter tb of the same segment, or the
     /// next ring whose position equals that point).
@@ -61,49 +105,27 @@ public:
 private:
     glm::dvec3 reflect(uint32_t seg, double ta, const Sample& a, const glm::dvec3& r0, double tb, const Sample& b,
                        uint32_t depth) {
-        glm::dvec3 v1 = b.x - a.x;
-        double c1 = glm::dot(v1, v1);
-        // Below the rounding noise of the positions the chord has no direction: a repeated point. The reflection
-        // about the plane normal to t0 + t1 takes t0 to -t1 and the second one (about t1) to t1, as needed.
-        const double noise = origin_noise_ + 1e-13 * (max_abs(a.x) + max_abs(b.x));
-        if (c1 <= noise * noise * 64.0) {
-            v1 = a.t + b.t;
-            c1 = glm::dot(v1, v1);
-            if (c1 < 1e-20) {  // tangent reverses at a point (cusp on a ring): minimal rotation
-                ++stats_.fallback_steps;
-                return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
+        glm::dvec3 w1{}, w2{};
+        const Mirrors m = mirrors(a, b, noise(a, b), w1, w2);
+        if (m != Mirrors::ok && depth < max_depth_ && in_.curve != nullptr && tb > ta) {
+            if (depth == 0) {
+                ++stats_.subdivided_steps;
             }
+            const CubicBezier& c = in_.curve->segments[seg];
+            const double tm = 0.5 * (ta + tb);
+            Sample mid{position(c, tm) - in_.origin_m, unit_tangent(c, tm)};
+            if (mid.t == glm::dvec3(0.0)) {
+                mid.t = a.t;
+            }
+            const glm::dvec3 rm = reflect(seg, ta, a, r0, tm, mid, depth + 1);
+            return reflect(seg, tm, mid, rm, tb, b, depth + 1);
         }
-        const glm::dvec3 rl = r0 - (2.0 / c1) * glm::dot(v1, r0) * v1;
-        const glm::dvec3 tl = a.t - (2.0 / c1) * glm::dot(v1, a.t) * v1;
-        const glm::dvec3 v2 = b.t - tl;
-        const double c2 = glm::dot(v2, v2);
-        // Hairpin guard. c2 ~ 0: the tangent turns "the wrong way" within the step (a loop), the second mirror
-        // is ill-conditioned. A turn of more than 45 degrees in one step (a hairpin under coarse sampling): the
-        // method's error grows with the turn per step. Either way split the step at its parameter midpoint; at a
-        // cusp only the half containing it keeps splitting, so the cost is O(depth), not O(2^depth).
-        if (c2 < 0.1 || glm::dot(a.t, b.t) < kSplitCos) {
-            if (depth < max_depth_ && in_.curve != nullptr && tb > ta) {
-                if (depth == 0) {
-                    ++stats_.subdivided_steps;
-                }
-                const CubicBezier& c = in_.curve->segments[seg];
-                const double tm = 0.5 * (ta + tb);
-                Sample m{position(c, tm) - in_.origin_m, unit_tangent(c, tm)};
-                if (m.t == glm::dvec3(0.0)) {
-                    m.t = a.t;
-                }
-                const glm::dvec3 rm = reflect(seg, ta, a, r0, tm, m, depth + 1);
-                return reflect(seg, tm, m, rm, tb, b, depth + 1);
-            }
-            if (c2 < 1e-20) {
-                ++stats_.fallback_steps;
-                return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
-            }
+        if (m == Mirrors::degenerate) {  // tangent reverses at a point: the minimal rotation
+            ++stats_.fallback_steps;
+            return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
         }
-        const glm::dvec3 r1 = rl - (2.0 / c2) * glm::dot(v2, rl) * v2;
         // Each reflection preserves length and the pair preserves handedness; re-project against rounding drift.
-        return orthonormalize(r1, b.t);
+        return orthonormalize(reflect_pair(w1, w2, r0), b.t);
     }
 
     const FrameInput& in_;
@@ -202,14 +224,48 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
     out[0].s = glm::cross(t0, r0);
 
     Transporter transport(in, settings, stats);
-    for (std::size_t i = 1; i < n; ++i) {
+    auto general_step = [&](std::size_t i, const glm::dvec3& r_prev) {
         const RingParam& pa = in.params[i - 1];
         const RingParam& pb = in.params[i];
         const double tb = pb.segment == pa.segment ? pb.t : 1.0;
-        const glm::dvec3 r = transport.step(pa.segment, pa.t, Sample{in.centre_m[i - 1], out[i - 1].t}, out[i - 1].r,
-                                            tb, Sample{in.centre_m[i], out[i].t});
-        out[i].r = r;
-        out[i].s = glm::cross(out[i].t, r);
+        return transport.step(pa.segment, pa.t, Sample{in.centre_m[i - 1], out[i - 1].t}, r_prev, tb,
+                              Sample{in.centre_m[i], out[i].t});
+    };
+    if (settings.method == FrameMethod::double_reflection) {
+        // Pass 1, independent per step: the mirror normals (kept in out[i].r, out[i].s until pass 2); a NaN marks a
+        // step for the guarded path. Pass 2 then carries r through two reflections per step: a short dependency
+        // chain (no square root, no division), which is what bounds the speed of a long wire.
+        constexpr double kSpecial = std::numeric_limits<double>::quiet_NaN();
+        for (std::size_t i = 1; i < n; ++i) {
+            const Sample a{in.centre_m[i - 1], out[i - 1].t};
+            const Sample b{in.centre_m[i], out[i].t};
+            glm::dvec3 w1{}, w2{};
+            if (mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
+                out[i].r = w1;
+                out[i].s = w2;
+            } else {
+                out[i].r.x = kSpecial;
+            }
+        }
+        glm::dvec3 r = r0;
+        for (std::size_t i = 1; i < n; ++i) {
+            if (std::isnan(out[i].r.x)) {
+                r = general_step(i, glm::normalize(r));
+            } else {
+                r = reflect_pair(out[i].r, out[i].s, r);
+                r -= glm::dot(r, out[i].t) * out[i].t;  // against drift off the normal plane (no sqrt)
+            }
+            out[i].r = r;
+        }
+        for (std::size_t i = 1; i < n; ++i) {
+            out[i].r = orthonormalize(out[i].r, out[i].t);
+            out[i].s = glm::cross(out[i].t, out[i].r);
+        }
+    } else {
+        for (std::size_t i = 1; i < n; ++i) {
+            out[i].r = general_step(i, out[i - 1].r);
+            out[i].s = glm::cross(out[i].t, out[i].r);
+        }
     }
 
     if (closed && n >= 1) {

@@ -31,46 +31,82 @@ double node_slope(const Curve& curve, std::size_t k) {
     return std::clamp(m, -lim, lim);
 }
 
+/// Per-segment constants, computed once per segment rather than per evaluation: power-basis derivatives,
+/// radius polynomial (power basis in t), texture scale.
+struct SegmentCoeffs {
+    glm::dvec3 p0, p1, p2, p3;  // B(t) = p0 + t (p1 + t (p2 + t p3))
+    glm::dvec3 d0, d1, d2;      // B'(t) = d0 + t (d1 + t d2)
+    glm::dvec3 e0, e1;          // B''(t) = e0 + t e1
+    double r0, r1, r2, r3;      // R(t) = r0 + t (r1 + t (r2 + t r3))
+    double u_scale;             // 1 / (2 pi stretch)
+    double tiny_speed;          // |B'| below this counts as vanishing (rounding noise of the control points)
+
+    SegmentCoeffs(const Curve& curve, uint32_t seg) {
+        const CubicBezier& c = curve.segments[seg];
+        p0 = c.b0;
+        p1 = 3.0 * (c.b1 - c.b0);
+        p2 = 3.0 * (c.b2 - 2.0 * c.b1 + c.b0);
+        p3 = c.b3 - 3.0 * c.b2 + 3.0 * c.b1 - c.b0;
+        d0 = p1;
+        d1 = 2.0 * p2;
+        d2 = 3.0 * p3;
+        e0 = d1;
+        e1 = 2.0 * d2;
+        const std::size_t n = curve.radius_m.size();
+        if (n == 0) {
+            r0 = 1.0;
+            r1 = r2 = r3 = 0.0;
+        } else {
+            const std::size_t a = std::min<std::size_t>(seg, n - 1);
+            const std::size_t b = curve.closed ? (a + 1) % n : std::min(a + 1, n - 1);
+            const double ra = curve.radius_m[a], rb = curve.radius_m[b];
+            const double ma = node_slope(curve, a), mb = node_slope(curve, b);
+            // Hermite basis expanded: R = ra + ma t + (-3ra - 2ma + 3rb - mb) t^2 + (2ra + ma - 2rb + mb) t^3.
+            r0 = ra;
+            r1 = ma;
+            r2 = -3.0 * ra - 2.0 * ma + 3.0 * rb - mb;
+            r3 = 2.0 * ra + ma - 2.0 * rb + mb;
+        }
+        double stretch = seg < curve.stretch.size() ? curve.stretch[seg] : 1.0;
+        if (!(stretch > 0.0) || !std::isfinite(stretch)) {
+            stretch = 1.0;
+        }
+        u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
+        tiny_speed = 1e-9 * (glm::length(d0) + glm::length(d1) + glm::length(d2));
+    }
+    [[nodiscard]] glm::dvec3 position(double t) const { return p0 + t * (p1 + t * (p2 + t * p3)); }
+    [[nodiscard]] glm::dvec3 derivative(double t) const { return d0 + t * (d1 + t * d2); }
+    [[nodiscard]] glm::dvec3 second_derivative(double t) const { return e0 + t * e1; }
+    [[nodiscard]] double radius(double t) const { return r0 + t * (r1 + t * (r2 + t * r3)); }
+};
+
 struct Interval {
     double length_m;
     double u;  // integral of |B'| / (2 pi R stretch) dt
 };
 
-/// Length and texture advance over segment `seg` from ta to tb.
-Interval integrate(const Curve& curve, uint32_t seg, double ta, double tb, double stretch) {
+/// Length and texture advance over one segment from ta to tb (5-point Gauss-Legendre).
+Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     Interval out{0.0, 0.0};
     const double h = tb - ta;
     if (!(h > 0.0)) {
         return out;
     }
-    const CubicBezier& c = curve.segments[seg];
     for (int k = 0; k < 5; ++k) {
         const double t = ta + h * kGlX[k];
-        const double speed = glm::length(derivative(c, t));
+        const double speed = glm::length(c.derivative(t));
         const double w = h * kGlW[k];
         out.length_m += w * speed;
-        out.u += w * speed / std::max(radius_at(curve, seg, t), 1e-30);
+        out.u += w * speed / std::max(c.radius(t), 1e-30);
     }
-    out.u /= 2.0 * std::numbers::pi * stretch;
+    out.u *= c.u_scale;
     return out;
 }
 
 }  // namespace
 
 double radius_at(const Curve& curve, uint32_t segment, double t) {
-    const std::size_t n = curve.radius_m.size();
-    if (n == 0) {
-        return 1.0;
-    }
-    const std::size_t a = std::min<std::size_t>(segment, n - 1);
-    const std::size_t b = curve.closed ? (a + 1) % n : std::min(a + 1, n - 1);
-    const double r0 = curve.radius_m[a];
-    const double r1 = curve.radius_m[b];
-    const double m0 = node_slope(curve, a);
-    const double m1 = node_slope(curve, b);
-    const double t2 = t * t;
-    const double t3 = t2 * t;
-    return (2 * t3 - 3 * t2 + 1) * r0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * r1 + (t3 - t2) * m1;
+    return SegmentCoeffs(curve, segment).radius(t);
 }
 
 void build_rings(const Curve& curve, std::span<const RingParam> params, const RingSettings& settings, RingSet& out) {
@@ -91,63 +127,65 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         out.frame_stats = FrameStats{};
         return;
     }
-    assert(curve.stretch.size() == curve.segment_count() && "build_rings: one stretch per segment");
 
     out.origin_m = position(curve.segments[params[0].segment], params[0].t);
+    SegmentCoeffs seg(curve, params[0].segment);
+    uint32_t seg_index = params[0].segment;
+    auto use_segment = [&](uint32_t i) {
+        if (i != seg_index) {
+            seg = SegmentCoeffs(curve, i);
+            seg_index = i;
+        }
+    };
+    double s = 0.0;
+    double u = settings.u_start;
     for (std::size_t i = 0; i < n; ++i) {
         const RingParam p = params[i];
-        const CubicBezier& c = curve.segments[p.segment];
-        out.centre_m[i] = position(c, p.t) - out.origin_m;
-        out.tangent_scratch[i] = unit_tangent(c, p.t);
-
-        // Fold: the inner side of the tube crosses itself where the radius reaches the curvature radius.
-        const glm::dvec3 d1 = derivative(c, p.t);
-        const glm::dvec3 d2 = second_derivative(c, p.t);
+        use_segment(p.segment);
+        out.centre_m[i] = (p.t == 0.0 ? curve.segments[p.segment].b0
+                                      : (p.t == 1.0 ? curve.segments[p.segment].b3 : seg.position(p.t))) -
+                          out.origin_m;
+        const glm::dvec3 d1 = seg.derivative(p.t);
+        const glm::dvec3 d2 = seg.second_derivative(p.t);
         const double speed = glm::length(d1);
-        const double radius = radius_at(curve, p.segment, p.t);
+        out.tangent_scratch[i] = speed > 0.0 ? d1 / speed : glm::dvec3(0.0);
+        // Near-zero derivative: the one-sided limits of unit_tangent() (rare; it re-derives the threshold).
+        if (!(speed > seg.tiny_speed)) {
+            out.tangent_scratch[i] = unit_tangent(curve.segments[p.segment], p.t);
+        }
+        // Fold: the inner side of the tube crosses itself where the radius reaches the curvature radius.
+        const double radius = seg.radius(p.t);
         const double bend = glm::length(glm::cross(d1, d2));  // = curvature * speed^3
         if (radius * bend >= speed * speed * speed && bend > 0.0) {
             if (out.fold_count++ == 0) {
                 out.first_fold_ring = static_cast<uint32_t>(i);
             }
         }
-        out.rings[i].radius_m = static_cast<float>(radius);
-        out.rings[i].segment = p.segment;
-    }
+        Ring& ring = out.rings[i];
+        ring.radius_m = static_cast<float>(radius);
+        ring.segment = p.segment;
 
-    // Arc length and u, interval by interval (always within one segment: a step into the next segment ends at t=1).
-    double s = 0.0;
-    double u = settings.u_start;
-    out.arc_length_m[0] = 0.0;
-    out.u[0] = u;
-    const std::size_t intervals = n - 1 + extra;
-    for (std::size_t i = 0; i < intervals; ++i) {
-        const RingParam a = params[i];
-        const bool wrap = i + 1 == n;
-        const RingParam b = wrap ? params[0] : params[i + 1];
-        const double tb = (!wrap && b.segment == a.segment) ? b.t : 1.0;
-        double stretch = curve.stretch[a.segment];
-        if (!(stretch > 0.0) || !std::isfinite(stretch)) {
-            stretch = 1.0;
+        // Arc length and u of the interval to the next ring (always within this segment: a step into the next
+        // segment ends at t = 1 of this one; for a closed wire the last interval returns to ring 0).
+        if (i == 0) {
+            out.arc_length_m[0] = 0.0;
+            out.u[0] = u;
         }
-        Interval iv{};
-        if (!wrap && b.segment != a.segment && b.segment != a.segment + 1) {
-            iv = Interval{0.0, 0.0};  // params skipped segments: callers pass place_rings() output
-        } else {
-            iv = integrate(curve, a.segment, a.t, tb, stretch);
-            // A step into the next segment that does not start at t = 0 (custom params) adds that segment's part.
-            if (!wrap && b.segment != a.segment && b.t > 0.0) {
-                double stretch_b = curve.stretch[b.segment];
-                stretch_b = (stretch_b > 0.0 && std::isfinite(stretch_b)) ? stretch_b : 1.0;
-                const Interval ib = integrate(curve, b.segment, 0.0, b.t, stretch_b);
+        if (i + 1 < n || extra) {
+            const bool wrap = i + 1 == n;
+            const RingParam b = wrap ? params[0] : params[i + 1];
+            const double tb = (!wrap && b.segment == p.segment) ? b.t : 1.0;
+            Interval iv = integrate(seg, p.t, tb);
+            if (!wrap && b.segment != p.segment && b.t > 0.0) {  // custom params: the next segment's part too
+                const Interval ib = integrate(SegmentCoeffs(curve, b.segment), 0.0, b.t);
                 iv.length_m += ib.length_m;
                 iv.u += ib.u;
             }
+            s += iv.length_m;
+            u += iv.u;
+            out.arc_length_m[i + 1] = s;
+            out.u[i + 1] = u;
         }
-        s += iv.length_m;
-        u += iv.u;
-        out.arc_length_m[i + 1] = s;
-        out.u[i + 1] = u;
     }
     out.length_m = s;
 

@@ -5,29 +5,70 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <numbers>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace wire {
 namespace {
 
 constexpr uint32_t kCachedSides = 64;
+constexpr float kLaneV[8] = {0, 0, 0, 0, 0, 0, 0, 1};  // v goes to the last float of a vertex
 
 uint32_t effective_sides(const TubeSettings& s) { return s.sides == 0 ? 8u : std::max(s.sides, 3u); }
 
-/// (cos, sin) of 2 pi j / n for j = 0..n; entry n repeats entry 0 exactly so the seam welds.
-const glm::vec2* side_table(uint32_t n) {
-    thread_local std::array<std::vector<glm::vec2>, kCachedSides + 1> cached;
-    thread_local std::vector<glm::vec2> large;
-    std::vector<glm::vec2>& table = n <= kCachedSides ? cached[n] : large;
-    if (table.size() != n + 1) {
-        table.resize(n + 1);
+/// Per side count, built once per thread: cos, sin and v of phi_j = 2 pi j / n for j = 0..n (entry n repeats entry
+/// 0's cos/sin exactly so the seam welds, with v = 1), and the index pattern of one band of quads relative to its
+/// first vertex (6 n entries).
+struct SideTable {
+    std::vector<float> cos_phi, sin_phi, v;
+    std::vector<uint32_t> band;
+};
+
+const SideTable& side_table(uint32_t n) {
+    thread_local std::array<SideTable, kCachedSides + 1> cached;
+    thread_local SideTable large;
+    SideTable& table = n <= kCachedSides ? cached[n] : large;
+    if (table.cos_phi.size() != n + 1) {
+        table.cos_phi.resize(n + 1);
+        table.sin_phi.resize(n + 1);
+        table.v.resize(n + 1);
         for (uint32_t j = 0; j < n; ++j) {
             const double phi = 2.0 * std::numbers::pi * j / n;
-            table[j] = glm::vec2(static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)));
+            table.cos_phi[j] = static_cast<float>(std::cos(phi));
+            table.sin_phi[j] = static_cast<float>(std::sin(phi));
+            table.v[j] = static_cast<float>(j) / static_cast<float>(n);
         }
-        table[n] = table[0];
+        table.cos_phi[n] = table.cos_phi[0];
+        table.sin_phi[n] = table.sin_phi[0];
+        table.v[n] = 1.0f;
+        table.band.resize(6 * std::size_t{n});
+        const uint32_t stride = n + 1;
+        for (uint32_t j = 0; j < n; ++j) {
+            // Counter-clockwise from outside: (a_j, a_j+1, b_j), (a_j+1, b_j+1, b_j) with t = r x s.
+            const uint32_t k[6] = {j, j + 1, stride + j, j + 1, stride + j + 1, stride + j};
+            std::copy(k, k + 6, table.band.begin() + 6 * std::ptrdiff_t{j});
+        }
     }
-    return table.data();
+    return table;
+}
+
+/// 32 bytes to dst; with `stream`, non-temporal (the caller checked 16-byte alignment).
+inline void store_vertex(TubeVertex* dst, const float (&o)[8], bool stream) {
+#if defined(__SSE2__)
+    if (stream) {
+        float* f = reinterpret_cast<float*>(dst);
+        _mm_stream_ps(f, _mm_loadu_ps(o));
+        _mm_stream_ps(f + 4, _mm_loadu_ps(o + 4));
+        return;
+    }
+#else
+    (void)stream;
+#endif
+    std::memcpy(static_cast<void*>(dst), o, sizeof(o));
 }
 
 }  // namespace
@@ -56,25 +97,35 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
         return counts;
     }
     const uint32_t n = effective_sides(settings);
-    const glm::vec2* cs = side_table(n);
+    const SideTable& table = side_table(n);
+    const float* cos_phi = table.cos_phi.data();
+    const float* sin_phi = table.sin_phi.data();
+    const float* v_of = table.v.data();
     const std::size_t ring_n = rings.size();
-    const float inv_n = 1.0f / static_cast<float>(n);
+    static_assert(offsetof(TubeVertex, normal) == 12 && offsetof(TubeVertex, uv) == 24, "8 packed floats");
+    const bool stream = settings.streaming_stores && reinterpret_cast<std::uintptr_t>(vertices.data()) % 16 == 0;
 
     TubeVertex* v = vertices.data();
     auto emit_ring = [&](const Ring& ring, float u, float slope) {
-        const glm::vec3 c = ring.centre_m;
-        const glm::vec3 r = ring.normal;
-        const glm::vec3 s = ring.binormal;
-        const float rad = ring.radius_m;
-        // Normal of a cone with dR/ds = slope: (d - slope t) / sqrt(1 + slope^2), d the radial direction.
+        // vertex_j = base + cos_j along_r + sin_j along_s + v_j lane_v as 8 floats (position, normal, uv): one
+        // fixed-width loop the compiler vectorizes. The normal of a cone with dR/ds = slope is
+        // (d - slope t) / sqrt(1 + slope^2), d the radial direction.
         const float a = 1.0f / std::sqrt(1.0f + slope * slope);
-        const glm::vec3 tb = (slope * a) * glm::cross(r, s);
+        const glm::vec3 tb = (slope * a) * glm::cross(ring.normal, ring.binormal);
+        const glm::vec3 rr = ring.radius_m * ring.normal;
+        const glm::vec3 sr = ring.radius_m * ring.binormal;
+        const glm::vec3 ra = a * ring.normal;
+        const glm::vec3 sa = a * ring.binormal;
+        const float base[8] = {ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, -tb.x, -tb.y, -tb.z, u, 0.0f};
+        const float along_r[8] = {rr.x, rr.y, rr.z, ra.x, ra.y, ra.z, 0.0f, 0.0f};
+        const float along_s[8] = {sr.x, sr.y, sr.z, sa.x, sa.y, sa.z, 0.0f, 0.0f};
         for (uint32_t j = 0; j <= n; ++j) {
-            const glm::vec3 d = cs[j].x * r + cs[j].y * s;
-            v->position = c + rad * d;
-            v->normal = a * d - tb;
-            v->uv = glm::vec2(u, static_cast<float>(j) * inv_n);
-            ++v;
+            const float cj = cos_phi[j], sj = sin_phi[j], vj = v_of[j];
+            float o[8];
+            for (int k = 0; k < 8; ++k) {
+                o[k] = base[k] + cj * along_r[k] + sj * along_s[k] + vj * kLaneV[k];
+            }
+            store_vertex(v++, o, stream);
         }
     };
     auto slope_at = [&](std::size_t i) -> float {
@@ -103,35 +154,46 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
     uint32_t* idx = indices.data();
     const std::size_t rows = ring_n + (closed ? 1 : 0);
     const uint32_t stride = n + 1;
+    const uint32_t* band = table.band.data();
+    const std::size_t band_size = 6 * std::size_t{n};
     for (std::size_t i = 0; i + 1 < rows; ++i) {
         const uint32_t a0 = base_vertex + static_cast<uint32_t>(i) * stride;
-        const uint32_t b0 = a0 + stride;
-        for (uint32_t j = 0; j < n; ++j) {
-            // Counter-clockwise from outside: (a_j, a_j+1, b_j), (a_j+1, b_j+1, b_j) with t = r x s.
-            idx[0] = a0 + j;
-            idx[1] = a0 + j + 1;
-            idx[2] = b0 + j;
-            idx[3] = a0 + j + 1;
-            idx[4] = b0 + j + 1;
-            idx[5] = b0 + j;
-            idx += 6;
+#if defined(__SSE2__)
+        if (stream) {
+            for (std::size_t k = 0; k < band_size; ++k) {
+                _mm_stream_si32(reinterpret_cast<int*>(idx + k), static_cast<int>(a0 + band[k]));
+            }
+            idx += band_size;
+            continue;
         }
+#endif
+        for (std::size_t k = 0; k < band_size; ++k) {
+            idx[k] = a0 + band[k];
+        }
+        idx += band_size;
     }
 
     if (!closed && settings.caps) {
         auto emit_cap = [&](const Ring& ring, float sign) {
             const uint32_t centre = base_vertex + static_cast<uint32_t>(v - vertices.data());
             const glm::vec3 normal = sign * glm::cross(ring.normal, ring.binormal);
-            v->position = ring.centre_m;
-            v->normal = normal;
-            v->uv = glm::vec2(0.5f, 0.5f);
-            ++v;
+            const float centre_vertex[8] = {ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, normal.x, normal.y,
+                                            normal.z, 0.5f, 0.5f};
+            store_vertex(v++, centre_vertex, stream);
+            // Rim positions by the side loop's exact expression, so they weld with the side vertices.
+            const glm::vec3 rr = ring.radius_m * ring.normal;
+            const glm::vec3 sr = ring.radius_m * ring.binormal;
+            const float base[8] = {ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, normal.x, normal.y, normal.z,
+                                   0.5f, 0.5f};
+            const float along_r[8] = {rr.x, rr.y, rr.z, 0.0f, 0.0f, 0.0f, 0.5f, 0.0f};
+            const float along_s[8] = {sr.x, sr.y, sr.z, 0.0f, 0.0f, 0.0f, 0.0f, 0.5f};
             for (uint32_t j = 0; j < n; ++j) {
-                const glm::vec3 d = cs[j].x * ring.normal + cs[j].y * ring.binormal;
-                v->position = ring.centre_m + ring.radius_m * d;  // same expression as the side: welds exactly
-                v->normal = normal;
-                v->uv = glm::vec2(0.5f + 0.5f * cs[j].x, 0.5f + 0.5f * cs[j].y);
-                ++v;
+                const float cj = cos_phi[j], sj = sin_phi[j];
+                float o[8];
+                for (int k = 0; k < 8; ++k) {
+                    o[k] = base[k] + cj * along_r[k] + sj * along_s[k] + 0.0f * kLaneV[k];
+                }
+                store_vertex(v++, o, stream);
             }
             for (uint32_t j = 0; j < n; ++j) {
                 const uint32_t rim_j = centre + 1 + j;
@@ -146,6 +208,11 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
         emit_cap(rings[0], -1.0f);
         emit_cap(rings[ring_n - 1], 1.0f);
     }
+#if defined(__SSE2__)
+    if (stream) {
+        _mm_sfence();  // streamed stores are weakly ordered: publish them before the caller hands the arena on
+    }
+#endif
     assert(static_cast<std::size_t>(v - vertices.data()) == counts.vertices);
     assert(static_cast<std::size_t>(idx - indices.data()) == counts.indices);
     return counts;

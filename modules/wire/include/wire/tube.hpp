@@ -26,6 +26,9 @@ struct TubeSettings {
     uint32_t sides = 0;                ///< radial sides; 0 -> 8; values below 3 become 3
     bool caps = true;                  ///< flat end caps on open wires (closed wires never get caps)
     bool tilt_normals = true;          ///< tilt side normals by the radius slope dR/ds (cones shade as cones)
+    /// Write vertices with non-temporal (cache-bypassing) stores: for large per-frame arenas that the CPU does not
+    /// read back (a mapped GPU buffer). Needs a 16-byte aligned vertex span, else ignored. Off: plain stores.
+    bool streaming_stores = false;
 };
 
 struct TubeCounts {
