@@ -1,0 +1,48 @@
+// The interface between the wire systems (CPU: which wires, what geometry) and the wire renderer (GL: upload
+// and draw): one DrawItem per visible wire per frame. Plain data; the arrays are owned by the systems and stay
+// valid until the next frame's systems run.
+#pragma once
+
+#include "wire/rings.hpp"
+#include "wire/tube.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace wire {
+
+/// How wire geometry reaches the GPU.
+enum class UploadPath : uint8_t {
+    cpu_mesh,   ///< vertices + indices built on the CPU (TubeVertex, 32 bytes a vertex)
+    gpu_rings,  ///< ring records only (Ring, 48 bytes a ring); the vertex shader expands sides from gl_VertexID
+};
+
+/// One visible wire this frame. Positions inside are relative to origin_m (double, world), so the renderer can
+/// draw camera-relative: offset = origin_m - camera position, computed in double, sent as float.
+struct DrawItem {
+    glm::dvec3 origin_m{};
+    uint32_t material = 0;   ///< index into the renderer's material table (texture, colour)
+    uint64_t wire_id = 0;    ///< the wire's entity, for statistics and tests
+
+    // cpu_mesh path
+    std::span<const TubeVertex> vertices;
+    std::span<const uint32_t> indices;  ///< relative to this item's first vertex
+
+    // gpu_rings path
+    std::span<const Ring> rings;
+    uint32_t sides = 8;      ///< radial sides, >= 3
+    bool closed = false;
+    bool caps = true;        ///< flat end caps on open wires
+    float u_close = 0.0f;    ///< closed wires: u where the loop returns to ring 0 (RingSet::u.back())
+};
+
+/// Everything the renderer needs for one frame.
+struct DrawList {
+    UploadPath path = UploadPath::cpu_mesh;
+    std::vector<DrawItem> items;
+};
+
+}  // namespace wire
