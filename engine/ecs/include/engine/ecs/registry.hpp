@@ -8,6 +8,7 @@
 #include <engine/ecs/storage.hpp>
 #include <engine/ecs/view.hpp>
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -19,8 +20,8 @@ namespace engine::ecs {
 
 namespace detail {
 inline std::size_t next_type_index() noexcept {
-    static std::size_t next = 0;
-    return next++;
+    static std::atomic<std::size_t> next{0};
+    return next.fetch_add(1, std::memory_order_relaxed);
 }
 // A dense, process-wide index per component type, assigned on first use.
 template <class T>
@@ -35,6 +36,7 @@ std::size_t type_index() noexcept {
 //   every older handle to it is stale: valid() is false, has()/try_get() report nothing.
 // - A slot whose version reaches 4095 is retired when destroyed (never reused), so a stale handle can never
 //   become valid again through version wrap-around. This costs one of the 2^20 - 1 slots per 4096 lifetimes.
+// - A registry is not thread-safe: one thread at a time may use it (and its storages and views).
 // - Calling emplace/replace/get/patch/mark_changed/remove/destroy with a stale or null handle is a
 //   programmer's mistake: it asserts with a message (ENGINE_ECS_ASSERT: debug builds, or when
 //   ENGINE_ECS_ENABLE_ASSERTS is defined). Without asserts such calls are undefined; valid(), has() and
@@ -82,6 +84,9 @@ public:
         slots_[index] = make_entity(free_head_, version + 1);
         free_head_ = index;
     }
+
+    // Reserves room for n entity slots (no entities are created).
+    void reserve(std::size_t n) { slots_.reserve(n); }
 
     // True iff e was returned by create() and not destroyed since. Safe for any handle.
     [[nodiscard]] bool valid(Entity e) const noexcept {
