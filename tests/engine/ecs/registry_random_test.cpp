@@ -31,9 +31,15 @@ constexpr int kSystems = 2;
 template <class Fn>
 void with_type(int t, Fn&& fn) {
     switch (t) {
-        case 0: fn(std::integral_constant<int, 0>{}); break;
-        case 1: fn(std::integral_constant<int, 1>{}); break;
-        default: fn(std::integral_constant<int, 2>{}); break;
+        case 0:
+            fn(std::integral_constant<int, 0>{});
+            break;
+        case 1:
+            fn(std::integral_constant<int, 1>{});
+            break;
+        default:
+            fn(std::integral_constant<int, 2>{});
+            break;
     }
 }
 
@@ -122,7 +128,9 @@ protected:
     void check_entities() {
         ASSERT_EQ(reg.alive(), model.size());
         std::array<std::size_t, kTypes> counts{};
-        for (const auto& [e, m] : model) {
+        for (const auto& entry : model) {
+            const Entity e = entry.first;  // a named copy: lambdas below capture it
+            const ModelEntity& m = entry.second;
             ASSERT_TRUE(reg.valid(e));
             for (int t = 0; t < kTypes; ++t) {
                 const auto& slot = m.comp[static_cast<std::size_t>(t)];
@@ -198,7 +206,8 @@ protected:
         for (int t = 0; t < kTypes; ++t) {
             std::set<Entity> seen;
             with_type(t, [&](auto tc) {
-                for (const Entity e : reg.changed<Comp<decltype(tc)::value>>(last_run[static_cast<std::size_t>(s)]))
+                for (const Entity e :
+                     reg.changed<Comp<decltype(tc)::value>>(last_run[static_cast<std::size_t>(s)]))
                     EXPECT_TRUE(seen.insert(e).second) << "changed<> listed an entity twice";
             });
             std::set<Entity> expect;

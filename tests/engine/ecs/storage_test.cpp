@@ -114,7 +114,8 @@ TEST(StorageChanges, TwoSystemsSeeAllChangesSinceTheirOwnRun) {
     EXPECT_EQ(collect(s.changed(last_b)).size(), 10u) << "B never ran: it still sees every change";
     last_b = s.clock();
     EXPECT_TRUE(collect(s.changed(last_b)).empty());
-    EXPECT_EQ(sorted(collect(s.changed(last_a))), sorted({es[3], es[7]})) << "B's run consumed nothing of A's";
+    EXPECT_EQ(sorted(collect(s.changed(last_a))), sorted({es[3], es[7]}))
+        << "B's run consumed nothing of A's";
 }
 
 TEST(StorageChanges, RemovedComponentsAreNotListed) {

@@ -114,8 +114,7 @@ TEST(View, RemovingCurrentEntityComponentDuringSingleTypeViewIsSafe) {
         if (a.v % 4 == 0) w.r.remove<A>(e);
     });
     EXPECT_EQ(seen, w.expect(true, false, false)) << "every member visited exactly once";
-    for (int i = 0; i < 30; i += 2)
-        EXPECT_EQ(w.r.has<A>(w.es[static_cast<std::size_t>(i)]), i % 4 != 0);
+    for (int i = 0; i < 30; i += 2) EXPECT_EQ(w.r.has<A>(w.es[static_cast<std::size_t>(i)]), i % 4 != 0);
 }
 
 TEST(View, DestroyingCurrentEntityDuringMultiTypeViewIsSafe) {

@@ -11,16 +11,20 @@ enum class Entity : std::uint32_t {};
 
 inline constexpr std::uint32_t entity_index_bits = 20;
 inline constexpr std::uint32_t entity_index_mask = (1u << entity_index_bits) - 1u;  // also the null index
-inline constexpr std::uint32_t entity_version_mask = 0xFFFu;                         // 12 bits
+inline constexpr std::uint32_t entity_version_mask = 0xFFFu;                        // 12 bits
 // Largest number of entity slots a registry can hand out (index 0xFFFFF is reserved for null).
 inline constexpr std::uint32_t max_entities = entity_index_mask;
 
 // The "no entity" handle: index 0xFFFFF, version 0xFFF. valid(null_entity) is always false.
 inline constexpr Entity null_entity{0xFFFFFFFFu};
 
-[[nodiscard]] constexpr std::uint32_t to_integral(Entity e) noexcept { return static_cast<std::uint32_t>(e); }
+[[nodiscard]] constexpr std::uint32_t to_integral(Entity e) noexcept {
+    return static_cast<std::uint32_t>(e);
+}
 // The slot index of a handle, in [0, max_entities] (max_entities only for null_entity).
-[[nodiscard]] constexpr std::uint32_t to_index(Entity e) noexcept { return to_integral(e) & entity_index_mask; }
+[[nodiscard]] constexpr std::uint32_t to_index(Entity e) noexcept {
+    return to_integral(e) & entity_index_mask;
+}
 // The version (generation) of a handle, in [0, 4095].
 [[nodiscard]] constexpr std::uint32_t to_version(Entity e) noexcept {
     return to_integral(e) >> entity_index_bits;

@@ -124,7 +124,8 @@ public:
     T& emplace_or_replace(Entity e, Args&&... args) {
         ENGINE_ECS_ASSERT(valid(e), "emplace_or_replace: stale or null entity handle");
         Storage<T>& s = storage<T>();
-        return s.contains(e) ? s.replace(e, std::forward<Args>(args)...) : s.emplace(e, std::forward<Args>(args)...);
+        return s.contains(e) ? s.replace(e, std::forward<Args>(args)...)
+                             : s.emplace(e, std::forward<Args>(args)...);
     }
     // Removes e's T if it has one; returns whether it had. Asserts valid(e).
     template <class T>

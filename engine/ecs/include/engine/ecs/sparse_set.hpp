@@ -40,7 +40,8 @@ public:
 
     // Dense position of e. Asserts that e is in the set.
     [[nodiscard]] std::size_t index_of(Entity e) const noexcept {
-        ENGINE_ECS_ASSERT(contains(e), "index_of: entity is not in this set (stale handle or missing component)");
+        ENGINE_ECS_ASSERT(contains(e),
+                          "index_of: entity is not in this set (stale handle or missing component)");
         return position_of_index(to_index(e));
     }
 

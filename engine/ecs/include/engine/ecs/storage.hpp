@@ -221,7 +221,8 @@ private:
     // First log position whose tick is >= tick (the log is sorted by tick).
     [[nodiscard]] std::size_t log_lower_bound(std::uint64_t tick) const noexcept {
         return static_cast<std::size_t>(
-            std::partition_point(log_.begin(), log_.end(), [tick](const LogEntry& le) { return le.tick < tick; }) -
+            std::partition_point(log_.begin(), log_.end(),
+                                 [tick](const LogEntry& le) { return le.tick < tick; }) -
             log_.begin());
     }
     void compact_log() {
