@@ -1,11 +1,14 @@
 // Rotation-minimizing frames by double reflection, hairpin subdivision, closed-loop holonomy removal; baselines.
 #include "wire/frames.hpp"
 
+#include <glm/mat3x3.hpp>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 namespace wire {
 namespace {
@@ -20,7 +23,7 @@ glm::dvec3 orthonormalize(const glm::dvec3& r, const glm::dvec3& t) {
     glm::dvec3 p = r - glm::dot(r, t) * t;
     const double len2 = glm::dot(p, p);
     if (len2 > 1e-20) {
-        return p / std::sqrt(len2);
+        return p * (1.0 / std::sqrt(len2));
     }
     return seed_normal(t);
 }
@@ -232,28 +235,37 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                               Sample{in.centre_m[i], out[i].t});
     };
     if (settings.method == FrameMethod::double_reflection) {
-        // Pass 1, independent per step: the mirror normals (kept in out[i].r, out[i].s until pass 2); a NaN marks a
-        // step for the guarded path. Pass 2 then carries r through two reflections per step: a short dependency
-        // chain (no square root, no division), which is what bounds the speed of a long wire.
+        // Pass 1, independent per step: the product of the two reflections as one matrix,
+        // H2 H1 = I - w1 w1^T - w2 w2^T + (w2.w1) w2 w1^T; a NaN marks a step for the guarded path. Pass 2 then
+        // carries r by one matrix-vector product per step: the only serial dependency, and a short one (no square
+        // root, no division), which is what bounds the speed. Pass 3 normalizes (independent per ring).
+        thread_local std::vector<glm::dmat3> step_matrix;  // grows once per thread, then reused
+        step_matrix.resize(n);
         constexpr double kSpecial = std::numeric_limits<double>::quiet_NaN();
         for (std::size_t i = 1; i < n; ++i) {
             const Sample a{in.centre_m[i - 1], out[i - 1].t};
             const Sample b{in.centre_m[i], out[i].t};
             glm::dvec3 w1{}, w2{};
             if (mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
-                out[i].r = w1;
-                out[i].s = w2;
+                const double k = glm::dot(w2, w1);
+                glm::dmat3 m(1.0);
+                for (int c = 0; c < 3; ++c) {  // column c: e_c - w1 w1_c - w2 w2_c + k w2 w1_c
+                    m[c] -= w1 * w1[c] + w2 * (w2[c] - k * w1[c]);
+                }
+                step_matrix[i] = m;
             } else {
-                out[i].r.x = kSpecial;
+                step_matrix[i][0][0] = kSpecial;
             }
         }
         glm::dvec3 r = r0;
         for (std::size_t i = 1; i < n; ++i) {
-            if (std::isnan(out[i].r.x)) {
+            if (std::isnan(step_matrix[i][0][0])) {
                 r = general_step(i, glm::normalize(r));
             } else {
-                r = reflect_pair(out[i].r, out[i].s, r);
-                r -= glm::dot(r, out[i].t) * out[i].t;  // against drift off the normal plane (no sqrt)
+                r = step_matrix[i] * r;
+                if ((i & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
+                    r = orthonormalize(r, out[i].t);
+                }
             }
             out[i].r = r;
         }

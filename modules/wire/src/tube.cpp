@@ -16,7 +16,6 @@ namespace wire {
 namespace {
 
 constexpr uint32_t kCachedSides = 64;
-constexpr float kLaneV[8] = {0, 0, 0, 0, 0, 0, 0, 1};  // v goes to the last float of a vertex
 
 uint32_t effective_sides(const TubeSettings& s) { return s.sides == 0 ? 8u : std::max(s.sides, 3u); }
 
@@ -54,6 +53,49 @@ const SideTable& side_table(uint32_t n) {
         }
     }
     return table;
+}
+
+/// `count` vertices: vertex_j = base + (cos_j along_r + sin_j along_s) + v_j (v_weight in the last lane), as the
+/// 8 floats of a TubeVertex. The side rows and the cap rims both go through here, so equal inputs give
+/// bit-identical positions and the mesh welds. Returns the vertex after the last one written.
+TubeVertex* emit_row(const float (&base)[8], const float (&along_r)[8], const float (&along_s)[8],
+                     const float* cos_phi, const float* sin_phi, const float* v_of, float v_weight, uint32_t count,
+                     TubeVertex* v, bool stream) {
+#if defined(__SSE2__)
+    // Two 4-float halves (x86-64 always has SSE2; no -march needed).
+    const __m128 b0 = _mm_loadu_ps(base), b1 = _mm_loadu_ps(base + 4);
+    const __m128 r0 = _mm_loadu_ps(along_r), r1 = _mm_loadu_ps(along_r + 4);
+    const __m128 s0 = _mm_loadu_ps(along_s), s1 = _mm_loadu_ps(along_s + 4);
+    const __m128 lane_v = _mm_set_ps(v_weight, 0.0f, 0.0f, 0.0f);
+    float* out = reinterpret_cast<float*>(v);
+    for (uint32_t j = 0; j < count; ++j, out += 8) {
+        const __m128 cj = _mm_set1_ps(cos_phi[j]);
+        const __m128 sj = _mm_set1_ps(sin_phi[j]);
+        const __m128 vj = _mm_set1_ps(v_of[j]);
+        const __m128 o0 = _mm_add_ps(b0, _mm_add_ps(_mm_mul_ps(cj, r0), _mm_mul_ps(sj, s0)));
+        const __m128 o1 = _mm_add_ps(_mm_add_ps(b1, _mm_mul_ps(vj, lane_v)),
+                                     _mm_add_ps(_mm_mul_ps(cj, r1), _mm_mul_ps(sj, s1)));
+        if (stream) {
+            _mm_stream_ps(out, o0);
+            _mm_stream_ps(out + 4, o1);
+        } else {
+            _mm_storeu_ps(out, o0);
+            _mm_storeu_ps(out + 4, o1);
+        }
+    }
+    return v + count;
+#else
+    (void)stream;
+    for (uint32_t j = 0; j < count; ++j, ++v) {
+        float o[8];
+        for (int k = 0; k < 8; ++k) {
+            o[k] = base[k] + (cos_phi[j] * along_r[k] + sin_phi[j] * along_s[k]);
+        }
+        o[7] += v_of[j] * v_weight;
+        std::memcpy(static_cast<void*>(v), o, sizeof(o));
+    }
+    return v;
+#endif
 }
 
 /// 32 bytes to dst; with `stream`, non-temporal (the caller checked 16-byte alignment).
@@ -119,14 +161,7 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
         const float base[8] = {ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, -tb.x, -tb.y, -tb.z, u, 0.0f};
         const float along_r[8] = {rr.x, rr.y, rr.z, ra.x, ra.y, ra.z, 0.0f, 0.0f};
         const float along_s[8] = {sr.x, sr.y, sr.z, sa.x, sa.y, sa.z, 0.0f, 0.0f};
-        for (uint32_t j = 0; j <= n; ++j) {
-            const float cj = cos_phi[j], sj = sin_phi[j], vj = v_of[j];
-            float o[8];
-            for (int k = 0; k < 8; ++k) {
-                o[k] = base[k] + cj * along_r[k] + sj * along_s[k] + vj * kLaneV[k];
-            }
-            store_vertex(v++, o, stream);
-        }
+        v = emit_row(base, along_r, along_s, cos_phi, sin_phi, v_of, 1.0f, n + 1, v, stream);
     };
     auto slope_at = [&](std::size_t i) -> float {
         if (!settings.tilt_normals || ring_n < 2) {
@@ -187,14 +222,7 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
                                    0.5f, 0.5f};
             const float along_r[8] = {rr.x, rr.y, rr.z, 0.0f, 0.0f, 0.0f, 0.5f, 0.0f};
             const float along_s[8] = {sr.x, sr.y, sr.z, 0.0f, 0.0f, 0.0f, 0.0f, 0.5f};
-            for (uint32_t j = 0; j < n; ++j) {
-                const float cj = cos_phi[j], sj = sin_phi[j];
-                float o[8];
-                for (int k = 0; k < 8; ++k) {
-                    o[k] = base[k] + cj * along_r[k] + sj * along_s[k] + 0.0f * kLaneV[k];
-                }
-                store_vertex(v++, o, stream);
-            }
+            v = emit_row(base, along_r, along_s, cos_phi, sin_phi, v_of, 0.0f, n, v, stream);
             for (uint32_t j = 0; j < n; ++j) {
                 const uint32_t rim_j = centre + 1 + j;
                 const uint32_t rim_k = centre + 1 + (j + 1) % n;

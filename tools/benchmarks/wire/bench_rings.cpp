@@ -147,11 +147,13 @@ void BM_RingsOnly(benchmark::State& state) {
 /// Tube vertices and indices from prepared rings only.
 void BM_TubeOnly(benchmark::State& state) {
     Scene& s = scene();
+    s.tube_settings.streaming_stores = state.range(0) != 0;
     for (auto _ : state) {
         for (int w = 0; w < kWires; ++w) s.tube(w);
         benchmark::DoNotOptimize(s.vertices.data());
         benchmark::ClobberMemory();
     }
+    s.tube_settings.streaming_stores = false;
     report(state, s);
 }
 
@@ -171,7 +173,7 @@ void BM_MemsetSameBytes(benchmark::State& state) {
 BENCHMARK(BM_RingsAndTube)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RingsAndTubeStreaming)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RingsOnly)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_TubeOnly)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TubeOnly)->ArgName("streaming")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MemsetSameBytes)->Unit(benchmark::kMillisecond);
 
 }  // namespace
