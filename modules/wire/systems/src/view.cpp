@@ -1,0 +1,12 @@
+// engine::scene::Camera -> wire::LodView.
+#include "wire/systems/view.hpp"
+
+namespace wire::systems {
+
+LodView lod_view(const engine::scene::Camera& camera, double width_px, double height_px) {
+    return LodView::perspective(glm::dvec3(camera.position), glm::dvec3(camera.target), glm::dvec3(camera.up),
+                                static_cast<double>(camera.fov_y_rad), width_px, height_px,
+                                static_cast<double>(camera.near_m), static_cast<double>(camera.far_m));
+}
+
+}  // namespace wire::systems

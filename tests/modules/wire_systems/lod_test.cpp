@@ -1,0 +1,445 @@
+// LOD proof: for random wires (random walks, hanging cables, helices) and cameras (near, far, grazing, partly
+// behind the near plane), the projected ring polyline stays within the pixel tolerance of a dense projected
+// reference of the curve; hysteresis never goes below what the tolerance needs and does not flicker; culled
+// wires get no rings.
+//
+// What "visible" means here: the guarantee is about what is on screen, so a reference point counts when its
+// depth is in [near, far] and it projects inside the 1920x1080 viewport. Polyline pieces are clipped at the near
+// plane before projection (a projective map keeps straight pieces straight only in front of the camera). Cameras
+// whose view crosses the wire ("partly behind") are included: their segments that cross the near plane are
+// refined at z_min = near, which is what the visible part needs.
+#include "wire/lod.hpp"
+#include "wire/spline.hpp"
+#include "wire/tessellate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace wire {
+namespace {
+
+constexpr double kWidth = 1920.0;
+constexpr double kHeight = 1080.0;
+const double kFov = 60.0 * std::numbers::pi / 180.0;
+
+using Rng = std::mt19937_64;
+
+double uniform(Rng& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+
+glm::dvec3 random_unit(Rng& rng) {
+    for (;;) {
+        const glm::dvec3 v(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+        const double l = glm::length(v);
+        if (l > 0.1 && l <= 1.0) return v / l;
+    }
+}
+
+enum class Shape { random_walk, hanging, helix };
+
+WireNodes make_wire(Shape shape, Rng& rng) {
+    WireNodes w;
+    const double scale = std::pow(10.0, uniform(rng, -1.0, 1.5));  // 0.1 m .. 30 m
+    const glm::dvec3 origin = random_unit(rng) * uniform(rng, 0.0, 5.0) * scale;
+    switch (shape) {
+        case Shape::random_walk: {
+            const int n = static_cast<int>(uniform(rng, 3, 40));
+            glm::dvec3 p = origin;
+            glm::dvec3 dir = random_unit(rng);
+            for (int i = 0; i < n; ++i) {
+                w.positions.push_back(p);
+                dir = glm::normalize(dir + random_unit(rng) * uniform(rng, 0.2, 1.5));
+                p += dir * uniform(rng, 0.02, 0.3) * scale;
+            }
+            break;
+        }
+        case Shape::hanging: {
+            const int n = static_cast<int>(uniform(rng, 4, 64));
+            const double span = scale;
+            const double a = span * uniform(rng, 0.15, 2.0);  // catenary parameter: deep to shallow sag
+            const glm::dvec3 along = random_unit(rng);
+            const glm::dvec3 down(0, -1, 0);
+            for (int i = 0; i < n; ++i) {
+                const double x = span * (static_cast<double>(i) / (n - 1) - 0.5);
+                const double sag = a * (std::cosh(x / a) - std::cosh(0.5 * span / a));
+                w.positions.push_back(origin + along * x - down * sag);
+            }
+            break;
+        }
+        case Shape::helix: {
+            const int n = static_cast<int>(uniform(rng, 8, 60));
+            const double radius = scale * uniform(rng, 0.05, 0.5);
+            const double pitch = scale * uniform(rng, 0.02, 0.3);
+            const double step = uniform(rng, 0.3, 1.2);  // radians between nodes
+            for (int i = 0; i < n; ++i) {
+                const double th = i * step;
+                w.positions.push_back(origin + glm::dvec3(radius * std::cos(th), pitch * th, radius * std::sin(th)));
+            }
+            break;
+        }
+    }
+    return w;
+}
+
+enum class CameraKind { near_fill, far_few_px, grazing, partly_behind };
+const char* name(CameraKind k) {
+    switch (k) {
+        case CameraKind::near_fill: return "near";
+        case CameraKind::far_few_px: return "far";
+        case CameraKind::grazing: return "grazing";
+        case CameraKind::partly_behind: return "partly_behind";
+    }
+    return "?";
+}
+
+LodView make_camera(CameraKind kind, const Curve& curve, Rng& rng) {
+    glm::dvec3 lo(std::numeric_limits<double>::infinity());
+    glm::dvec3 hi(-std::numeric_limits<double>::infinity());
+    for (const CubicBezier& c : curve.segments) {
+        for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+    }
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    const double r = std::max(0.5 * glm::length(hi - lo), 1e-3);
+    const double near = 0.05;
+    const double far = 1e6;
+    glm::dvec3 eye, target;
+    switch (kind) {
+        case CameraKind::near_fill:
+            target = centre + random_unit(rng) * r * 0.2;
+            eye = centre + random_unit(rng) * r / std::tan(0.5 * kFov) * uniform(rng, 0.6, 1.2);
+            break;
+        case CameraKind::far_few_px: {
+            const double f = 0.5 * kHeight / std::tan(0.5 * kFov);
+            target = centre;
+            eye = centre + random_unit(rng) * r * f / uniform(rng, 2.0, 20.0);  // wire spans 4..40 px
+            break;
+        }
+        case CameraKind::grazing: {
+            // Behind the first node, looking along the wire's first tangent, slightly off the line.
+            const CubicBezier& c = curve.segments.front();
+            glm::dvec3 t = c.b1 - c.b0;
+            if (glm::length(t) < 1e-12) t = c.b3 - c.b0;
+            t = glm::normalize(t);
+            eye = c.b0 - t * r * uniform(rng, 0.05, 1.0) + random_unit(rng) * r * 0.02;
+            target = c.b0 + t * r;
+            break;
+        }
+        case CameraKind::partly_behind: {
+            const CubicBezier& c = curve.segments[curve.segments.size() / 2];
+            eye = position(c, uniform(rng, 0.0, 1.0)) + random_unit(rng) * r * uniform(rng, 0.01, 0.1);
+            target = eye + random_unit(rng);
+            break;
+        }
+    }
+    glm::dvec3 up(0, 1, 0);
+    if (glm::length(glm::cross(glm::normalize(target - eye), up)) < 1e-3) up = glm::dvec3(1, 0, 0);
+    return LodView::perspective(eye, target, up, kFov, kWidth, kHeight, near, far);
+}
+
+// Independent brute-force measurement: each on-screen reference point against every (clipped, projected) piece.
+double brute_force_error_px(const Curve& curve, const std::vector<RingParam>& params, const LodView& view,
+                            int per_segment) {
+    std::vector<std::pair<glm::dvec2, glm::dvec2>> pieces;
+    const std::size_t n = params.size();
+    const std::size_t np = curve.closed ? n : n - 1;
+    for (std::size_t j = 0; j < np; ++j) {
+        glm::dvec3 a = view.to_view(position(curve.segments[params[j].segment], params[j].t));
+        glm::dvec3 b = view.to_view(position(curve.segments[params[(j + 1) % n].segment], params[(j + 1) % n].t));
+        const double zn = view.near_m;
+        if (a.z < zn && b.z < zn) continue;
+        if (a.z < zn) a += (b - a) * ((zn - a.z) / (b.z - a.z));
+        if (b.z < zn) b += (a - b) * ((zn - b.z) / (a.z - b.z));
+        a.z = std::max(a.z, zn);
+        b.z = std::max(b.z, zn);
+        pieces.emplace_back(view.view_to_px(a), view.view_to_px(b));
+    }
+    double worst = 0.0;
+    for (std::size_t i = 0; i < curve.segment_count(); ++i) {
+        for (int s = 0; s <= per_segment; ++s) {
+            const glm::dvec3 q = view.to_view(position(curve.segments[i], static_cast<double>(s) / per_segment));
+            if (!(q.z >= view.near_m && q.z <= view.far_m)) continue;
+            const glm::dvec2 p = view.view_to_px(q);
+            if (!(p.x >= 0 && p.x <= view.width_px && p.y >= 0 && p.y <= view.height_px)) continue;
+            double best = std::numeric_limits<double>::infinity();
+            for (const auto& [a, b] : pieces) {
+                const glm::dvec2 ab = b - a;
+                const double l2 = glm::dot(ab, ab);
+                const double h = l2 > 0 ? std::clamp(glm::dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+                best = std::min(best, glm::length(p - (a + h * ab)));
+            }
+            worst = std::max(worst, best);
+        }
+    }
+    return worst;
+}
+
+struct ProofStats {
+    double worst_ratio = 0.0;  // max error / tolerance over all cases
+    std::size_t cases = 0, visible_cases = 0, samples = 0;
+    std::string worst_case;
+};
+
+void run_proof(double tolerance_px, int wires_per_shape, ProofStats& st) {
+    Rng rng(static_cast<uint64_t>(tolerance_px * 1000.0) + 12345);
+    const LodSettings settings{.tolerance_px = tolerance_px, .max_rings_per_segment = 1u << 16};
+    for (Shape shape : {Shape::random_walk, Shape::hanging, Shape::helix}) {
+        for (int w = 0; w < wires_per_shape; ++w) {
+            const WireNodes nodes = make_wire(shape, rng);
+            Curve curve;
+            ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.01f}, curve).ok);
+            for (CameraKind kind :
+                 {CameraKind::near_fill, CameraKind::far_few_px, CameraKind::grazing, CameraKind::partly_behind}) {
+                const LodView view = make_camera(kind, curve, rng);
+                WireLod lod;
+                update_lod(curve, view, settings, lod);
+                ++st.cases;
+                if (!lod.visible) continue;
+                ++st.visible_cases;
+                ASSERT_EQ(lod.clamped_segments, 0u);
+                std::vector<RingParam> params;
+                place_rings(curve, lod.counts, params);
+                const ScreenError e = measure_screen_error(curve, params, view, 256);
+                st.samples += e.samples;
+                const double ratio = e.max_px / tolerance_px;
+                if (ratio > st.worst_ratio) {
+                    st.worst_ratio = ratio;
+                    st.worst_case = std::string(name(kind)) + " shape " + std::to_string(static_cast<int>(shape)) +
+                                    " wire " + std::to_string(w);
+                }
+                ASSERT_LE(e.max_px, tolerance_px * (1.0 + 1e-9))
+                    << "camera " << name(kind) << ", shape " << static_cast<int>(shape) << ", wire " << w
+                    << ", segment " << e.worst_segment << " t " << e.worst_t;
+            }
+        }
+    }
+}
+
+TEST(LodProof, ScreenErrorWithinTolerance) {
+    for (double tol : {0.5, 0.1, 2.0}) {
+        ProofStats st;
+        run_proof(tol, 40, st);
+        if (HasFatalFailure()) return;
+        std::printf("tolerance %.2f px: %zu cases (%zu visible), %zu on-screen reference points, worst error "
+                    "%.3f of tolerance (%s)\n",
+                    tol, st.cases, st.visible_cases, st.samples, st.worst_ratio, st.worst_case.c_str());
+        EXPECT_GT(st.visible_cases, st.cases / 2);
+        EXPECT_GT(st.worst_ratio, 0.2) << "the bound should not be wildly loose";
+    }
+}
+
+// The measurement used by the proof is an upper bound of the brute-force distance to the whole polyline and
+// it notices too few rings: with half the required counts the tolerance is exceeded.
+TEST(LodProof, MeasurementAgreesWithBruteForceAndDetectsUnderTessellation) {
+    Rng rng(99);
+    int exceeded = 0, tried = 0;
+    for (int w = 0; w < 24; ++w) {
+        const WireNodes nodes = make_wire(static_cast<Shape>(w % 3), rng);
+        Curve curve;
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{}, curve).ok);
+        const LodView view = make_camera(static_cast<CameraKind>(w % 4), curve, rng);
+        WireLod lod;
+        update_lod(curve, view, LodSettings{.max_rings_per_segment = 1u << 16}, lod);
+        if (!lod.visible) continue;
+        std::vector<RingParam> params;
+        place_rings(curve, lod.counts, params);
+        const double local = measure_screen_error(curve, params, view, 64).max_px;
+        const double brute = brute_force_error_px(curve, params, view, 64);
+        EXPECT_GE(local + 1e-9, brute);
+        EXPECT_LE(local, 0.5 * (1 + 1e-9));
+
+        std::vector<uint32_t> half = lod.counts;
+        for (uint32_t& c : half) c = std::max<uint32_t>(1, c / 2);
+        place_rings(curve, half, params);
+        ++tried;
+        if (measure_screen_error(curve, params, view, 64).max_px > 0.5) ++exceeded;
+    }
+    EXPECT_GT(tried, 12);
+    EXPECT_GT(exceeded, tried / 3) << "halving the counts should break the tolerance on most wires";
+}
+
+// Sides: the n-gon's radial error R_px (1 - cos(pi/n)) is within the tolerance at every on-screen sample.
+TEST(LodProof, SidesPolygonErrorWithinTolerance) {
+    Rng rng(5);
+    for (int w = 0; w < 60; ++w) {
+        WireNodes nodes = make_wire(static_cast<Shape>(w % 3), rng);
+        Curve curve;
+        const float radius = static_cast<float>(std::pow(10.0, uniform(rng, -3.0, -0.5)));
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok);
+        const LodView view = make_camera(static_cast<CameraKind>(w % 4), curve, rng);
+        const LodSettings settings{.tolerance_px = 0.5, .max_sides = 1024};
+        WireLod lod;
+        update_lod(curve, view, settings, lod);
+        if (!lod.visible || lod.visible_segments == 0) continue;
+        ASSERT_GE(lod.sides, 3u);
+        if (lod.sides == 1024u) continue;
+        for (std::size_t i = 0; i < curve.segment_count(); ++i) {
+            for (int s = 0; s <= 32; ++s) {
+                const glm::dvec3 q = view.to_view(position(curve.segments[i], s / 32.0));
+                if (!(q.z >= view.near_m)) continue;
+                const glm::dvec2 p = view.view_to_px(q);
+                if (!(p.x >= 0 && p.x <= kWidth && p.y >= 0 && p.y <= kHeight)) continue;
+                // Projected radius at this point, with the same off-axis factor as the bound.
+                const double a = q.x / q.z, b = q.y / q.z;
+                const double r_px = radius * view.focal_px * std::sqrt(1 + a * a + b * b) / q.z;
+                EXPECT_LE(r_px * (1.0 - std::cos(std::numbers::pi / lod.sides)), 0.5 * (1 + 1e-9));
+            }
+        }
+    }
+}
+
+LodView orbit_camera(double angle, double distance) {
+    const glm::dvec3 eye(distance * std::sin(angle), 1.0, distance * std::cos(angle));
+    return LodView::perspective(eye, glm::dvec3(0.0), glm::dvec3(0, 1, 0), kFov, kWidth, kHeight, 0.05, 1e4);
+}
+
+Curve hanging_curve(int n) {
+    WireNodes nodes;
+    for (int i = 0; i < n; ++i) {
+        const double x = 4.0 * (static_cast<double>(i) / (n - 1) - 0.5);
+        nodes.positions.emplace_back(x, 1.5 * (std::cosh(x / 1.5) - std::cosh(2.0 / 1.5)), 0.0);
+    }
+    Curve c;
+    EXPECT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.02f}, c).ok);
+    return c;
+}
+
+TEST(LodHysteresis, NeverBelowRequirementOnACameraWalk) {
+    const Curve curve = hanging_curve(16);
+    Rng rng(3);
+    WireLod lod;
+    double angle = 0.0, distance = 3.0;
+    std::size_t total_changes = 0;
+    for (int frame = 0; frame < 400; ++frame) {
+        // Slow drift with occasional jumps toward and away from the wire.
+        angle += uniform(rng, -0.01, 0.02);
+        distance = std::clamp(distance * std::exp(uniform(rng, -0.05, 0.05) + (frame % 100 == 50 ? 1.5 : 0.0) -
+                                                  (frame % 100 == 99 ? 1.5 : 0.0)),
+                              0.3, 500.0);
+        const LodView view = orbit_camera(angle, distance);
+        update_lod(curve, view, LodSettings{}, lod);
+        total_changes += lod.changed_counts;
+        if (!lod.visible) continue;
+        for (std::size_t i = 0; i < lod.counts.size(); ++i) ASSERT_GE(lod.counts[i], lod.required[i]);
+        ASSERT_GE(lod.sides, lod.required_sides);
+        std::vector<RingParam> params;
+        place_rings(curve, lod.counts, params);
+        ASSERT_LE(measure_screen_error(curve, params, view, 64).max_px, 0.5 * (1 + 1e-9)) << "frame " << frame;
+    }
+    EXPECT_GT(total_changes, 0u);
+}
+
+// Sum of everything the raw (no hysteresis) LOD would pick at this distance, to find count boundaries.
+uint64_t raw_signature(const Curve& curve, double distance) {
+    WireLod lod;
+    update_lod(curve, orbit_camera(0.3, distance), LodSettings{.hysteresis_band = -1.0}, lod);
+    uint64_t sig = lod.required_sides;
+    for (uint32_t r : lod.required) sig = sig * 31 + r;
+    return sig;
+}
+
+TEST(LodHysteresis, TinyBackAndForthMotionDoesNotFlicker) {
+    const Curve curve = hanging_curve(24);
+    // Find camera distances where some raw count steps (the worst place for flicker), by bisection.
+    std::vector<double> boundaries;
+    for (double d = 0.8; d < 60.0 && boundaries.size() < 6; d *= 1.15) {
+        double lo = d, hi = d * 1.15;
+        const uint64_t sig_lo = raw_signature(curve, lo);
+        if (sig_lo == raw_signature(curve, hi)) continue;
+        for (int it = 0; it < 60; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (raw_signature(curve, mid) == sig_lo ? lo : hi) = mid;
+        }
+        boundaries.push_back(0.5 * (lo + hi));
+    }
+    ASSERT_GE(boundaries.size(), 4u);
+    for (double base : boundaries) {
+        // The camera jitters by 1e-4 of its distance across the boundary.
+        WireLod lod, raw;
+        std::size_t late_changes = 0, raw_changes = 0;
+        for (int frame = 0; frame < 200; ++frame) {
+            const double d = base * (1.0 + 1e-4 * std::sin(frame * 0.9));
+            const uint32_t sides_before = lod.sides, raw_sides_before = raw.sides;
+            update_lod(curve, orbit_camera(0.3, d), LodSettings{}, lod);
+            update_lod(curve, orbit_camera(0.3, d), LodSettings{.hysteresis_band = -1.0}, raw);
+            if (frame >= 5) {
+                late_changes += lod.changed_counts + (lod.sides != sides_before ? 1u : 0u);
+                raw_changes += raw.changed_counts + (raw.sides != raw_sides_before ? 1u : 0u);
+            }
+            for (std::size_t i = 0; i < lod.counts.size(); ++i) ASSERT_GE(lod.counts[i], lod.required[i]);
+            ASSERT_GE(lod.sides, lod.required_sides);
+        }
+        EXPECT_EQ(late_changes, 0u) << "distance " << base;
+        // Without hysteresis the same jitter flickers (so the check above is not vacuous).
+        EXPECT_GT(raw_changes, 20u) << "distance " << base;
+    }
+}
+
+TEST(LodHysteresis, CountsComeDownWhenTheCameraLeaves) {
+    const Curve curve = hanging_curve(16);
+    WireLod lod;
+    update_lod(curve, orbit_camera(0.0, 2.5), LodSettings{}, lod);
+    uint32_t near_total = 0;
+    for (uint32_t c : lod.counts) near_total += c;
+    update_lod(curve, orbit_camera(0.0, 200.0), LodSettings{}, lod);
+    uint32_t far_total = 0;
+    for (uint32_t c : lod.counts) far_total += c;
+    EXPECT_LT(far_total, near_total);
+    for (std::size_t i = 0; i < lod.counts.size(); ++i) {
+        EXPECT_LE(lod.counts[i], lod.required[i] + 1 + lod.required[i] / 8);  // only the drop headroom is kept
+    }
+}
+
+TEST(LodCulling, CulledWireGetsNoRings) {
+    const Curve curve = hanging_curve(16);
+    WireLod lod;
+    update_lod(curve, orbit_camera(0.0, 3.0), LodSettings{}, lod);
+    ASSERT_TRUE(lod.visible);
+    // Looking away from the wire.
+    const LodView away = LodView::perspective(glm::dvec3(0, 0, 3), glm::dvec3(0, 0, 10), glm::dvec3(0, 1, 0), kFov,
+                                              kWidth, kHeight, 0.05, 1e4);
+    EXPECT_TRUE(update_lod(curve, away, LodSettings{}, lod));
+    EXPECT_FALSE(lod.visible);
+    EXPECT_TRUE(lod.counts.empty());
+    EXPECT_EQ(lod.sides, 0u);
+    EXPECT_EQ(ring_count(lod.counts, curve.closed), 0u);
+    // Just past the far plane, too.
+    const LodView far_cam = LodView::perspective(glm::dvec3(0, 0, 50), glm::dvec3(0, 0, 0), glm::dvec3(0, 1, 0),
+                                                 kFov, kWidth, kHeight, 0.05, 40.0);
+    update_lod(curve, far_cam, LodSettings{}, lod);
+    EXPECT_FALSE(lod.visible);
+    // The radius inflates the hull: a thick wire just outside the side plane is still drawn.
+    EXPECT_TRUE(hull_visible(curve.segments, 0.0, orbit_camera(0.0, 3.0)));
+}
+
+TEST(LodCulling, OffscreenSegmentsAreCoarse) {
+    // A long straight-ish cable passing beside and behind the camera: segments off screen get 1 ring.
+    WireNodes nodes;
+    for (int i = 0; i < 40; ++i) nodes.positions.emplace_back(0.3 * std::sin(i * 0.7), 0.0, -20.0 + i);
+    Curve curve;
+    ASSERT_TRUE(build_curve(nodes, SplineSettings{}, curve).ok);
+    const LodView view = LodView::perspective(glm::dvec3(1, 0.5, 0), glm::dvec3(1, 0.5, -1), glm::dvec3(0, 1, 0),
+                                              kFov, kWidth, kHeight, 0.05, 1e4);
+    WireLod lod;
+    update_lod(curve, view, LodSettings{}, lod);
+    ASSERT_TRUE(lod.visible);
+    EXPECT_LT(lod.visible_segments, curve.segment_count());
+    EXPECT_EQ(lod.counts.back(), 1u);  // behind the camera
+    std::vector<RingParam> params;
+    place_rings(curve, lod.counts, params);
+    EXPECT_LE(measure_screen_error(curve, params, view, 256).max_px, 0.5 * (1 + 1e-9));
+}
+
+}  // namespace
+}  // namespace wire
