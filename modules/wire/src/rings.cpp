@@ -150,16 +150,19 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
                           out.origin_m;
         const glm::dvec3 d1 = seg.derivative(p.t);
         const glm::dvec3 d2 = seg.second_derivative(p.t);
-        const double speed = glm::length(d1);
-        out.tangent_scratch[i] = speed > 0.0 ? d1 / speed : glm::dvec3(0.0);
-        // Near-zero derivative: the one-sided limits of unit_tangent() (rare; it re-derives the threshold).
-        if (!(speed > seg.tiny_speed)) {
+        const double speed2 = glm::dot(d1, d1);
+        const double speed = std::sqrt(speed2);
+        if (speed > seg.tiny_speed) {
+            out.tangent_scratch[i] = d1 * (1.0 / speed);
+        } else {  // vanishing derivative: the one-sided limits of unit_tangent() (rare)
             out.tangent_scratch[i] = unit_tangent(curve.segments[p.segment], p.t);
         }
-        // Fold: the inner side of the tube crosses itself where the radius reaches the curvature radius.
+        // Fold: the inner side of the tube crosses itself where the radius reaches the curvature radius
+        // |B'|^3 / |B' x B''|; compared squared, without a root.
         const double radius = seg.radius(p.t);
-        const double bend = glm::length(glm::cross(d1, d2));  // = curvature * speed^3
-        if (radius * bend >= speed * speed * speed && bend > 0.0) {
+        const glm::dvec3 bend = glm::cross(d1, d2);  // |bend| = curvature * speed^3
+        const double bend2 = glm::dot(bend, bend);
+        if (radius * radius * bend2 >= speed2 * speed2 * speed2 && bend2 > 0.0) {
             if (out.fold_count++ == 0) {
                 out.first_fold_ring = static_cast<uint32_t>(i);
             }

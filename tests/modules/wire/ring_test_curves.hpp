@@ -107,10 +107,13 @@ inline bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfi
 inline bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 /// Frames finite, unit, mutually orthogonal and right-handed to `tol`; float ring records unit to 1e-5.
-inline void expect_orthonormal(const RingSet& set, double tol = 1e-5) {
+inline double expect_orthonormal(const RingSet& set, double tol = 1e-5) {
     std::size_t bad = 0;
+    double worst = 0.0;
     for (std::size_t i = 0; i < set.frames.size(); ++i) {
         const Frame& f = set.frames[i];
+        worst = std::max({worst, std::abs(glm::length(f.r) - 1.0), std::abs(glm::dot(f.t, f.r)),
+                          std::abs(glm::length(f.s) - 1.0), std::abs(glm::dot(f.t, f.s))});
         const bool ok = finite(f.t) && finite(f.r) && finite(f.s) && std::abs(glm::length(f.t) - 1.0) < tol &&
                         std::abs(glm::length(f.r) - 1.0) < tol && std::abs(glm::length(f.s) - 1.0) < tol &&
                         std::abs(glm::dot(f.t, f.r)) < tol && std::abs(glm::dot(f.t, f.s)) < tol &&
@@ -126,6 +129,7 @@ inline void expect_orthonormal(const RingSet& set, double tol = 1e-5) {
         }
     }
     EXPECT_EQ(bad, 0u);
+    return worst;
 }
 
 /// u strictly increasing where the wire has length (non-decreasing everywhere) and finite.

@@ -65,8 +65,8 @@ struct FrameInput {
 /// uses a neighbouring tangent); `degenerate` reports whether the derivative vanished.
 [[nodiscard]] glm::dvec3 unit_tangent(const CubicBezier& c, double t, bool* degenerate = nullptr);
 
-/// Frames at every ring of `in` into `out` (out.size() == in.params.size()). Orthonormal to 1e-12 in practice
-/// (each frame is re-orthonormalized), promised to 1e-5. Closed curves: unless keep_holonomy, ring i is rotated
+/// Frames at every ring of `in` into `out` (out.size() == in.params.size()). Orthonormal to ~1e-14 in practice
+/// (re-orthonormalized every 64 steps), promised to 1e-5. Closed curves: unless keep_holonomy, ring i is rotated
 /// about its tangent by -wrap(holonomy) * s_i / L so the frame transported around the loop returns to ring 0's.
 FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, std::span<Frame> out);
 
