@@ -1,0 +1,355 @@
+// WireRenderer: one stream-buffer region per frame holding per-draw records, indirect commands and geometry (tube
+// vertices + indices, or ring records), drawn with one glMultiDraw*Indirect per material.
+#include "wire/render/wire_renderer.hpp"
+
+#include "shaders.hpp"
+#include "wire/render/stream_buffer.hpp"
+#include "wire/render/weave.hpp"
+
+#include <epoxy/gl.h>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <cassert>
+#include <cstring>
+#include <numeric>
+
+namespace wire::render {
+namespace {
+
+namespace gfx = engine::gfx;
+
+struct DrawElementsIndirectCommand {
+    uint32_t count;
+    uint32_t instance_count;
+    uint32_t first_index;
+    int32_t base_vertex;
+    uint32_t base_instance;
+};
+struct DrawArraysIndirectCommand {
+    uint32_t count;
+    uint32_t instance_count;
+    uint32_t first;
+    uint32_t base_instance;
+};
+static_assert(sizeof(DrawElementsIndirectCommand) == 20 && sizeof(DrawArraysIndirectCommand) == 16);
+
+constexpr std::size_t kSectionAlign = 256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every driver we know
+constexpr GLuint kDrawIndexLocation = 3;
+
+std::size_t align_up(std::size_t v) { return (v + kSectionAlign - 1) / kSectionAlign * kSectionAlign; }
+
+/// Vertices the ring expansion produces for a gpu-rings item (0 if it draws nothing).
+uint32_t expanded_vertices(const DrawItem& item) {
+    const auto rings = static_cast<uint32_t>(item.rings.size());
+    if (rings == 0) return 0;
+    const uint32_t n = item.sides;
+    const uint32_t bands = rings - 1 + (item.closed ? 1 : 0);
+    uint32_t count = bands * 6 * n;
+    if (!item.closed && item.caps) count += 2 * 3 * n;
+    return count;
+}
+
+bool has_geometry(const DrawItem& item, UploadPath path) {
+    if (path == UploadPath::cpu_mesh) return !item.vertices.empty() && !item.indices.empty();
+    return expanded_vertices(item) > 0;
+}
+
+}  // namespace
+
+struct WireRenderer::State {
+    RendererDesc desc;
+    gfx::Program cpu_program;
+    gfx::Program rings_program;
+    gfx::VertexArray cpu_vao;
+    gfx::VertexArray rings_vao;
+    gfx::Buffer draw_index_buffer;  ///< 0, 1, 2, ... for the instanced draw-index attribute (fallback only)
+    std::size_t draw_index_capacity = 0;
+    bool draw_parameters = false;
+    StreamBuffer stream;
+    std::vector<gfx::Texture> textures;
+    std::vector<Material> materials;
+    std::vector<uint32_t> order;  ///< items with geometry, sorted by material (scratch, reused)
+
+    Expected<void> ensure_draw_index_capacity(std::size_t n) {
+        if (draw_parameters || n <= draw_index_capacity) return {};
+        const std::size_t capacity = std::max<std::size_t>(n, std::max<std::size_t>(1024, 2 * draw_index_capacity));
+        std::vector<uint32_t> iota(capacity);
+        std::iota(iota.begin(), iota.end(), 0u);
+        Expected<gfx::Buffer> made = gfx::make_buffer(std::span<const uint32_t>(iota), "wire draw index");
+        if (!made) return made.error();
+        draw_index_buffer = std::move(made).value();
+        draw_index_capacity = capacity;
+        for (const gfx::VertexArray* vao : {&cpu_vao, &rings_vao}) {
+            glVertexArrayVertexBuffer(vao->id(), 1, draw_index_buffer.id(), 0, sizeof(uint32_t));
+        }
+        return {};
+    }
+};
+
+WireRenderer::WireRenderer() = default;
+WireRenderer::WireRenderer(WireRenderer&&) noexcept = default;
+WireRenderer& WireRenderer::operator=(WireRenderer&&) noexcept = default;
+WireRenderer::~WireRenderer() = default;
+
+Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
+    WireRenderer r;
+    r.state_ = std::make_unique<State>();
+    State& s = *r.state_;
+    s.desc = desc;
+    s.draw_parameters = !desc.force_draw_index_attribute &&
+                        (epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_shader_draw_parameters"));
+
+    const std::string fragment = detail::fragment_source(desc.shading_glsl);
+    const std::string cpu_vertex = detail::vertex_source(true, s.draw_parameters);
+    const std::string rings_vertex = detail::vertex_source(false, s.draw_parameters);
+    Expected<gfx::Program> cpu = gfx::make_program({.vertex = cpu_vertex, .fragment = fragment, .label = "wire cpu-mesh"});
+    if (!cpu) return cpu.error();
+    Expected<gfx::Program> rings =
+        gfx::make_program({.vertex = rings_vertex, .fragment = fragment, .label = "wire gpu-rings"});
+    if (!rings) return rings.error();
+    s.cpu_program = std::move(cpu).value();
+    s.rings_program = std::move(rings).value();
+
+    // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 (the buffer is set per frame); both read the
+    // draw index at binding 1 when the draw-parameters extension is missing.
+    s.cpu_vao = gfx::make_vertex_array({.label = "wire cpu-mesh"});
+    s.rings_vao = gfx::make_vertex_array({.label = "wire gpu-rings"});
+    const GLuint cpu_vao = s.cpu_vao.id();
+    const struct {
+        GLuint location;
+        GLint components;
+        GLuint offset;
+    } attributes[] = {{0, 3, offsetof(TubeVertex, position)}, {1, 3, offsetof(TubeVertex, normal)},
+                      {2, 2, offsetof(TubeVertex, uv)}};
+    for (const auto& a : attributes) {
+        glEnableVertexArrayAttrib(cpu_vao, a.location);
+        glVertexArrayAttribFormat(cpu_vao, a.location, a.components, GL_FLOAT, GL_FALSE, a.offset);
+        glVertexArrayAttribBinding(cpu_vao, a.location, 0);
+    }
+    if (!s.draw_parameters) {
+        for (const gfx::VertexArray* vao : {&s.cpu_vao, &s.rings_vao}) {
+            glEnableVertexArrayAttrib(vao->id(), kDrawIndexLocation);
+            glVertexArrayAttribIFormat(vao->id(), kDrawIndexLocation, 1, GL_UNSIGNED_INT, 0);
+            glVertexArrayAttribBinding(vao->id(), kDrawIndexLocation, 1);
+            glVertexArrayBindingDivisor(vao->id(), 1, 1);
+        }
+        if (Expected<void> st = s.ensure_draw_index_capacity(1); !st) return st.error();
+    }
+
+    // The built-in weave: mipmapped, repeating, anisotropic where available.
+    const int weave_size = desc.weave_size_px > 0 ? desc.weave_size_px : 256;
+    const std::vector<uint8_t> weave = make_weave_rgba({.size_px = weave_size});
+    Expected<gfx::Texture> texture = gfx::make_texture({.width = weave_size,
+                                                        .height = weave_size,
+                                                        .rgba = weave,
+                                                        .mipmaps = true,
+                                                        .wrap = gfx::Wrap::repeat,
+                                                        .label = "wire weave"});
+    if (!texture) return texture.error();
+    if (epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_texture_filter_anisotropic") ||
+        epoxy_has_gl_extension("GL_EXT_texture_filter_anisotropic")) {
+        GLfloat max_supported = 1.0f;
+        glGetFloatv(GL_MAX_TEXTURE_MAX_ANISOTROPY_EXT, &max_supported);
+        const float wanted = desc.max_anisotropy > 0.0f ? desc.max_anisotropy : 8.0f;
+        glTextureParameterf(texture->id(), GL_TEXTURE_MAX_ANISOTROPY_EXT, std::min(wanted, max_supported));
+    }
+    s.textures.push_back(std::move(texture).value());
+    s.materials.push_back({.tint = {0.95f, 0.62f, 0.38f}, .texture = 0});
+
+    Expected<StreamBuffer> stream = StreamBuffer::create({.regions = desc.frames_in_flight,
+                                                          .region_bytes = desc.region_bytes != 0
+                                                                              ? desc.region_bytes
+                                                                              : std::size_t{4} << 20,
+                                                          .growth = desc.growth,
+                                                          .alignment = kSectionAlign,
+                                                          .label = "wire stream"});
+    if (!stream) return stream.error();
+    s.stream = std::move(stream).value();
+    return r;
+}
+
+uint32_t WireRenderer::add_texture(engine::gfx::Texture texture) {
+    state_->textures.push_back(std::move(texture));
+    return static_cast<uint32_t>(state_->textures.size() - 1);
+}
+
+uint32_t WireRenderer::add_material(const Material& material) {
+    assert(material.texture < state_->textures.size() && "Material::texture out of range");
+    state_->materials.push_back(material);
+    return static_cast<uint32_t>(state_->materials.size() - 1);
+}
+
+void WireRenderer::set_material(uint32_t index, const Material& material) {
+    assert(index < state_->materials.size() && material.texture < state_->textures.size());
+    state_->materials[index] = material;
+}
+
+const std::vector<Material>& WireRenderer::materials() const { return state_->materials; }
+bool WireRenderer::uses_draw_parameters() const { return state_->draw_parameters; }
+std::size_t WireRenderer::live_stream_buffers() const { return state_->stream.live_buffers(); }
+const std::vector<unsigned>& WireRenderer::allocated_stream_buffers() const {
+    return state_->stream.allocated_buffers();
+}
+std::size_t WireRenderer::region_bytes() const { return state_->stream.region_bytes(); }
+
+FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
+                              const FrameSettings& settings) {
+    State& s = *state_;
+    FrameStats stats;
+    const bool cpu = list.path == UploadPath::cpu_mesh;
+
+    // Items with geometry, grouped by material (stable: equal materials keep the list's order).
+    s.order.clear();
+    for (uint32_t i = 0; i < list.items.size(); ++i) {
+        const DrawItem& item = list.items[i];
+        assert(item.material < s.materials.size() && "DrawItem::material out of range");
+        assert((cpu || item.sides >= 3) && "DrawItem::sides must be >= 3");
+        if (has_geometry(item, list.path)) s.order.push_back(i);
+    }
+    if (s.order.empty()) return stats;  // nothing to draw: no GL call at all
+    std::stable_sort(s.order.begin(), s.order.end(),
+                     [&](uint32_t a, uint32_t b) { return list.items[a].material < list.items[b].material; });
+    const std::size_t n = s.order.size();
+    if (Expected<void> st = s.ensure_draw_index_capacity(n); !st) return stats;
+
+    // Region layout: per-draw records | indirect commands | vertices or rings | indices.
+    std::size_t geometry_bytes = 0;
+    std::size_t index_bytes = 0;
+    for (uint32_t i : s.order) {
+        const DrawItem& item = list.items[i];
+        if (cpu) {
+            geometry_bytes += item.vertices.size_bytes();
+            index_bytes += item.indices.size_bytes();
+        } else {
+            geometry_bytes += item.rings.size_bytes();
+        }
+    }
+    const std::size_t draws_bytes = n * sizeof(detail::GpuDraw);
+    const std::size_t command_stride = cpu ? sizeof(DrawElementsIndirectCommand) : sizeof(DrawArraysIndirectCommand);
+    const std::size_t command_offset = align_up(draws_bytes);
+    const std::size_t geometry_offset = align_up(command_offset + n * command_stride);
+    const std::size_t index_offset = align_up(geometry_offset + geometry_bytes);
+    const std::size_t total = index_offset + index_bytes;
+
+    Expected<StreamRegion> begun = s.stream.begin(total);
+    if (!begun) return stats;  // allocation failed: skip the frame's wires, the rest of the frame goes on
+    const StreamRegion region = *begun;
+    stats.buffer_grew = region.grew;
+    stats.waited_for_gpu = region.waited;
+
+    // Fill the region with memcpy only (write-combined memory: never read it back).
+    const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : glm::dvec3(camera.position);
+    std::byte* base = region.data;
+    std::size_t geometry_cursor = 0;  // bytes into the geometry section
+    std::size_t index_cursor = 0;     // indices into the index section
+    uint32_t vertex_cursor = 0;       // vertices into the vertex section
+    uint32_t ring_cursor = 0;
+    const std::size_t first_index_base = (region.offset_bytes + index_offset) / sizeof(uint32_t);
+    for (std::size_t k = 0; k < n; ++k) {
+        const DrawItem& item = list.items[s.order[k]];
+        const glm::vec3 offset(item.origin_m - eye);  // difference in double, then float
+        detail::GpuDraw draw{{offset.x, offset.y, offset.z}, 0, 0, 0, 0, 0.0f};
+        if (cpu) {
+            const auto vertex_count = static_cast<uint32_t>(item.vertices.size());
+            const auto index_count = static_cast<uint32_t>(item.indices.size());
+            std::memcpy(base + geometry_offset + geometry_cursor, item.vertices.data(), item.vertices.size_bytes());
+            std::memcpy(base + index_offset + index_cursor * sizeof(uint32_t), item.indices.data(),
+                        item.indices.size_bytes());
+            const DrawElementsIndirectCommand command{index_count, 1,
+                                                      static_cast<uint32_t>(first_index_base + index_cursor),
+                                                      static_cast<int32_t>(vertex_cursor), static_cast<uint32_t>(k)};
+            std::memcpy(base + command_offset + k * command_stride, &command, sizeof(command));
+            geometry_cursor += item.vertices.size_bytes();
+            index_cursor += index_count;
+            vertex_cursor += vertex_count;
+            stats.vertices += vertex_count;
+            stats.triangles += index_count / 3;
+        } else {
+            const auto ring_count = static_cast<uint32_t>(item.rings.size());
+            std::memcpy(base + geometry_offset + geometry_cursor, item.rings.data(), item.rings.size_bytes());
+            draw.ring_first = ring_cursor;
+            draw.ring_count = ring_count;
+            draw.sides = item.sides;
+            draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) | detail::kTilt;
+            draw.u_close = item.u_close;
+            const uint32_t count = expanded_vertices(item);
+            const DrawArraysIndirectCommand command{count, 1, 0, static_cast<uint32_t>(k)};
+            std::memcpy(base + command_offset + k * command_stride, &command, sizeof(command));
+            geometry_cursor += item.rings.size_bytes();
+            ring_cursor += ring_count;
+            stats.vertices += count;
+            stats.triangles += count / 3;
+        }
+        std::memcpy(base + k * sizeof(detail::GpuDraw), &draw, sizeof(draw));
+    }
+    stats.bytes_uploaded = draws_bytes + n * command_stride + geometry_bytes + index_bytes;
+    stats.draw_items = n;
+    stats.indirect_commands = n;
+
+    // GL state for the wires.
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+    if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);  // front faces only: culling stays on
+
+    const gfx::Program& program = cpu ? s.cpu_program : s.rings_program;
+    program.use();
+    // Camera-relative: the view is the camera's rotation only; positions arrive as offsets from the eye.
+    const glm::mat4 view_rel = glm::lookAt(glm::vec3(0.0f), camera.target - camera.position, camera.up);
+    program.set("u_clip_from_rel", camera.projection() * view_rel);
+    program.set("u_to_light", glm::normalize(settings.light.to_light));
+    program.set("u_light_color", settings.light.color);
+    program.set("u_ambient", settings.light.ambient);
+    program.set("u_specular", settings.light.specular);
+    program.set("u_shininess", settings.light.shininess);
+
+    const GLuint buffer = region.buffer;
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, buffer, static_cast<GLintptr>(region.offset_bytes),
+                      static_cast<GLsizeiptr>(draws_bytes));
+    if (cpu) {
+        glVertexArrayVertexBuffer(s.cpu_vao.id(), 0, buffer,
+                                  static_cast<GLintptr>(region.offset_bytes + geometry_offset), sizeof(TubeVertex));
+        glVertexArrayElementBuffer(s.cpu_vao.id(), buffer);
+        s.cpu_vao.bind();
+    } else {
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, buffer,
+                          static_cast<GLintptr>(region.offset_bytes + geometry_offset),
+                          static_cast<GLsizeiptr>(geometry_bytes));
+        s.rings_vao.bind();
+    }
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, buffer);
+
+    // One multi-draw per run of equal materials.
+    for (std::size_t first = 0; first < n;) {
+        const uint32_t material_index = list.items[s.order[first]].material;
+        std::size_t last = first + 1;
+        while (last < n && list.items[s.order[last]].material == material_index) ++last;
+        const Material& material = s.materials[material_index];
+        program.set("u_tint", material.tint);
+        s.textures[material.texture].bind(0);
+        const auto* indirect =
+            reinterpret_cast<const void*>(region.offset_bytes + command_offset + first * command_stride);
+        const auto count = static_cast<GLsizei>(last - first);
+        if (cpu) {
+            glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, indirect, count, 0);
+        } else {
+            glMultiDrawArraysIndirect(GL_TRIANGLES, indirect, count, 0);
+        }
+        ++stats.multi_draw_calls;
+        first = last;
+    }
+    s.stream.end();
+
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    glBindVertexArray(0);
+    if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    return stats;
+}
+
+}  // namespace wire::render
