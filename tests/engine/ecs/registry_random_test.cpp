@@ -1,10 +1,13 @@
 // Randomized model check: 100,000 random create/destroy/emplace/remove/patch/mark-changed operations
-// (fixed seeds) against a std::map model; every 1000 operations all queries are compared with the model:
-// validity, has/get, storage sizes, views for every combination of types, and the changed-since sets of
-// two systems that run at different rates.
+// (fixed seeds), with now and then a view walk that removes components of, or destroys, the current entity.
+// Every 1000 operations all queries are compared with a std::map model: validity, has/get, storage sizes,
+// views for every combination of types, and the changed-since sets of two systems that run at different
+// rates.
 #include <engine/ecs/registry.hpp>
 
 #include <gtest/gtest.h>
+
+#include "test_print.hpp"
 
 #include <array>
 #include <cstdint>
@@ -58,6 +61,7 @@ protected:
     std::array<std::uint64_t, kSystems> last_run{};
     std::mt19937 rng{GetParam()};
     int checks = 0;
+    std::size_t sweep_visits = 0;
 
     int rand_int(int lo, int hi) { return std::uniform_int_distribution<int>{lo, hi}(rng); }
     Entity pick() { return live[static_cast<std::size_t>(rand_int(0, static_cast<int>(live.size()) - 1))]; }
@@ -65,7 +69,48 @@ protected:
         for (auto& d : m.dirty) d[static_cast<std::size_t>(t)] = true;
     }
 
+    void destroy_entity(Entity e) {
+        reg.destroy(e);
+        model.erase(e);
+        live.erase(std::find(live.begin(), live.end(), e));
+        stale.push_back(e);
+    }
+    void remove_component(Entity e, int t) {
+        bool removed = false;
+        with_type(t, [&](auto tc) { removed = reg.remove<Comp<decltype(tc)::value>>(e); });
+        ModelEntity& m = model.at(e);
+        auto& slot = m.comp[static_cast<std::size_t>(t)];
+        ASSERT_EQ(removed, slot.has_value());
+        slot.reset();
+        for (auto& d : m.dirty) d[static_cast<std::size_t>(t)] = false;
+    }
+
+    // Walks view<Comp<0>, Comp<1>> and removes components of, or destroys, the current entity at random:
+    // every member at the start must be visited exactly once.
+    void sweep() {
+        const std::set<Entity> expect = expected_view(0b011);
+        std::set<Entity> seen;
+        reg.view<Comp<0>, Comp<1>>().each([&](Entity e, Comp<0>& a, Comp<1>& b) {
+            EXPECT_TRUE(seen.insert(e).second) << "sweep visited an entity twice";
+            ++sweep_visits;
+            const ModelEntity& m = model.at(e);
+            EXPECT_EQ(a.v, *m.comp[0]);
+            EXPECT_EQ(b.v, *m.comp[1]);
+            const int r = rand_int(0, 9);
+            if (r == 0) {
+                destroy_entity(e);
+            } else if (r < 4) {
+                remove_component(e, rand_int(0, kTypes - 1));
+            }
+        });
+        ASSERT_EQ(seen, expect);
+    }
+
     void step() {
+        if (rand_int(0, 999) < 3) {
+            sweep();
+            return;
+        }
         const int op = rand_int(0, 99);
         if (live.empty() || op < 12) {
             if (live.size() < 3000) {
@@ -81,10 +126,7 @@ protected:
         const int t = rand_int(0, kTypes - 1);
         auto& slot = m.comp[static_cast<std::size_t>(t)];
         if (op < 22) {  // destroy
-            reg.destroy(e);
-            model.erase(e);
-            live.erase(std::find(live.begin(), live.end(), e));
-            stale.push_back(e);
+            destroy_entity(e);
         } else if (op < 52) {  // emplace or replace
             const int v = rand_int(-1000000, 1000000);
             with_type(t, [&](auto tc) {
@@ -100,11 +142,7 @@ protected:
             slot = v;
             stamp(m, t);
         } else if (op < 70) {  // remove
-            bool removed = false;
-            with_type(t, [&](auto tc) { removed = reg.remove<Comp<decltype(tc)::value>>(e); });
-            ASSERT_EQ(removed, slot.has_value());
-            slot.reset();
-            for (auto& d : m.dirty) d[static_cast<std::size_t>(t)] = false;
+            remove_component(e, t);
         } else if (op < 88) {  // patch
             if (!slot) return;
             const int delta = rand_int(1, 100);
@@ -240,6 +278,7 @@ TEST_P(RandomOps, HundredThousandOpsMatchModel) {
     EXPECT_EQ(checks, kOps / 1000);
     EXPECT_GT(reg.alive(), 0u);
     EXPECT_GT(stale.size(), 1000u) << "the mix must exercise destroy";
+    EXPECT_GT(sweep_visits, 1000u) << "the mix must exercise removal during view walks";
     // Change logs stay bounded by their live sizes no matter how many stamps happened.
     EXPECT_LE(reg.storage<Comp<0>>().change_log_size(), 2 * reg.storage<Comp<0>>().size() + 64);
 }

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_print.hpp"
+
 #include <chrono>
 #include <string>
 #include <thread>

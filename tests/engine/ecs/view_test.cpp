@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_print.hpp"
+
 #include <algorithm>
 #include <set>
 #include <vector>
