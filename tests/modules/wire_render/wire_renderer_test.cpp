@@ -244,36 +244,50 @@ TEST(WireRendererTest, CpuMeshRendersLitTexturedWires) {
     EXPECT_GT(covered, static_cast<std::size_t>(kWidth * kHeight / 20));
 }
 
-// The aim: the same picture from ring records only.
+// The aim: the same picture from ring records only. Three views: the whole scene, a close-up of the thick
+// wire's end cap, a close-up of the wire of varying radius (tilted normals).
 TEST(WireRendererTest, GpuRingsMatchCpuMesh) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
     WireRenderer renderer = make_renderer();
     const Scene scene = test_scene();
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
-    FrameStats cpu_stats, gpu_stats;
-    const platform::Image cpu =
-        render(*ctx, renderer, scene.list(UploadPath::cpu_mesh), scene_camera(), {}, &cpu_stats);
-    const platform::Image gpu =
-        render(*ctx, renderer, scene.list(UploadPath::gpu_rings), scene_camera(), {}, &gpu_stats);
-    save(cpu, "wire_render_cpu_mesh.png");
-    save(gpu, "wire_render_gpu_rings.png");
-    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
-    EXPECT_EQ(gpu_stats.draw_items, cpu_stats.draw_items);
-    EXPECT_EQ(gpu_stats.triangles, cpu_stats.triangles);  // same triangles, expanded instead of indexed
-    EXPECT_EQ(gpu_stats.multi_draw_calls, 1u);
+    engine::scene::Camera cap_view = scene_camera();
+    cap_view.position = {2.4f, -0.5f, 2.4f};
+    cap_view.target = {1.5f, -0.75f, 1.4f};
+    engine::scene::Camera radius_view = scene_camera();
+    radius_view.position = {-0.9f, 0.6f, 2.6f};
+    radius_view.target = {-0.9f, 0.0f, 1.1f};
+    const struct {
+        const char* name;
+        engine::scene::Camera camera;
+    } views[] = {{"scene", scene_camera()}, {"cap", cap_view}, {"radius", radius_view}};
+    for (const auto& view : views) {
+        FrameStats cpu_stats, gpu_stats;
+        const platform::Image cpu =
+            render(*ctx, renderer, scene.list(UploadPath::cpu_mesh), view.camera, {}, &cpu_stats);
+        const platform::Image gpu =
+            render(*ctx, renderer, scene.list(UploadPath::gpu_rings), view.camera, {}, &gpu_stats);
+        save(cpu, std::string("wire_render_") + view.name + "_cpu_mesh.png");
+        save(gpu, std::string("wire_render_") + view.name + "_gpu_rings.png");
+        EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        EXPECT_EQ(gpu_stats.draw_items, cpu_stats.draw_items);
+        EXPECT_EQ(gpu_stats.triangles, cpu_stats.triangles);  // same triangles, expanded instead of indexed
+        EXPECT_EQ(gpu_stats.multi_draw_calls, 1u);
 
-    const Comparison c = compare(cpu, gpu, bg.data(), 2);
-    const std::size_t covered = covered_pixels(cpu, bg.data());
-    std::printf("cpu-mesh vs gpu-rings: %zu covered px, %zu px differ by > 2/255 (%.4f%% of the image), %zu of "
-                "them off silhouettes, max difference %d/255; bytes %zu vs %zu (%.1fx)\n",
-                covered, c.mismatched, 100.0 * static_cast<double>(c.mismatched) / static_cast<double>(c.pixels),
-                c.off_silhouette, c.max_difference, cpu_stats.bytes_uploaded, gpu_stats.bytes_uploaded,
-                static_cast<double>(cpu_stats.bytes_uploaded) / static_cast<double>(gpu_stats.bytes_uploaded));
-    EXPECT_GT(covered, c.pixels / 20);
-    EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.pixels));
-    EXPECT_EQ(c.off_silhouette, 0u);
-    EXPECT_LT(gpu_stats.bytes_uploaded * 6, cpu_stats.bytes_uploaded);
+        const Comparison c = compare(cpu, gpu, bg.data(), 2);
+        const std::size_t covered = covered_pixels(cpu, bg.data());
+        std::printf("%s view, cpu-mesh vs gpu-rings: %zu covered px, %zu px differ by > 2/255 (%.4f%% of the "
+                    "image), %zu of them off silhouettes, max difference %d/255; bytes %zu vs %zu (%.1fx)\n",
+                    view.name, covered, c.mismatched,
+                    100.0 * static_cast<double>(c.mismatched) / static_cast<double>(c.pixels), c.off_silhouette,
+                    c.max_difference, cpu_stats.bytes_uploaded, gpu_stats.bytes_uploaded,
+                    static_cast<double>(cpu_stats.bytes_uploaded) / static_cast<double>(gpu_stats.bytes_uploaded));
+        EXPECT_GT(covered, c.pixels / 20);
+        EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.pixels));
+        EXPECT_EQ(c.off_silhouette, 0u);
+        EXPECT_LT(gpu_stats.bytes_uploaded * 6, cpu_stats.bytes_uploaded);
+    }
 }
 
 // The draw index reaches the shader either as gl_BaseInstanceARB or as an instanced attribute: same image.
