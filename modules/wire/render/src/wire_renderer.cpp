@@ -273,7 +273,13 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
             draw.ring_first = ring_cursor;
             draw.ring_count = ring_count;
             draw.sides = item.sides;
-            draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) | detail::kTilt;
+            // Normals tilt by the radius slope as write_tube's default does; a wire of constant radius has slope 0
+            // everywhere, so the shader skips the three neighbour fetches per vertex for it.
+            const float r0 = item.rings.front().radius_m;
+            const bool varying = std::any_of(item.rings.begin(), item.rings.end(),
+                                             [r0](const Ring& r) { return r.radius_m != r0; });
+            draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) |
+                         (varying ? detail::kTilt : 0u);
             draw.u_close = item.u_close;
             const uint32_t count = expanded_vertices(item);
             const DrawArraysIndirectCommand command{count, 1, 0, static_cast<uint32_t>(k)};
