@@ -48,13 +48,32 @@ double point_segment_distance2(const glm::dvec3& p, const glm::dvec3& a, const g
 
 double directed_distance(const std::vector<glm::dvec3>& from, const std::vector<glm::dvec3>& to) {
     double worst2 = 0.0;
+    if (to.size() == 1) {
+        for (const glm::dvec3& p : from) worst2 = std::max(worst2, glm::dot(p - to[0], p - to[0]));
+        return std::sqrt(worst2);
+    }
+    // Exact, but fast on curves that follow each other: scan outward from the previous point's nearest piece and
+    // stop as soon as this point cannot raise the maximum.
+    const std::size_t pieces = to.size() - 1;
+    std::size_t hint = 0;
     for (const glm::dvec3& p : from) {
         double best2 = std::numeric_limits<double>::infinity();
-        if (to.size() == 1) best2 = glm::dot(p - to[0], p - to[0]);
-        for (std::size_t i = 0; i + 1 < to.size(); ++i) {
-            best2 = std::min(best2, point_segment_distance2(p, to[i], to[i + 1]));
+        std::size_t best_i = hint;
+        for (std::size_t step = 0; step < 2 * pieces; ++step) {
+            const std::size_t off = (step + 1) / 2;
+            std::size_t i;
+            if (step % 2 == 0) {
+                if (hint + off >= pieces) continue;
+                i = hint + off;
+            } else {
+                if (off > hint) continue;
+                i = hint - off;
+            }
+            const double d2 = point_segment_distance2(p, to[i], to[i + 1]);
+            if (d2 < best2) best2 = d2, best_i = i;
             if (best2 <= worst2) break;  // cannot raise the maximum any more
         }
+        hint = best_i;
         worst2 = std::max(worst2, best2);
     }
     return std::sqrt(worst2);
@@ -62,14 +81,21 @@ double directed_distance(const std::vector<glm::dvec3>& from, const std::vector<
 
 }  // namespace
 
+// The one evaluation used for cut points, so the two pieces on either side of a cut share it bit for bit.
+glm::dvec3 cut_point(const CubicBezier& c, double t) {
+    if (t <= 0.0) return c.b0;
+    if (t >= 1.0) return c.b3;
+    return split(c, t, false).b3;
+}
+
 CubicBezier sub_segment(const CubicBezier& c, double t0, double t1) {
     if (t0 <= 0.0 && t1 >= 1.0) return c;
-    if (t0 <= 0.0) return split(c, t1, false);
-    if (t1 >= 1.0) return split(c, t0, true);
-    const CubicBezier right = split(c, t0, true);
-    CubicBezier out = split(right, (t1 - t0) / (1.0 - t0), false);
-    out.b0 = position(c, t0);  // both cuts evaluate the same point bit-for-bit as the neighbours' cuts do
-    out.b3 = position(c, t1);
+    CubicBezier out;
+    if (t0 <= 0.0) out = split(c, t1, false);
+    else if (t1 >= 1.0) out = split(c, t0, true);
+    else out = split(split(c, t0, true), (t1 - t0) / (1.0 - t0), false);
+    out.b0 = cut_point(c, t0);
+    out.b3 = cut_point(c, t1);
     return out;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "wire/bezier.hpp"
+#include "wire/multires.hpp"
 #include "wire/nodes.hpp"
 #include "wire/reference.hpp"
 #include "wire/spline.hpp"
@@ -96,6 +97,55 @@ inline std::vector<NamedSettings> spline_variants() {
         {"automatic", {.kind = SplineKind::automatic}},
         {"linear", {.kind = SplineKind::linear}},
     };
+}
+
+/// The 16-node cable with one node inserted between nodes 7 and 8, exactly on the curve `kind` renders
+/// (at the segment's parameter 0.5), or on the exact catenary at the same arc length (on_catenary = true).
+inline WireNodes cable_with_inserted_node(const Catenary& cable, const SplineSettings& spline, bool on_catenary = false) {
+    WireNodes n = cable_nodes(cable, 16);
+    Curve c;
+    (void)build_curve(n, spline, c);
+    const glm::dvec3 p = on_catenary ? cable.point_at_arc_length(cable.length_m() * 7.5 / 15.0) : position(c.segments[7], 0.5);
+    n.positions.insert(n.positions.begin() + 8, p);
+    n.ids.insert(n.ids.begin() + 8, 175u);
+    return n;
+}
+
+/// The 16-node cable without its node 8 (id 180).
+inline WireNodes cable_with_removed_node(const Catenary& cable) {
+    WireNodes n = cable_nodes(cable, 16);
+    n.positions.erase(n.positions.begin() + 8);
+    n.ids.erase(n.ids.begin() + 8);
+    return n;
+}
+
+struct PopNumbers {
+    double no_remedy_m = 0.0;    ///< jump of the exact curves from one state to the next
+    double remedy_max_m = 0.0;   ///< largest jump between consecutive rendered frames with the geomorph
+    int frames = 0;              ///< frames until the geomorph ended
+    double final_gap_m = 0.0;    ///< distance between the last rendered frame and the exact new curve
+};
+
+/// Shows `before` for two frames, then `after` until the geomorph ends (at most 1000 frames).
+inline PopNumbers measure_pop(const SplineSettings& spline, const WireNodes& before, const WireNodes& after) {
+    PopNumbers r;
+    Curve a, b;
+    (void)build_curve(before, spline, a);
+    (void)build_curve(after, spline, b);
+    r.no_remedy_m = curve_jump_m(a, b);
+    MultiresCurve m({.spline = spline});
+    Curve prev, cur;
+    (void)m.update(before, prev);
+    (void)m.update(before, prev);
+    for (int f = 0; f < 1000; ++f) {
+        (void)m.update(after, cur);
+        r.remedy_max_m = std::max(r.remedy_max_m, curve_jump_m(prev, cur));
+        prev = cur;
+        ++r.frames;
+        if (!m.blending()) break;
+    }
+    r.final_gap_m = curve_jump_m(cur, m.target());
+    return r;
 }
 
 }  // namespace wire::testing

@@ -35,5 +35,20 @@ int main() {
             std::printf("%-22s %14.3e %14.3e %10.3f\n", v.name.c_str(), b.straight_dev_m, b.overshoot_m, b.kink_deg);
         }
     }
+    std::printf("\n== pop on the 20 m cable (16 nodes), max jump between consecutive frames (m) ==\n");
+    std::printf("%-22s %-26s %12s %12s %7s %12s\n", "kind", "event", "no remedy", "geomorph", "frames", "final gap");
+    for (const NamedSettings& v : spline_variants()) {
+        const WireNodes base = cable_nodes(cable, 16);
+        const WireNodes inserted = cable_with_inserted_node(cable, v.settings);
+        const WireNodes on_cat = cable_with_inserted_node(cable, v.settings, true);
+        const WireNodes removed = cable_with_removed_node(cable);
+        const struct { const char* name; const WireNodes& from; const WireNodes& to; } events[] = {
+            {"insert on curve", base, inserted}, {"remove inserted", inserted, base}, {"remove node 8", base, removed},
+            {"insert on catenary", base, on_cat}};
+        for (const auto& e : events) {
+            const PopNumbers p = measure_pop(v.settings, e.from, e.to);
+            std::printf("%-22s %-26s %12.3e %12.3e %7d %12.1e\n", v.name.c_str(), e.name, p.no_remedy_m, p.remedy_max_m, p.frames, p.final_gap_m);
+        }
+    }
     return 0;
 }
