@@ -1,0 +1,81 @@
+// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them as
+// changed); the wire systems own everything else and keep it between frames.
+#pragma once
+
+#include "wire/curve.hpp"
+#include "wire/lod.hpp"
+#include "wire/multires.hpp"
+#include "wire/nodes.hpp"
+#include "wire/rings.hpp"
+#include "wire/tube.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace wire::systems {
+
+/// The wire's lumped-element nodes (wire::WireNodes: positions, stable ids, stretch, optional radius and physics
+/// arrays). Written by the game or the physics; every write must stamp it (set_nodes / edit_nodes / patch).
+struct Nodes : WireNodes {};
+
+/// How the wire looks. Zero means default.
+struct Style {
+    float radius_m = 0.01f;       ///< tube radius where a node's radius is 0; 0 -> 1 cm
+    uint32_t max_sides = 0;       ///< upper clamp of the LOD's radial sides; 0 -> 16
+    SplineSettings spline{};      ///< curve settings (spline.closed and spline.radius_m are taken from this Style)
+    uint32_t material = 0;        ///< renderer material index
+    bool caps = true;             ///< flat end caps on open wires
+    bool closed = false;          ///< closed loop
+};
+
+// ---- derived state, owned by the systems (read them, do not write them) ----
+
+/// Curve stage: the rendered curve (pop-free: blended while nodes appear or vanish) and its change counter.
+struct WireCurve {
+    MultiresCurve multires{MultiresSettings{}};
+    Curve curve;                       ///< what is drawn; empty until the nodes were valid once
+    SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
+    uint64_t generation = 0;           ///< +1 each time `curve` changes
+    uint64_t builds = 0;               ///< times the curve stage ran for this wire (test/statistics counter)
+    bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
+    bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
+};
+
+/// LOD stage: visibility, per-segment ring counts and sides for the context's camera.
+struct WireLodState {
+    WireLod lod;
+    uint64_t generation = 0;           ///< +1 each time counts or visibility change
+    uint64_t seen_curve = 0;           ///< WireCurve::generation the LOD was computed for
+    uint64_t seen_view = 0;            ///< WireContext view generation the LOD was computed for
+    uint64_t updates = 0;              ///< times update_lod ran for this wire
+};
+
+/// Ring stage: ring records along the wire (the gpu_rings path uploads these).
+struct WireRings {
+    std::vector<RingParam> params;
+    RingSet rings;
+    uint64_t generation = 0;           ///< +1 each time the rings are rebuilt
+    uint64_t seen_curve = 0;
+    uint64_t seen_lod = 0;
+};
+
+/// Mesh stage (cpu_mesh path only): the tube's vertices and indices.
+struct WireMesh {
+    TubeMesh mesh;
+    uint64_t generation = 0;           ///< +1 each time the mesh is rebuilt
+    uint64_t seen_rings = 0;
+    uint32_t sides = 0;
+    bool caps = true;
+};
+
+/// A wire whose nodes are invalid (NaN, fewer than 2 distinct nodes, ...): the message names the entity and the
+/// input node, e.g. "wire entity 12 (index 12, version 0): node 3: position.y is NaN". Reported once (in
+/// WireContext::new_errors and through WireContext::on_error) when it appears or its message changes; removed
+/// when the nodes become valid again. While it is present the wire keeps drawing its last valid curve, if any.
+struct WireError {
+    std::string message;
+    int node = -1;                     ///< offending input node, -1 if no single node
+};
+
+}  // namespace wire::systems

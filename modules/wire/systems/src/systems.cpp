@@ -1,0 +1,350 @@
+// The wire systems: curve -> lod -> rings -> mesh -> draw list, each over a dense array of the wires that need
+// work, in parallel with oneTBB; every wire writes only its own components.
+#include "wire/systems/systems.hpp"
+
+#include "wire/systems/api.hpp"
+#include "wire/systems/components.hpp"
+#include "wire/systems/view.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+namespace wire::systems {
+namespace {
+
+using engine::ecs::Entity;
+using engine::ecs::Registry;
+
+constexpr uint32_t kDefaultMaxSides = 16;
+constexpr float kDefaultRadius = 0.01f;
+
+template <class Fn>
+void parallel_over(std::size_t n, Fn&& fn) {
+    if (n == 0) return;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) fn(i);
+    });
+}
+
+bool by_index(Entity a, Entity b) { return engine::ecs::to_index(a) < engine::ecs::to_index(b); }
+
+void sort_unique(std::vector<Entity>& v) {
+    std::sort(v.begin(), v.end(), by_index);
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+bool same_spline(const SplineSettings& a, const SplineSettings& b) {
+    return a.kind == b.kind && a.alpha == b.alpha && a.tension == b.tension && a.bias == b.bias &&
+           a.continuity == b.continuity && a.curvature_tension == b.curvature_tension && a.closed == b.closed &&
+           a.radius_m == b.radius_m && a.merge_epsilon_rel == b.merge_epsilon_rel;
+}
+
+bool same_lod(const LodSettings& a, const LodSettings& b) {
+    return a.tolerance_px == b.tolerance_px && a.max_rings_per_segment == b.max_rings_per_segment &&
+           a.max_sides == b.max_sides && a.hysteresis_band == b.hysteresis_band &&
+           a.coarse_offscreen_segments == b.coarse_offscreen_segments;
+}
+
+SplineSettings spline_of(const Style& style) {
+    SplineSettings s = style.spline;
+    s.closed = style.closed;
+    s.radius_m = style.radius_m > 0.0f ? style.radius_m : kDefaultRadius;
+    return s;
+}
+
+struct CurveJob {
+    Entity entity;
+    const Nodes* nodes;
+    const Style* style;
+    WireCurve* curve;
+    Status status;
+    bool changed = false;
+};
+
+struct LodJob {
+    const Style* style;
+    const WireCurve* curve;
+    WireLodState* lod;
+};
+
+struct RingJob {
+    const WireCurve* curve;
+    const WireLodState* lod;
+    WireRings* rings;
+};
+
+struct MeshJob {
+    const WireRings* rings;
+    const WireLodState* lod;
+    const Style* style;
+    WireMesh* mesh;
+};
+
+bool caps_of(const Style& style) { return style.caps && !style.closed; }
+
+}  // namespace
+
+void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
+    ctx.stats = FrameStats{};
+    ctx.new_errors.clear();
+    ctx.curve_changed.clear();
+
+    std::vector<Entity> work;
+    for (const Entity e : registry.changed<Nodes>(since)) work.push_back(e);
+    for (const Entity e : registry.changed<Style>(since)) work.push_back(e);
+    for (const Entity e : ctx.blending) work.push_back(e);
+    sort_unique(work);
+
+    std::vector<CurveJob> jobs;
+    jobs.reserve(work.size());
+    for (const Entity e : work) {
+        if (!registry.valid(e)) continue;  // destroyed while blending
+        Nodes* nodes = registry.try_get<Nodes>(e);
+        Style* style = registry.try_get<Style>(e);
+        WireCurve* curve = registry.try_get<WireCurve>(e);
+        if (nodes == nullptr || style == nullptr || curve == nullptr) continue;
+        jobs.push_back(CurveJob{e, nodes, style, curve, Status::success()});
+    }
+
+    const bool pop_free = ctx.pop_free;
+    parallel_over(jobs.size(), [&](std::size_t i) {
+        CurveJob& job = jobs[i];
+        WireCurve& c = *job.curve;
+        const SplineSettings spline = spline_of(*job.style);
+        if (c.builds == 0 || !same_spline(spline, c.spline) || c.geomorph != pop_free) {
+            c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free});
+            c.spline = spline;
+            c.geomorph = pop_free;
+        }
+        ++c.builds;
+        job.status = c.multires.update(*job.nodes, c.curve);
+        if (job.status.ok) {
+            ++c.generation;
+            job.changed = true;
+        }
+        c.blending = job.status.ok && c.multires.blending();
+    });
+
+    // Serial, in entity order: errors (reported once per distinct message), work lists.
+    ctx.blending.clear();
+    for (CurveJob& job : jobs) {
+        if (!job.status.ok) {
+            std::string message = describe_entity(job.entity) + ": " + job.status.message;
+            const WireError* old = registry.try_get<WireError>(job.entity);
+            if (old == nullptr || old->message != message) {
+                registry.emplace_or_replace<WireError>(job.entity, message, job.status.node);
+                ErrorReport report{job.entity, std::move(message)};
+                if (ctx.on_error) ctx.on_error(report);
+                ctx.new_errors.push_back(std::move(report));
+            }
+        } else if (registry.has<WireError>(job.entity)) {
+            registry.remove<WireError>(job.entity);
+        }
+        if (job.changed) ctx.curve_changed.push_back(job.entity);
+        if (job.curve->blending) ctx.blending.push_back(job.entity);
+    }
+    ctx.stats.curves_built = jobs.size();
+    ctx.stats.wires = registry.storage<WireCurve>().size();
+    ctx.stats.errors = registry.storage<WireError>().size();
+}
+
+void lod_system(Registry& registry, WireContext& ctx) {
+    const LodView view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
+    const bool view_changed = !ctx.has_view || !(view == ctx.view) || !same_lod(ctx.lod, ctx.seen_lod);
+    if (view_changed) {
+        ctx.view = view;
+        ctx.seen_lod = ctx.lod;
+        ctx.has_view = true;
+        ++ctx.view_generation;
+    }
+
+    std::vector<LodJob> jobs;
+    auto consider = [&](Entity e, const Style* style, const WireCurve* curve, WireLodState* lod) {
+        if (style == nullptr || curve == nullptr || lod == nullptr) return;
+        if (lod->seen_curve == curve->generation && lod->seen_view == ctx.view_generation) return;
+        jobs.push_back(LodJob{style, curve, lod});
+        (void)e;
+    };
+    if (view_changed) {
+        // Every wire: the camera moved. Dense order of the LOD storage (deterministic, thread-independent).
+        auto& storage = registry.storage<WireLodState>();
+        jobs.reserve(storage.size());
+        for (std::size_t i = 0; i < storage.size(); ++i) {
+            const Entity e = storage.at(i);
+            consider(e, registry.try_get<Style>(e), registry.try_get<WireCurve>(e), &storage.at_position(i));
+        }
+    } else {
+        // Same camera: only wires whose curve changed this frame.
+        for (const Entity e : ctx.curve_changed) {
+            if (!registry.valid(e)) continue;
+            consider(e, registry.try_get<Style>(e), registry.try_get<WireCurve>(e), registry.try_get<WireLodState>(e));
+        }
+    }
+
+    const uint64_t view_generation = ctx.view_generation;
+    const LodSettings base = ctx.lod;
+    parallel_over(jobs.size(), [&](std::size_t i) {
+        LodJob& job = jobs[i];
+        LodSettings settings = base;
+        settings.max_sides = job.style->max_sides ? job.style->max_sides : kDefaultMaxSides;
+        if (base.max_sides != 0) settings.max_sides = std::min(settings.max_sides, base.max_sides);
+        WireLodState& s = *job.lod;
+        if (update_lod(job.curve->curve, ctx.view, settings, s.lod)) ++s.generation;
+        ++s.updates;
+        s.seen_curve = job.curve->generation;
+        s.seen_view = view_generation;
+    });
+    ctx.stats.lod_updates = jobs.size();
+}
+
+void rings_system(Registry& registry, WireContext& ctx) {
+    std::vector<RingJob> jobs;
+    auto& storage = registry.storage<WireRings>();
+    for (std::size_t i = 0; i < storage.size(); ++i) {
+        const Entity e = storage.at(i);
+        const WireCurve* curve = registry.try_get<WireCurve>(e);
+        const WireLodState* lod = registry.try_get<WireLodState>(e);
+        if (curve == nullptr || lod == nullptr || !lod->lod.visible) continue;
+        WireRings& rings = storage.at_position(i);
+        // Counts computed for an older curve (cannot happen in install() order, but a caller may skip lod).
+        if (lod->seen_curve != curve->generation) continue;
+        if (rings.seen_curve == curve->generation && rings.seen_lod == lod->generation && rings.generation != 0) continue;
+        jobs.push_back(RingJob{curve, lod, &rings});
+    }
+    parallel_over(jobs.size(), [&](std::size_t i) {
+        RingJob& job = jobs[i];
+        WireRings& r = *job.rings;
+        place_rings(job.curve->curve, job.lod->lod.counts, r.params);
+        RingSettings settings;
+        if (!r.rings.frames.empty()) {
+            // Temporal coherence: carry the first normal over instead of re-seeding it from a world axis.
+            settings.frames.has_previous_normal = true;
+            settings.frames.previous_normal = r.rings.frames.front().r;
+        }
+        build_rings(job.curve->curve, r.params, settings, r.rings);
+        ++r.generation;
+        r.seen_curve = job.curve->generation;
+        r.seen_lod = job.lod->generation;
+    });
+    ctx.stats.rings_built = jobs.size();
+}
+
+void mesh_system(Registry& registry, WireContext& ctx) {
+    if (ctx.path != UploadPath::cpu_mesh) return;
+    std::vector<MeshJob> jobs;
+    auto& storage = registry.storage<WireMesh>();
+    for (std::size_t i = 0; i < storage.size(); ++i) {
+        const Entity e = storage.at(i);
+        const WireRings* rings = registry.try_get<WireRings>(e);
+        const WireLodState* lod = registry.try_get<WireLodState>(e);
+        const Style* style = registry.try_get<Style>(e);
+        if (rings == nullptr || lod == nullptr || style == nullptr || !lod->lod.visible || rings->generation == 0) continue;
+        WireMesh& mesh = storage.at_position(i);
+        if (mesh.seen_rings == rings->generation && mesh.sides == lod->lod.sides && mesh.caps == caps_of(*style)) continue;
+        jobs.push_back(MeshJob{rings, lod, style, &mesh});
+    }
+    parallel_over(jobs.size(), [&](std::size_t i) {
+        MeshJob& job = jobs[i];
+        WireMesh& m = *job.mesh;
+        m.sides = job.lod->lod.sides;
+        m.caps = caps_of(*job.style);
+        build_tube(job.rings->rings, TubeSettings{.sides = m.sides, .caps = m.caps}, m.mesh);
+        ++m.generation;
+        m.seen_rings = job.rings->generation;
+    });
+    ctx.stats.meshes_built = jobs.size();
+}
+
+void draw_list_system(Registry& registry, WireContext& ctx) {
+    DrawList& list = ctx.draw_list;
+    list.path = ctx.path;
+    list.items.clear();
+
+    std::vector<Entity> visible;
+    auto& lods = registry.storage<WireLodState>();
+    for (std::size_t i = 0; i < lods.size(); ++i) {
+        if (lods.at_position(i).lod.visible) {
+            visible.push_back(lods.at(i));
+        } else {
+            ++ctx.stats.culled_wires;
+        }
+    }
+    std::sort(visible.begin(), visible.end(), by_index);  // entity order, whatever the storage order
+
+    list.items.reserve(visible.size());
+    for (const Entity e : visible) {
+        const WireRings* rings = registry.try_get<WireRings>(e);
+        const WireLodState* lod = registry.try_get<WireLodState>(e);
+        const Style* style = registry.try_get<Style>(e);
+        const WireCurve* curve = registry.try_get<WireCurve>(e);
+        if (rings == nullptr || lod == nullptr || style == nullptr || curve == nullptr) continue;
+        if (rings->generation == 0 || rings->seen_curve != curve->generation || rings->seen_lod != lod->generation) {
+            continue;  // not rebuilt for this frame's counts (a caller skipped the rings system)
+        }
+        const RingSet& rs = rings->rings;
+        DrawItem item;
+        item.origin_m = rs.origin_m;
+        item.material = style->material;
+        item.wire_id = engine::ecs::to_integral(e);
+        item.rings = rs.rings;
+        item.sides = std::max<uint32_t>(lod->lod.sides, 3);
+        item.closed = rs.closed;
+        item.caps = caps_of(*style);
+        item.u_close = rs.closed && !rs.u.empty() ? static_cast<float>(rs.u.back()) : 0.0f;
+        if (ctx.path == UploadPath::cpu_mesh) {
+            const WireMesh* mesh = registry.try_get<WireMesh>(e);
+            if (mesh == nullptr || mesh->seen_rings != rings->generation) continue;
+            item.vertices = mesh->mesh.vertices;
+            item.indices = mesh->mesh.indices;
+            ctx.stats.vertices += mesh->mesh.vertices.size();
+            ctx.stats.indices += mesh->mesh.indices.size();
+        } else {
+            const TubeCounts counts = tube_counts(rs.rings.size(), rs.closed, TubeSettings{.sides = item.sides, .caps = item.caps});
+            ctx.stats.vertices += counts.vertices;
+            ctx.stats.indices += counts.indices;
+        }
+        ctx.stats.rings += rs.rings.size();
+        list.items.push_back(item);
+    }
+    ctx.stats.visible_wires = visible.size();
+    ctx.stats.draw_items = list.items.size();
+}
+
+void install(engine::ecs::Schedule& schedule, WireContext& context) {
+    WireContext* ctx = &context;
+    schedule.add(kCurveSystem, [ctx](Registry& r, const engine::ecs::FrameContext& f) {
+        curve_system(r, *ctx, f.last_run_tick);
+    });
+    schedule.add(kLodSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { lod_system(r, *ctx); });
+    schedule.add(kRingsSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { rings_system(r, *ctx); });
+    schedule.add(kMeshSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { mesh_system(r, *ctx); });
+    schedule.add(kDrawListSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { draw_list_system(r, *ctx); });
+}
+
+ScreenError wire_screen_error(Registry& registry, const WireContext& ctx, Entity wire, int samples_per_segment) {
+    const WireCurve* curve = registry.try_get<WireCurve>(wire);
+    const WireRings* rings = registry.try_get<WireRings>(wire);
+    const WireLodState* lod = registry.try_get<WireLodState>(wire);
+    if (curve == nullptr || rings == nullptr || lod == nullptr || !lod->lod.visible || rings->params.empty()) return {};
+    return measure_screen_error(curve->curve, rings->params, ctx.view, samples_per_segment);
+}
+
+ScreenError scene_screen_error(Registry& registry, const WireContext& ctx, int samples_per_segment) {
+    ScreenError worst;
+    std::size_t samples = 0;
+    for (const DrawItem& item : ctx.draw_list.items) {
+        const Entity e{static_cast<uint32_t>(item.wire_id)};
+        const ScreenError s = wire_screen_error(registry, ctx, e, samples_per_segment);
+        samples += s.samples;
+        if (s.max_px > worst.max_px) worst = s;
+    }
+    worst.samples = samples;
+    return worst;
+}
+
+}  // namespace wire::systems
