@@ -21,9 +21,11 @@ TEST(WeaveTest, SizeGreyOpaqueAndTiles) {
     }
     EXPECT_LT(min, 80);   // gaps are dark
     EXPECT_GT(max, 240);  // strand crowns are bright
-    auto at = [&](int x, int y) { return rgba[(static_cast<std::size_t>((y + n) % n) * n + (x + n) % n) * 4]; };
-    // Symmetric under the mirror x -> -x, y -> -y (pixel centres: x -> n-1-x) and under the swap (x, y) -> (y, x)
-    // combined with a shift, so the pattern has no preferred direction around the wire.
+    auto at = [&](int x, int y) {
+        return rgba[(static_cast<std::size_t>((y + n) % n) * n + (x + n) % n) * 4];
+    };
+    // Symmetric under the mirror x -> -x, y -> -y (pixel centres: x -> n-1-x) and under the swap (x, y) ->
+    // (y, x) combined with a shift, so the pattern has no preferred direction around the wire.
     for (int y = 0; y < n; ++y) {
         for (int x = 0; x < n; ++x) {
             ASSERT_EQ(at(x, y), at(n - 1 - x, n - 1 - y)) << x << "," << y;

@@ -1,6 +1,7 @@
-// wire::render::WireRenderer on headless llvmpipe: cpu-mesh and gpu-rings render the same image, no cracks along a
-// known wire, empty lists draw nothing, frames are deterministic, the stream buffer grows without leaking, shader
-// errors carry the driver log. Images are written next to the test binary (wire_render_*.png) for a human look.
+// wire::render::WireRenderer on headless llvmpipe: cpu-mesh and gpu-rings render the same image, no cracks
+// along a known wire, empty lists draw nothing, frames are deterministic, the stream buffer grows without
+// leaking, shader errors carry the driver log. Images are written next to the test binary (wire_render_*.png)
+// for a human look.
 #include <gtest/gtest.h>
 
 #include <epoxy/gl.h>
@@ -138,7 +139,8 @@ Scene test_scene() {
         wire::WireNodes loop;
         for (int i = 0; i < 7; ++i) {
             const double a = 2.0 * std::numbers::pi * i / 7.0;
-            loop.positions.push_back({1.3 + 0.9 * std::cos(a), -0.5 + 0.35 * std::sin(a), 0.2 + 0.7 * std::sin(a)});
+            loop.positions.push_back(
+                {1.3 + 0.9 * std::cos(a), -0.5 + 0.35 * std::sin(a), 0.2 + 0.7 * std::sin(a)});
         }
         scene.add(loop, wire_settings(0.06f, 12, true));
     }
@@ -168,20 +170,25 @@ void save(const platform::Image& image, const std::string& name) {
     EXPECT_TRUE(st.ok()) << st.error().message;
 }
 
-bool same_pixel(const uint8_t* a, const uint8_t* b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+bool same_pixel(const uint8_t* a, const uint8_t* b) {
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
 
 struct Comparison {
     std::size_t pixels = 0;
-    std::size_t mismatched = 0;       // some channel differs by more than the tolerance
-    std::size_t off_silhouette = 0;   // mismatched and not within 1 px of a coverage edge in either image
+    std::size_t mismatched = 0;      // some channel differs by more than the tolerance
+    std::size_t off_silhouette = 0;  // mismatched and not within 1 px of a coverage edge in either image
     int max_difference = 0;
 };
 
 // Per-pixel comparison; "coverage" is pixel != background.
-Comparison compare(const platform::Image& a, const platform::Image& b, const uint8_t* background, int tolerance) {
+Comparison compare(const platform::Image& a, const platform::Image& b, const uint8_t* background,
+                   int tolerance) {
     Comparison c;
     c.pixels = static_cast<std::size_t>(a.width) * a.height;
-    auto covered = [&](const platform::Image& im, int x, int y) { return !same_pixel(im.pixel(x, y), background); };
+    auto covered = [&](const platform::Image& im, int x, int y) {
+        return !same_pixel(im.pixel(x, y), background);
+    };
     auto near_edge = [&](const platform::Image& im, int x, int y) {
         const bool centre = covered(im, x, y);
         for (int dy = -1; dy <= 1; ++dy) {
@@ -225,7 +232,8 @@ TEST(WireRendererTest, CpuMeshRendersLitTexturedWires) {
     const Scene scene = test_scene();
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
     FrameStats stats;
-    const platform::Image image = render(*ctx, renderer, scene.list(UploadPath::cpu_mesh), scene_camera(), {}, &stats);
+    const platform::Image image =
+        render(*ctx, renderer, scene.list(UploadPath::cpu_mesh), scene_camera(), {}, &stats);
     save(image, "wire_render_cpu_mesh.png");
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
     EXPECT_EQ(stats.draw_items, scene.pipelines.size());
@@ -239,13 +247,13 @@ TEST(WireRendererTest, CpuMeshRendersLitTexturedWires) {
     EXPECT_EQ(stats.vertices, vertices);
     EXPECT_EQ(stats.triangles, indices / 3);
     const std::size_t covered = covered_pixels(image, bg.data());
-    std::printf("cpu-mesh: %zu of %d pixels covered, %zu bytes uploaded, %zu vertices\n", covered, kWidth * kHeight,
-                stats.bytes_uploaded, stats.vertices);
+    std::printf("cpu-mesh: %zu of %d pixels covered, %zu bytes uploaded, %zu vertices\n", covered,
+                kWidth * kHeight, stats.bytes_uploaded, stats.vertices);
     EXPECT_GT(covered, static_cast<std::size_t>(kWidth * kHeight / 20));
 }
 
-// The aim: the same picture from ring records only. Three views: the whole scene, a close-up of the thick
-// wire's end cap, a close-up of the wire of varying radius (tilted normals).
+// The aim: the same picture from ring records only. Three views: the whole scene, a close-up of the
+// thick wire's end cap, a close-up of the wire of varying radius (tilted normals).
 TEST(WireRendererTest, GpuRingsMatchCpuMesh) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -277,12 +285,13 @@ TEST(WireRendererTest, GpuRingsMatchCpuMesh) {
 
         const Comparison c = compare(cpu, gpu, bg.data(), 2);
         const std::size_t covered = covered_pixels(cpu, bg.data());
-        std::printf("%s view, cpu-mesh vs gpu-rings: %zu covered px, %zu px differ by > 2/255 (%.4f%% of the "
-                    "image), %zu of them off silhouettes, max difference %d/255; bytes %zu vs %zu (%.1fx)\n",
-                    view.name, covered, c.mismatched,
-                    100.0 * static_cast<double>(c.mismatched) / static_cast<double>(c.pixels), c.off_silhouette,
-                    c.max_difference, cpu_stats.bytes_uploaded, gpu_stats.bytes_uploaded,
-                    static_cast<double>(cpu_stats.bytes_uploaded) / static_cast<double>(gpu_stats.bytes_uploaded));
+        std::printf(
+            "%s view, cpu-mesh vs gpu-rings: %zu covered px, %zu px differ by > 2/255 (%.4f%% of the "
+            "image), %zu of them off silhouettes, max difference %d/255; bytes %zu vs %zu (%.1fx)\n",
+            view.name, covered, c.mismatched,
+            100.0 * static_cast<double>(c.mismatched) / static_cast<double>(c.pixels), c.off_silhouette,
+            c.max_difference, cpu_stats.bytes_uploaded, gpu_stats.bytes_uploaded,
+            static_cast<double>(cpu_stats.bytes_uploaded) / static_cast<double>(gpu_stats.bytes_uploaded));
         EXPECT_GT(covered, c.pixels / 20);
         EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.pixels));
         EXPECT_EQ(c.off_silhouette, 0u);
@@ -307,8 +316,8 @@ TEST(WireRendererTest, DrawIndexAttributeFallbackMatches) {
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
-// Projects a wire's centre line: every pixel along it is covered (no cracks between rings or segments, none at
-// the seam), pixels across the tube are covered, and the background well away from it is untouched.
+// Projects a wire's centre line: every pixel along it is covered (no cracks between rings or segments, none
+// at the seam), pixels across the tube are covered, and the background well away from it is untouched.
 TEST(WireRendererTest, KnownWireSilhouetteHasNoCracks) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -349,35 +358,39 @@ TEST(WireRendererTest, KnownWireSilhouetteHasNoCracks) {
                     ASSERT_TRUE(x >= 2 && x < kWidth - 2 && y >= 12 && y < kHeight - 12);
                     ++checked;
                     if (same_pixel(image.pixel(x, y), bg.data())) ++cracks;
-                    // Across the tube (vertically: the wire runs left to right): inside radius - 1.5 px covered
-                    // (away from the end rings, where the tilted caps cut the vertical span), beyond radius + 3 px
-                    // (plus the sag's slope) background.
+                    // Across the tube (vertically: the wire runs left to right): inside radius - 1.5 px
+                    // covered (away from the end rings, where the tilted caps cut the vertical span), beyond
+                    // radius + 3 px (plus the sag's slope) background.
                     const bool end = i == 0 || i + 2 == rings.centre_m.size();
                     const int inner = end ? 0 : static_cast<int>(radius_px - 1.5f);
                     for (int d = -inner; d <= inner; ++d) {
                         if (same_pixel(image.pixel(x, y + d), bg.data())) ++across_missing;
                     }
-                    const int outer = static_cast<int>(std::ceil(radius_px + 3.0f + (k.sag_m > 0 ? 3.0f : 0.0f)));
+                    const int outer =
+                        static_cast<int>(std::ceil(radius_px + 3.0f + (k.sag_m > 0 ? 3.0f : 0.0f)));
                     if (!same_pixel(image.pixel(x, y - outer), bg.data())) ++halo;
                     if (!same_pixel(image.pixel(x, y + outer), bg.data())) ++halo;
                 }
             }
-            std::printf("%s %s: %zu centre-line samples, %zu uncovered, %zu uncovered across, %zu covered beyond "
-                        "the radius (%.1f px)\n", k.name, path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings",
-                        checked, cracks, across_missing, halo, radius_px);
+            std::printf(
+                "%s %s: %zu centre-line samples, %zu uncovered, %zu uncovered across, %zu covered beyond "
+                "the radius (%.1f px)\n",
+                k.name, path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings", checked, cracks,
+                across_missing, halo, radius_px);
             EXPECT_GT(checked, 100u);
             EXPECT_EQ(cracks, 0u);
             EXPECT_EQ(across_missing, 0u);
             EXPECT_EQ(halo, 0u);
             // Far corners are background.
-            for (auto [x, y] : {std::pair{0, 0}, {kWidth - 1, 0}, {0, kHeight - 1}, {kWidth - 1, kHeight - 1}})
+            for (auto [x, y] :
+                 {std::pair{0, 0}, {kWidth - 1, 0}, {0, kHeight - 1}, {kWidth - 1, kHeight - 1}})
                 EXPECT_TRUE(same_pixel(image.pixel(x, y), bg.data()));
         }
     }
 }
 
-// Culling contract at the renderer: an empty list draws nothing (no primitive reaches the rasterizer) and leaves
-// the background; a non-empty list generates exactly the triangles the stats report.
+// Culling contract at the renderer: an empty list draws nothing (no primitive reaches the rasterizer) and
+// leaves the background; a non-empty list generates exactly the triangles the stats report.
 TEST(WireRendererTest, EmptyListDrawsNothing) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -405,7 +418,8 @@ TEST(WireRendererTest, EmptyListDrawsNothing) {
         EXPECT_EQ(stats.bytes_uploaded, 0u);
         EXPECT_EQ(stats.draw_items, 0u);
         for (std::size_t i = 0; i < image.rgba.size(); i += 4)
-            ASSERT_TRUE(same_pixel(&image.rgba[i], image.rgba.data())) << "pixel " << i / 4 << " is not background";
+            ASSERT_TRUE(same_pixel(&image.rgba[i], image.rgba.data()))
+                << "pixel " << i / 4 << " is not background";
         // Items without geometry are dropped too.
         DrawList hollow{.path = path, .items = {DrawItem{}, DrawItem{}}};
         EXPECT_EQ(primitives(hollow, stats, image), 0u);
@@ -434,8 +448,8 @@ TEST(WireRendererTest, FramesAreDeterministic) {
     }
 }
 
-// Starts with a region of 512 bytes and draws more wires every frame: the buffer grows, old buffers live until
-// their fences signal and are then deleted, every image equals the one a roomy renderer draws.
+// Starts with a region of 512 bytes and draws more wires every frame: the buffer grows, old buffers live
+// until their fences signal and are then deleted, every image equals the one a roomy renderer draws.
 TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -451,7 +465,8 @@ TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
         const DrawList all = pool.list(path);
         std::size_t growths = 0, max_live = 0;
         for (std::size_t count = 1; count <= all.items.size(); count += 3) {
-            DrawList list{.path = path, .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)}};
+            DrawList list{.path = path,
+                          .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)}};
             FrameStats stats;
             const platform::Image got = render(*ctx, growing, list, scene_camera(), {}, &stats);
             const platform::Image want = render(*ctx, roomy, list, scene_camera());
@@ -473,14 +488,16 @@ TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
         EXPECT_EQ(growing.live_stream_buffers(), 1u);
         for (std::size_t i = 0; i + 1 < allocated.size(); ++i) {
             EXPECT_FALSE(glIsBuffer(allocated[i]) && allocated[i] != allocated.back() &&
-                         std::find(roomy.allocated_stream_buffers().begin(), roomy.allocated_stream_buffers().end(),
+                         std::find(roomy.allocated_stream_buffers().begin(),
+                                   roomy.allocated_stream_buffers().end(),
                                    allocated[i]) == roomy.allocated_stream_buffers().end())
                 << "retired buffer " << allocated[i] << " still exists";
         }
     }
 }
 
-// A shader that does not compile comes back as an error with the driver's log, through engine::gfx::make_program.
+// A shader that does not compile comes back as an error with the driver's log, through
+// engine::gfx::make_program.
 TEST(WireRendererTest, ShaderErrorCarriesDriverLog) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -489,15 +506,19 @@ TEST(WireRendererTest, ShaderErrorCarriesDriverLog) {
     ASSERT_FALSE(broken.ok());
     const std::string& message = broken.error().message;
     std::printf("%s\n", message.c_str());
-    EXPECT_NE(message.find("fragment shader of 'wire cpu-mesh' failed to compile"), std::string::npos) << message;
+    EXPECT_NE(message.find("fragment shader of 'wire cpu-mesh' failed to compile"), std::string::npos)
+        << message;
     EXPECT_NE(message.find("undeclared_thing"), std::string::npos) << message;  // from the driver's log
 
     // A custom shade() that compiles is used: flat white.
-    auto flat = WireRenderer::create({.shading_glsl = "vec3 shade(vec3 a, vec3 n, vec3 e) { return vec3(1.0); }\n"});
+    auto flat =
+        WireRenderer::create({.shading_glsl = "vec3 shade(vec3 a, vec3 n, vec3 e) { return vec3(1.0); }\n"});
     ASSERT_TRUE(flat.ok()) << flat.error().message;
-    const platform::Image image = render(*ctx, flat.value(), test_scene().list(UploadPath::gpu_rings), scene_camera());
+    const platform::Image image =
+        render(*ctx, flat.value(), test_scene().list(UploadPath::gpu_rings), scene_camera());
     std::size_t white = 0;
-    for (std::size_t i = 0; i < image.rgba.size(); i += 4) white += image.rgba[i] == 255 && image.rgba[i + 2] == 255;
+    for (std::size_t i = 0; i < image.rgba.size(); i += 4)
+        white += image.rgba[i] == 255 && image.rgba[i + 2] == 255;
     EXPECT_GT(white, image.rgba.size() / 4 / 20);
 }
 
@@ -536,8 +557,8 @@ TEST(WireRendererTest, MaterialsAndWireframe) {
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 
-// Camera-relative drawing: the scene moved 1e6 m away, seen from a camera moved with it (eye in double), gives the
-// same picture.
+// Camera-relative drawing: the scene moved 1e6 m away, seen from a camera moved with it (eye in double),
+// gives the same picture.
 TEST(WireRendererTest, FarFromOriginKeepsPrecision) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -563,8 +584,8 @@ TEST(WireRendererTest, FarFromOriginKeepsPrecision) {
     }
 }
 
-// Informational: bytes uploaded by both paths for 100 wires (asserted: gpu-rings at least 6x fewer) and the frame
-// time of both on llvmpipe (printed only; timing never decides a test).
+// Informational: bytes uploaded by both paths for 100 wires (asserted: gpu-rings at least 6x fewer) and the
+// frame time of both on llvmpipe (printed only; timing never decides a test).
 TEST(WireRendererTest, HundredWiresBytesAndFrameTime) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -591,22 +612,25 @@ TEST(WireRendererTest, HundredWiresBytesAndFrameTime) {
             ctx->end_frame();
         }
         glFinish();
-        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / frames;
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() /
+               frames;
     };
     const double cpu_ms = time_frames(cpu_list, cpu_stats);
     const double gpu_ms = time_frames(gpu_list, gpu_stats);
     std::size_t rings = 0;
     for (const auto& p : scene.pipelines) rings += p.rings().rings.size();
-    std::printf("100 wires, %zu rings, 8 sides: cpu-mesh %zu bytes, %zu vertices, %.2f ms/frame; gpu-rings %zu "
-                "bytes, %zu vertices expanded, %.2f ms/frame; bytes ratio %.2fx (%dx%d, llvmpipe, informational)\n",
-                rings, cpu_stats.bytes_uploaded, cpu_stats.vertices, cpu_ms, gpu_stats.bytes_uploaded,
-                gpu_stats.vertices, gpu_ms,
-                static_cast<double>(cpu_stats.bytes_uploaded) / static_cast<double>(gpu_stats.bytes_uploaded), kWidth,
-                kHeight);
+    std::printf(
+        "100 wires, %zu rings, 8 sides: cpu-mesh %zu bytes, %zu vertices, %.2f ms/frame; gpu-rings %zu "
+        "bytes, %zu vertices expanded, %.2f ms/frame; bytes ratio %.2fx (%dx%d, llvmpipe, informational)\n",
+        rings, cpu_stats.bytes_uploaded, cpu_stats.vertices, cpu_ms, gpu_stats.bytes_uploaded,
+        gpu_stats.vertices, gpu_ms,
+        static_cast<double>(cpu_stats.bytes_uploaded) / static_cast<double>(gpu_stats.bytes_uploaded), kWidth,
+        kHeight);
     EXPECT_EQ(cpu_stats.draw_items, 100u);
     EXPECT_EQ(gpu_stats.draw_items, 100u);
     EXPECT_EQ(cpu_stats.multi_draw_calls, 1u);
-    EXPECT_GE(static_cast<double>(cpu_stats.bytes_uploaded), 6.0 * static_cast<double>(gpu_stats.bytes_uploaded));
+    EXPECT_GE(static_cast<double>(cpu_stats.bytes_uploaded),
+              6.0 * static_cast<double>(gpu_stats.bytes_uploaded));
 }
 
 }  // namespace

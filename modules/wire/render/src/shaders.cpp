@@ -1,5 +1,6 @@
-// GLSL sources. The ring expansion reproduces wire::write_tube (tube.cpp) vertex for vertex: same layout, same
-// triangle order and winding, same normal tilt by the radius slope, so both paths rasterize the same triangles.
+// GLSL sources. The ring expansion reproduces wire::write_tube (tube.cpp) vertex for vertex: same layout,
+// same triangle order and winding, same normal tilt by the radius slope, so both paths rasterize the same
+// triangles.
 #include "shaders.hpp"
 
 namespace wire::render::detail {

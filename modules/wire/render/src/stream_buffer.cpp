@@ -1,4 +1,5 @@
-// StreamBuffer: glBufferStorage(MAP_WRITE | MAP_PERSISTENT | MAP_COHERENT), mapped once; glFenceSync per region.
+// StreamBuffer: glBufferStorage(MAP_WRITE | MAP_PERSISTENT | MAP_COHERENT), mapped once; glFenceSync per
+// region.
 #include "wire/render/stream_buffer.hpp"
 
 #include "engine/gfx/resources.hpp"
@@ -16,7 +17,9 @@ namespace {
 constexpr GLbitfield kMapFlags = GL_MAP_WRITE_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
 constexpr GLuint64 kWaitStepNs = 1'000'000'000;  // 1 s per wait call; we loop until signalled or failed
 
-std::size_t round_up(std::size_t v, std::size_t a) { return (v + a - 1) / a * a; }
+std::size_t round_up(std::size_t v, std::size_t a) {
+    return (v + a - 1) / a * a;
+}
 
 /// True when the fence has signalled (a null fence has nothing pending).
 bool signalled(GLsync fence) {
@@ -71,7 +74,8 @@ struct StreamBuffer::State {
         auto* ptr = static_cast<std::byte*>(
             glMapNamedBufferRange(made->id(), 0, static_cast<GLsizeiptr>(total), kMapFlags));
         if (ptr == nullptr) {
-            return Error{"stream buffer '" + desc.label + "': mapping " + std::to_string(total) + " bytes failed"};
+            return Error{"stream buffer '" + desc.label + "': mapping " + std::to_string(total) +
+                         " bytes failed"};
         }
         if (buffer) {
             // Retire the old buffer: one fence after everything issued so far covers all its regions.
@@ -114,7 +118,8 @@ Expected<StreamBuffer> StreamBuffer::create(const StreamBufferDesc& desc) {
     if (s.desc.alignment == 0) s.desc.alignment = 256;
     if (s.desc.label.empty()) s.desc.label = "stream buffer";
     s.fences.assign(s.desc.regions, nullptr);
-    if (Expected<void> st = s.allocate(round_up(s.desc.region_bytes, s.desc.alignment)); !st) return st.error();
+    if (Expected<void> st = s.allocate(round_up(s.desc.region_bytes, s.desc.alignment)); !st)
+        return st.error();
     return sb;
 }
 
@@ -125,7 +130,8 @@ Expected<StreamRegion> StreamBuffer::begin(std::size_t bytes) {
     s.collect_retired();
     StreamRegion region;
     if (bytes > s.region_bytes) {
-        const auto grown = static_cast<std::size_t>(std::ceil(static_cast<double>(s.region_bytes) * s.desc.growth));
+        const auto grown =
+            static_cast<std::size_t>(std::ceil(static_cast<double>(s.region_bytes) * s.desc.growth));
         const std::size_t size = round_up(std::max(bytes, grown), s.desc.alignment);
         if (Expected<void> st = s.allocate(size); !st) return st.error();
         region.grew = true;
@@ -153,9 +159,15 @@ void StreamBuffer::end() {
     s.open = false;
 }
 
-std::size_t StreamBuffer::region_bytes() const { return state_ ? state_->region_bytes : 0; }
-uint32_t StreamBuffer::regions() const { return state_ ? state_->desc.regions : 0; }
-std::size_t StreamBuffer::live_buffers() const { return state_ ? 1 + state_->retired.size() : 0; }
+std::size_t StreamBuffer::region_bytes() const {
+    return state_ ? state_->region_bytes : 0;
+}
+uint32_t StreamBuffer::regions() const {
+    return state_ ? state_->desc.regions : 0;
+}
+std::size_t StreamBuffer::live_buffers() const {
+    return state_ ? 1 + state_->retired.size() : 0;
+}
 const std::vector<unsigned>& StreamBuffer::allocated_buffers() const {
     static const std::vector<unsigned> none;
     return state_ ? state_->allocated : none;

@@ -13,7 +13,8 @@ std::vector<uint8_t> make_weave_rgba(const WeaveDesc& desc) {
     const double width = desc.strand_width > 0.0f ? std::min(1.0, double{desc.strand_width}) : 0.82;
     std::vector<uint8_t> rgba(static_cast<std::size_t>(size) * size * 4);
 
-    // Brightness across one strand (f in [0, 1) of the pitch): a rounded profile, 0 in the gap between strands.
+    // Brightness across one strand (f in [0, 1) of the pitch): a rounded profile, 0 in the gap between
+    // strands.
     auto profile = [width](double f) {
         const double d = std::abs(2.0 * f - 1.0) / width;  // 0 on the strand's centre line, 1 at its edge
         return d >= 1.0 ? 0.0 : std::sqrt(1.0 - d * d);
@@ -35,8 +36,9 @@ std::vector<uint8_t> make_weave_rgba(const WeaveDesc& desc) {
     };
     for (int py = 0; py < size; ++py) {
         for (int px = 0; px < size; ++px) {
-            // Pixel centres; averaging with the point mirror (x, y) -> (1 - x, 1 - y) makes the pixels exactly
-            // symmetric even where a strand edge falls on a pixel centre (floor() is not symmetric there).
+            // Pixel centres; averaging with the point mirror (x, y) -> (1 - x, 1 - y) makes the pixels
+            // exactly symmetric even where a strand edge falls on a pixel centre (floor() is not symmetric
+            // there).
             const double x = (px + 0.5) / size;
             const double y = (py + 0.5) / size;
             const double value = 0.5 * (weave(x, y) + weave(1.0 - x, 1.0 - y));

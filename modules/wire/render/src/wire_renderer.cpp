@@ -1,5 +1,5 @@
-// WireRenderer: one stream-buffer region per frame holding per-draw records, indirect commands and geometry (tube
-// vertices + indices, or ring records), drawn with one glMultiDraw*Indirect per material.
+// WireRenderer: one stream-buffer region per frame holding per-draw records, indirect commands and geometry
+// (tube vertices + indices, or ring records), drawn with one glMultiDraw*Indirect per material.
 #include "wire/render/wire_renderer.hpp"
 
 #include "shaders.hpp"
@@ -36,10 +36,13 @@ struct DrawArraysIndirectCommand {
 };
 static_assert(sizeof(DrawElementsIndirectCommand) == 20 && sizeof(DrawArraysIndirectCommand) == 16);
 
-constexpr std::size_t kSectionAlign = 256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every driver we know
+constexpr std::size_t kSectionAlign =
+    256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every driver we know
 constexpr GLuint kDrawIndexLocation = 3;
 
-std::size_t align_up(std::size_t v) { return (v + kSectionAlign - 1) / kSectionAlign * kSectionAlign; }
+std::size_t align_up(std::size_t v) {
+    return (v + kSectionAlign - 1) / kSectionAlign * kSectionAlign;
+}
 
 /// Vertices the ring expansion produces for a gpu-rings item (0 if it draws nothing).
 uint32_t expanded_vertices(const DrawItem& item) {
@@ -75,7 +78,8 @@ struct WireRenderer::State {
 
     Expected<void> ensure_draw_index_capacity(std::size_t n) {
         if (draw_parameters || n <= draw_index_capacity) return {};
-        const std::size_t capacity = std::max<std::size_t>(n, std::max<std::size_t>(1024, 2 * draw_index_capacity));
+        const std::size_t capacity =
+            std::max<std::size_t>(n, std::max<std::size_t>(1024, 2 * draw_index_capacity));
         std::vector<uint32_t> iota(capacity);
         std::iota(iota.begin(), iota.end(), 0u);
         Expected<gfx::Buffer> made = gfx::make_buffer(std::span<const uint32_t>(iota), "wire draw index");
@@ -105,7 +109,8 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     const std::string fragment = detail::fragment_source(desc.shading_glsl);
     const std::string cpu_vertex = detail::vertex_source(true, s.draw_parameters);
     const std::string rings_vertex = detail::vertex_source(false, s.draw_parameters);
-    Expected<gfx::Program> cpu = gfx::make_program({.vertex = cpu_vertex, .fragment = fragment, .label = "wire cpu-mesh"});
+    Expected<gfx::Program> cpu =
+        gfx::make_program({.vertex = cpu_vertex, .fragment = fragment, .label = "wire cpu-mesh"});
     if (!cpu) return cpu.error();
     Expected<gfx::Program> rings =
         gfx::make_program({.vertex = rings_vertex, .fragment = fragment, .label = "wire gpu-rings"});
@@ -113,8 +118,8 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     s.cpu_program = std::move(cpu).value();
     s.rings_program = std::move(rings).value();
 
-    // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 (the buffer is set per frame); both read the
-    // draw index at binding 1 when the draw-parameters extension is missing.
+    // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 (the buffer is set per frame); both read
+    // the draw index at binding 1 when the draw-parameters extension is missing.
     s.cpu_vao = gfx::make_vertex_array({.label = "wire cpu-mesh"});
     s.rings_vao = gfx::make_vertex_array({.label = "wire gpu-rings"});
     const GLuint cpu_vao = s.cpu_vao.id();
@@ -122,7 +127,8 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
         GLuint location;
         GLint components;
         GLuint offset;
-    } attributes[] = {{0, 3, offsetof(TubeVertex, position)}, {1, 3, offsetof(TubeVertex, normal)},
+    } attributes[] = {{0, 3, offsetof(TubeVertex, position)},
+                      {1, 3, offsetof(TubeVertex, normal)},
                       {2, 2, offsetof(TubeVertex, uv)}};
     for (const auto& a : attributes) {
         glEnableVertexArrayAttrib(cpu_vao, a.location);
@@ -159,13 +165,12 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     s.textures.push_back(std::move(texture).value());
     s.materials.push_back({.tint = {0.95f, 0.62f, 0.38f}, .texture = 0});
 
-    Expected<StreamBuffer> stream = StreamBuffer::create({.regions = desc.frames_in_flight,
-                                                          .region_bytes = desc.region_bytes != 0
-                                                                              ? desc.region_bytes
-                                                                              : std::size_t{4} << 20,
-                                                          .growth = desc.growth,
-                                                          .alignment = kSectionAlign,
-                                                          .label = "wire stream"});
+    Expected<StreamBuffer> stream = StreamBuffer::create(
+        {.regions = desc.frames_in_flight,
+         .region_bytes = desc.region_bytes != 0 ? desc.region_bytes : std::size_t{4} << 20,
+         .growth = desc.growth,
+         .alignment = kSectionAlign,
+         .label = "wire stream"});
     if (!stream) return stream.error();
     s.stream = std::move(stream).value();
     return r;
@@ -187,13 +192,21 @@ void WireRenderer::set_material(uint32_t index, const Material& material) {
     state_->materials[index] = material;
 }
 
-const std::vector<Material>& WireRenderer::materials() const { return state_->materials; }
-bool WireRenderer::uses_draw_parameters() const { return state_->draw_parameters; }
-std::size_t WireRenderer::live_stream_buffers() const { return state_->stream.live_buffers(); }
+const std::vector<Material>& WireRenderer::materials() const {
+    return state_->materials;
+}
+bool WireRenderer::uses_draw_parameters() const {
+    return state_->draw_parameters;
+}
+std::size_t WireRenderer::live_stream_buffers() const {
+    return state_->stream.live_buffers();
+}
 const std::vector<unsigned>& WireRenderer::allocated_stream_buffers() const {
     return state_->stream.allocated_buffers();
 }
-std::size_t WireRenderer::region_bytes() const { return state_->stream.region_bytes(); }
+std::size_t WireRenderer::region_bytes() const {
+    return state_->stream.region_bytes();
+}
 
 FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
                               const FrameSettings& settings) {
@@ -228,7 +241,8 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         }
     }
     const std::size_t draws_bytes = n * sizeof(detail::GpuDraw);
-    const std::size_t command_stride = cpu ? sizeof(DrawElementsIndirectCommand) : sizeof(DrawArraysIndirectCommand);
+    const std::size_t command_stride =
+        cpu ? sizeof(DrawElementsIndirectCommand) : sizeof(DrawArraysIndirectCommand);
     const std::size_t command_offset = align_up(draws_bytes);
     const std::size_t geometry_offset = align_up(command_offset + n * command_stride);
     const std::size_t index_offset = align_up(geometry_offset + geometry_bytes);
@@ -255,12 +269,13 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         if (cpu) {
             const auto vertex_count = static_cast<uint32_t>(item.vertices.size());
             const auto index_count = static_cast<uint32_t>(item.indices.size());
-            std::memcpy(base + geometry_offset + geometry_cursor, item.vertices.data(), item.vertices.size_bytes());
+            std::memcpy(base + geometry_offset + geometry_cursor, item.vertices.data(),
+                        item.vertices.size_bytes());
             std::memcpy(base + index_offset + index_cursor * sizeof(uint32_t), item.indices.data(),
                         item.indices.size_bytes());
-            const DrawElementsIndirectCommand command{index_count, 1,
-                                                      static_cast<uint32_t>(first_index_base + index_cursor),
-                                                      static_cast<int32_t>(vertex_cursor), static_cast<uint32_t>(k)};
+            const DrawElementsIndirectCommand command{
+                index_count, 1, static_cast<uint32_t>(first_index_base + index_cursor),
+                static_cast<int32_t>(vertex_cursor), static_cast<uint32_t>(k)};
             std::memcpy(base + command_offset + k * command_stride, &command, sizeof(command));
             geometry_cursor += item.vertices.size_bytes();
             index_cursor += index_count;
@@ -273,8 +288,8 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
             draw.ring_first = ring_cursor;
             draw.ring_count = ring_count;
             draw.sides = item.sides;
-            // Normals tilt by the radius slope as write_tube's default does; a wire of constant radius has slope 0
-            // everywhere, so the shader skips the three neighbour fetches per vertex for it.
+            // Normals tilt by the radius slope as write_tube's default does; a wire of constant radius has
+            // slope 0 everywhere, so the shader skips the three neighbour fetches per vertex for it.
             const float r0 = item.rings.front().radius_m;
             const bool varying = std::any_of(item.rings.begin(), item.rings.end(),
                                              [r0](const Ring& r) { return r.radius_m != r0; });
@@ -320,7 +335,8 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
                       static_cast<GLsizeiptr>(draws_bytes));
     if (cpu) {
         glVertexArrayVertexBuffer(s.cpu_vao.id(), 0, buffer,
-                                  static_cast<GLintptr>(region.offset_bytes + geometry_offset), sizeof(TubeVertex));
+                                  static_cast<GLintptr>(region.offset_bytes + geometry_offset),
+                                  sizeof(TubeVertex));
         glVertexArrayElementBuffer(s.cpu_vao.id(), buffer);
         s.cpu_vao.bind();
     } else {

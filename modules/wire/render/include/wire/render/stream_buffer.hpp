@@ -1,6 +1,7 @@
-// A persistently mapped GL buffer split into regions for the frames in flight, each guarded by a fence: the CPU
-// writes a frame's data with memcpy into the region the GPU finished with. Grows without stalling the frame.
-// (Generic GL: belongs in engine::gfx once that folder takes it; kept here so wire code touches GL in one place.)
+// A persistently mapped GL buffer split into regions for the frames in flight, each guarded by a fence: the
+// CPU writes a frame's data with memcpy into the region the GPU finished with. Grows without stalling the
+// frame. (Generic GL: belongs in engine::gfx once that folder takes it; kept here so wire code touches GL in
+// one place.)
 #pragma once
 
 #include "engine/platform/expected.hpp"
@@ -21,18 +22,19 @@ struct StreamBufferDesc {
     uint32_t regions = 0;          ///< frames in flight; 0 -> 3
     std::size_t region_bytes = 0;  ///< initial capacity of one region; 0 -> 1 MiB
     float growth = 0.0f;           ///< a region that is too small grows to max(needed, growth * size); 0 -> 2
-    std::size_t alignment = 0;     ///< region sizes are multiples of this; 0 -> 256 (>= any SSBO offset alignment)
-    std::string label{};           ///< GL object label
+    std::size_t alignment =
+        0;                ///< region sizes are multiples of this; 0 -> 256 (>= any SSBO offset alignment)
+    std::string label{};  ///< GL object label
 };
 
 /// One frame's slice of the buffer, mapped for writing (write only: the memory may be uncached).
 struct StreamRegion {
-    std::byte* data = nullptr;       ///< mapped pointer to the region's first byte
-    std::size_t offset_bytes = 0;    ///< of the region inside the GL buffer (for binding ranges, draw offsets)
+    std::byte* data = nullptr;     ///< mapped pointer to the region's first byte
+    std::size_t offset_bytes = 0;  ///< of the region inside the GL buffer (for binding ranges, draw offsets)
     std::size_t size_bytes = 0;
-    unsigned buffer = 0;             ///< GL name of the buffer holding the region
-    bool grew = false;               ///< this call allocated a bigger buffer
-    bool waited = false;             ///< this call had to wait for the GPU (the region's fence was not signalled)
+    unsigned buffer = 0;  ///< GL name of the buffer holding the region
+    bool grew = false;    ///< this call allocated a bigger buffer
+    bool waited = false;  ///< this call had to wait for the GPU (the region's fence was not signalled)
 };
 
 class StreamBuffer {
@@ -46,9 +48,10 @@ public:
     ~StreamBuffer();
 
     /// The next region, holding at least `bytes`. Waits on the region's fence only if the GPU still reads it
-    /// (frames_in_flight frames ago). If `bytes` exceeds the region size, a bigger buffer is allocated and the
-    /// old one is retired: kept alive until a fence placed after its last use signals, then deleted (checked at
-    /// every begin()). Errors: the allocation or the mapping failed (the old buffer stays usable).
+    /// (frames_in_flight frames ago). If `bytes` exceeds the region size, a bigger buffer is allocated and
+    /// the old one is retired: kept alive until a fence placed after its last use signals, then deleted
+    /// (checked at every begin()). Errors: the allocation or the mapping failed (the old buffer stays
+    /// usable).
     Expected<StreamRegion> begin(std::size_t bytes);
     /// Fences the region returned by the last begin(): call after the draws that read it are issued.
     void end();

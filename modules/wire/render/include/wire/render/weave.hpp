@@ -14,8 +14,9 @@ struct WeaveDesc {
 };
 
 /// RGBA8 pixels (size_px^2 * 4 bytes) of a plain over/under weave of two families of helical strands along
-/// x + y and x - y (x = u along the wire, y = v around it). Tiles seamlessly in x and y and is symmetric under
-/// x -> -x and y -> -y (the two families swap). Grey levels (R = G = B, A = 255), so a material's tint colours it.
+/// x + y and x - y (x = u along the wire, y = v around it). Tiles seamlessly in x and y and is symmetric
+/// under x -> -x and y -> -y (the two families swap). Grey levels (R = G = B, A = 255), so a material's tint
+/// colours it.
 [[nodiscard]] std::vector<uint8_t> make_weave_rgba(const WeaveDesc& desc = {});
 
 }  // namespace wire::render

@@ -1,5 +1,5 @@
-// The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into one
-// persistently mapped buffer and one multi-draw per material. The only wire code that touches GL.
+// The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
+// one persistently mapped buffer and one multi-draw per material. The only wire code that touches GL.
 //
 //   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
 //   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
@@ -28,12 +28,12 @@ using engine::platform::Expected;
 
 /// A row of the material table (DrawItem::material indexes it).
 struct Material {
-    glm::vec3 tint{1.0f};   ///< multiplies the texture (linear RGB)
-    uint32_t texture = 0;   ///< index into the renderer's textures; 0 is the built-in weave
+    glm::vec3 tint{1.0f};  ///< multiplies the texture (linear RGB)
+    uint32_t texture = 0;  ///< index into the renderer's textures; 0 is the built-in weave
 };
 
-/// Directional light: colour = (albedo * (ambient + (1 - ambient) * max(0, n.l)) + specular * blinn^shininess) *
-/// light colour, albedo = texture(u, v) * tint. Both upload paths shade identically.
+/// Directional light: colour = (albedo * (ambient + (1 - ambient) * max(0, n.l)) + specular *
+/// blinn^shininess) * light colour, albedo = texture(u, v) * tint. Both upload paths shade identically.
 struct Light {
     glm::vec3 to_light{0.3f, 1.0f, 0.5f};  ///< direction toward the light (normalized by the renderer)
     glm::vec3 color{1.0f};
@@ -44,14 +44,14 @@ struct Light {
 
 /// Zero means default.
 struct RendererDesc {
-    uint32_t frames_in_flight = 0;   ///< regions of the stream buffer, each fenced; 0 -> 3
-    std::size_t region_bytes = 0;    ///< initial capacity of one region; 0 -> 4 MiB (grows as needed)
-    float growth = 0.0f;             ///< growth factor of a region that is too small; 0 -> 2
-    int weave_size_px = 0;           ///< built-in weave texture edge; 0 -> 256
-    float max_anisotropy = 0.0f;     ///< anisotropic filtering of the weave if the driver has it; 0 -> 8
+    uint32_t frames_in_flight = 0;  ///< regions of the stream buffer, each fenced; 0 -> 3
+    std::size_t region_bytes = 0;   ///< initial capacity of one region; 0 -> 4 MiB (grows as needed)
+    float growth = 0.0f;            ///< growth factor of a region that is too small; 0 -> 2
+    int weave_size_px = 0;          ///< built-in weave texture edge; 0 -> 256
+    float max_anisotropy = 0.0f;    ///< anisotropic filtering of the weave if the driver has it; 0 -> 8
     /// Optional GLSL `vec3 shade(vec3 albedo, vec3 n, vec3 to_eye)` replacing the default lighting (uniforms
-    /// u_to_light, u_light_color, u_ambient, u_specular, u_shininess are declared). A shader that fails to compile
-    /// makes create() return the driver's log.
+    /// u_to_light, u_light_color, u_ambient, u_specular, u_shininess are declared). A shader that fails to
+    /// compile makes create() return the driver's log.
     std::string_view shading_glsl{};
     /// Use the instanced draw-index attribute even when ARB_shader_draw_parameters is available (tests).
     bool force_draw_index_attribute = false;
@@ -60,28 +60,30 @@ struct RendererDesc {
 /// Per-frame options.
 struct FrameSettings {
     Light light{};
-    bool wireframe = false;                 ///< glPolygonMode(GL_LINE) for this frame's wires
-    /// Camera position in double (world metres); unset: camera.position. Offsets origin_m - eye are computed in
-    /// double and sent as float, so wires far from the world origin keep their precision.
+    bool wireframe = false;  ///< glPolygonMode(GL_LINE) for this frame's wires
+    /// Camera position in double (world metres); unset: camera.position. Offsets origin_m - eye are computed
+    /// in double and sent as float, so wires far from the world origin keep their precision.
     std::optional<glm::dvec3> eye_m{};
 };
 
 /// What one draw() did.
 struct FrameStats {
-    std::size_t bytes_uploaded = 0;     ///< bytes memcpy'd into the mapped buffer (geometry, per-draw, commands)
-    std::size_t draw_items = 0;         ///< items drawn (items with no geometry are skipped)
-    std::size_t vertices = 0;           ///< cpu-mesh: vertices uploaded; gpu-rings: vertices expanded by the shader
+    std::size_t bytes_uploaded = 0;  ///< bytes memcpy'd into the mapped buffer (geometry, per-draw, commands)
+    std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
+    std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices expanded by the shader
     std::size_t triangles = 0;
     std::size_t indirect_commands = 0;
-    std::size_t multi_draw_calls = 0;   ///< one per material in use
+    std::size_t multi_draw_calls = 0;  ///< one per material in use
     bool buffer_grew = false;
-    bool waited_for_gpu = false;        ///< the region's fence had not signalled (more frames in flight than regions)
+    bool waited_for_gpu =
+        false;  ///< the region's fence had not signalled (more frames in flight than regions)
 };
 
 class WireRenderer {
 public:
-    /// Compiles the programs (errors carry the driver's log via engine::gfx::make_program), makes the weave texture
-    /// and the stream buffer. Material 0 is the weave with a copper tint. Needs a current GL 4.5 context.
+    /// Compiles the programs (errors carry the driver's log via engine::gfx::make_program), makes the weave
+    /// texture and the stream buffer. Material 0 is the weave with a copper tint. Needs a current GL 4.5
+    /// context.
     static Expected<WireRenderer> create(const RendererDesc& desc = {});
 
     WireRenderer();
@@ -89,7 +91,8 @@ public:
     WireRenderer& operator=(WireRenderer&&) noexcept;
     ~WireRenderer();
 
-    /// Adds a texture (e.g. engine::gfx::make_texture with Wrap::repeat); returns its index for Material::texture.
+    /// Adds a texture (e.g. engine::gfx::make_texture with Wrap::repeat); returns its index for
+    /// Material::texture.
     uint32_t add_texture(engine::gfx::Texture texture);
     /// Adds a material; returns its index for DrawItem::material.
     uint32_t add_material(const Material& material);
@@ -98,12 +101,13 @@ public:
 
     /// Uploads and draws `list` into the bound framebuffer with depth test and back-face culling (it does not
     /// clear). All items go into one region of the stream buffer; one glMultiDraw*Indirect per material; the
-    /// region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material < materials(),
-    /// cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
-    FrameStats draw(const DrawList& list, const engine::scene::Camera& camera, const FrameSettings& settings = {});
+    /// region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material <
+    /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
+    FrameStats draw(const DrawList& list, const engine::scene::Camera& camera,
+                    const FrameSettings& settings = {});
 
-    /// True when the draw index comes from gl_BaseInstanceARB (ARB_shader_draw_parameters), false when from the
-    /// instanced attribute.
+    /// True when the draw index comes from gl_BaseInstanceARB (ARB_shader_draw_parameters), false when from
+    /// the instanced attribute.
     [[nodiscard]] bool uses_draw_parameters() const;
     /// GL buffers of the stream buffer alive now (1 plus retired buffers still waiting for their fences).
     [[nodiscard]] std::size_t live_stream_buffers() const;
