@@ -55,26 +55,36 @@ const SideTable& side_table(uint32_t n) {
     return table;
 }
 
-/// `count` vertices: vertex_j = base + (cos_j along_r + sin_j along_s) + v_j (v_weight in the last lane), as the
-/// 8 floats of a TubeVertex. The side rows and the cap rims both go through here, so equal inputs give
-/// bit-identical positions and the mesh welds. Returns the vertex after the last one written.
-TubeVertex* emit_row(const float (&base)[8], const float (&along_r)[8], const float (&along_s)[8],
-                     const float* cos_phi, const float* sin_phi, const float* v_of, float v_weight, uint32_t count,
-                     TubeVertex* v, bool stream) {
 #if defined(__SSE2__)
-    // Two 4-float halves (x86-64 always has SSE2; no -march needed).
-    const __m128 b0 = _mm_loadu_ps(base), b1 = _mm_loadu_ps(base + 4);
-    const __m128 r0 = _mm_loadu_ps(along_r), r1 = _mm_loadu_ps(along_r + 4);
-    const __m128 s0 = _mm_loadu_ps(along_s), s1 = _mm_loadu_ps(along_s + 4);
-    const __m128 lane_v = _mm_set_ps(v_weight, 0.0f, 0.0f, 0.0f);
+using Quad = __m128;
+inline Quad quad(float a, float b, float c, float d) { return _mm_setr_ps(a, b, c, d); }
+#else
+using Quad = std::array<float, 4>;
+inline Quad quad(float a, float b, float c, float d) { return Quad{a, b, c, d}; }
+#endif
+
+/// One row of vertices as two 4-float halves of a TubeVertex (position xyz + normal x | normal yz + uv):
+/// vertex_j = base + (cos_j along_r + sin_j along_s) + v_j v_weight (last lane). Built in registers (no
+/// store-forwarding stalls); side rows and cap rims both go through emit_row, so equal inputs give bit-identical
+/// positions and the mesh welds.
+struct Row {
+    Quad base0, base1, r0, r1, s0, s1;
+};
+
+/// Writes `count` vertices of `row`; returns the vertex after the last one written.
+TubeVertex* emit_row(const Row& row, const float* cos_phi, const float* sin_phi, const float* v_of, float v_weight,
+                     uint32_t count, TubeVertex* v, bool stream) {
     float* out = reinterpret_cast<float*>(v);
+#if defined(__SSE2__)
+    // x86-64 always has SSE2; no -march needed.
+    const __m128 lane_v = _mm_setr_ps(0.0f, 0.0f, 0.0f, v_weight);
     for (uint32_t j = 0; j < count; ++j, out += 8) {
         const __m128 cj = _mm_set1_ps(cos_phi[j]);
         const __m128 sj = _mm_set1_ps(sin_phi[j]);
         const __m128 vj = _mm_set1_ps(v_of[j]);
-        const __m128 o0 = _mm_add_ps(b0, _mm_add_ps(_mm_mul_ps(cj, r0), _mm_mul_ps(sj, s0)));
-        const __m128 o1 = _mm_add_ps(_mm_add_ps(b1, _mm_mul_ps(vj, lane_v)),
-                                     _mm_add_ps(_mm_mul_ps(cj, r1), _mm_mul_ps(sj, s1)));
+        const __m128 o0 = _mm_add_ps(row.base0, _mm_add_ps(_mm_mul_ps(cj, row.r0), _mm_mul_ps(sj, row.s0)));
+        const __m128 o1 = _mm_add_ps(_mm_add_ps(row.base1, _mm_mul_ps(vj, lane_v)),
+                                     _mm_add_ps(_mm_mul_ps(cj, row.r1), _mm_mul_ps(sj, row.s1)));
         if (stream) {
             _mm_stream_ps(out, o0);
             _mm_stream_ps(out + 4, o1);
@@ -83,19 +93,19 @@ TubeVertex* emit_row(const float (&base)[8], const float (&along_r)[8], const fl
             _mm_storeu_ps(out + 4, o1);
         }
     }
-    return v + count;
 #else
     (void)stream;
-    for (uint32_t j = 0; j < count; ++j, ++v) {
+    for (uint32_t j = 0; j < count; ++j, out += 8) {
         float o[8];
-        for (int k = 0; k < 8; ++k) {
-            o[k] = base[k] + (cos_phi[j] * along_r[k] + sin_phi[j] * along_s[k]);
+        for (int k = 0; k < 4; ++k) {
+            o[k] = row.base0[k] + (cos_phi[j] * row.r0[k] + sin_phi[j] * row.s0[k]);
+            o[4 + k] = row.base1[k] + (cos_phi[j] * row.r1[k] + sin_phi[j] * row.s1[k]);
         }
         o[7] += v_of[j] * v_weight;
-        std::memcpy(static_cast<void*>(v), o, sizeof(o));
+        std::memcpy(out, o, sizeof(o));
     }
-    return v;
 #endif
+    return v + count;
 }
 
 /// 32 bytes to dst; with `stream`, non-temporal (the caller checked 16-byte alignment).
@@ -158,10 +168,10 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
         const glm::vec3 sr = ring.radius_m * ring.binormal;
         const glm::vec3 ra = a * ring.normal;
         const glm::vec3 sa = a * ring.binormal;
-        const float base[8] = {ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, -tb.x, -tb.y, -tb.z, u, 0.0f};
-        const float along_r[8] = {rr.x, rr.y, rr.z, ra.x, ra.y, ra.z, 0.0f, 0.0f};
-        const float along_s[8] = {sr.x, sr.y, sr.z, sa.x, sa.y, sa.z, 0.0f, 0.0f};
-        v = emit_row(base, along_r, along_s, cos_phi, sin_phi, v_of, 1.0f, n + 1, v, stream);
+        const Row row{quad(ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, -tb.x), quad(-tb.y, -tb.z, u, 0.0f),
+                      quad(rr.x, rr.y, rr.z, ra.x),  quad(ra.y, ra.z, 0.0f, 0.0f),
+                      quad(sr.x, sr.y, sr.z, sa.x),  quad(sa.y, sa.z, 0.0f, 0.0f)};
+        v = emit_row(row, cos_phi, sin_phi, v_of, 1.0f, n + 1, v, stream);
     };
     auto slope_at = [&](std::size_t i) -> float {
         if (!settings.tilt_normals || ring_n < 2) {
@@ -218,11 +228,11 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
             // Rim positions by the side loop's exact expression, so they weld with the side vertices.
             const glm::vec3 rr = ring.radius_m * ring.normal;
             const glm::vec3 sr = ring.radius_m * ring.binormal;
-            const float base[8] = {ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, normal.x, normal.y, normal.z,
-                                   0.5f, 0.5f};
-            const float along_r[8] = {rr.x, rr.y, rr.z, 0.0f, 0.0f, 0.0f, 0.5f, 0.0f};
-            const float along_s[8] = {sr.x, sr.y, sr.z, 0.0f, 0.0f, 0.0f, 0.0f, 0.5f};
-            v = emit_row(base, along_r, along_s, cos_phi, sin_phi, v_of, 0.0f, n, v, stream);
+            const Row row{quad(ring.centre_m.x, ring.centre_m.y, ring.centre_m.z, normal.x),
+                          quad(normal.y, normal.z, 0.5f, 0.5f),
+                          quad(rr.x, rr.y, rr.z, 0.0f), quad(0.0f, 0.0f, 0.5f, 0.0f),
+                          quad(sr.x, sr.y, sr.z, 0.0f), quad(0.0f, 0.0f, 0.0f, 0.5f)};
+            v = emit_row(row, cos_phi, sin_phi, v_of, 0.0f, n, v, stream);
             for (uint32_t j = 0; j < n; ++j) {
                 const uint32_t rim_j = centre + 1 + j;
                 const uint32_t rim_k = centre + 1 + (j + 1) % n;
