@@ -1,15 +1,31 @@
 // WirePipeline: the stages of one wire chained, with state carried between successive states.
 #include "wire/pipeline.hpp"
 
-#include "wire/spline.hpp"
 
 namespace wire {
+namespace {
+
+bool same_spline(const SplineSettings& a, const SplineSettings& b) {
+    return a.kind == b.kind && a.alpha == b.alpha && a.tension == b.tension && a.bias == b.bias &&
+           a.continuity == b.continuity && a.curvature_tension == b.curvature_tension && a.closed == b.closed &&
+           a.radius_m == b.radius_m && a.merge_epsilon_rel == b.merge_epsilon_rel;
+}
+
+}  // namespace
 
 Status WirePipeline::update(const WireNodes& nodes, const PipelineSettings& settings) {
+    // A change of spline settings or of the remedy starts a new history: the curves are not comparable.
+    if (states_ == 0 || pop_free_ != settings.pop_free || !same_spline(multires_spline_, settings.spline)) {
+        MultiresSettings m = settings.multires;
+        m.spline = settings.spline;
+        m.geomorph = settings.pop_free;
+        multires_ = MultiresCurve(m);
+        multires_spline_ = settings.spline;
+        pop_free_ = settings.pop_free;
+    }
     Curve next;
-    if (Status st = build_curve(nodes, settings.spline, next); !st.ok) return st;
-    target_ = std::move(next);
-    rendered_ = target_;
+    if (Status st = multires_.update(nodes, next); !st.ok) return st;
+    rendered_ = std::move(next);
 
     segment_ring_counts(rendered_, settings.tessellate, counts_);
     place_rings(rendered_, counts_, params_);

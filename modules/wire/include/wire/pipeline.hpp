@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wire/curve.hpp"
+#include "wire/multires.hpp"
 #include "wire/nodes.hpp"
 #include "wire/rings.hpp"
 #include "wire/status.hpp"
@@ -19,7 +20,8 @@ struct PipelineSettings {
     TessellateSettings tessellate{};
     TubeSettings tube{};
     FrameMethod frame_method = FrameMethod::double_reflection;
-    bool pop_free = true;  ///< blend the curve over a few states when node ids appear or vanish
+    bool pop_free = true;  ///< geomorph (MultiresCurve) when node ids appear or vanish between states
+    MultiresSettings multires{};  ///< blend length and per-frame step bound; its `spline` is taken from `spline`
 };
 
 /// Stateful per wire: call update() with each new state of the wire's nodes, in order.
@@ -30,13 +32,16 @@ public:
     [[nodiscard]] Status update(const WireNodes& nodes, const PipelineSettings& settings);
 
     [[nodiscard]] const Curve& curve() const { return rendered_; }
+    [[nodiscard]] const MultiresCurve& multires() const { return multires_; }
     [[nodiscard]] const RingSet& rings() const { return rings_; }
     [[nodiscard]] const TubeMesh& mesh() const { return mesh_; }
     [[nodiscard]] std::size_t states() const { return states_; }
 
 private:
-    Curve target_;    ///< the curve of the newest nodes
-    Curve rendered_;  ///< what is drawn (equals target_ unless the pop-free remedy is blending)
+    MultiresCurve multires_;
+    SplineSettings multires_spline_{};  ///< the spline settings multires_ was made with
+    bool pop_free_ = false;
+    Curve rendered_;  ///< what is drawn (the newest nodes' curve unless the pop-free remedy is blending)
     std::vector<uint32_t> counts_;
     std::vector<RingParam> params_;
     RingSet rings_;
