@@ -216,7 +216,9 @@ Status MultiresCurve::update(const WireNodes& nodes, Curve& rendered) {
     };
     std::unordered_map<uint32_t, std::size_t> t_index;
     for (std::size_t j = 0; j < tn; ++j) t_index.emplace(tid[j], j);
-    if (!settings_.geomorph || !has_state_ || T.closed || target_.closed || t_index.size() != tn) return show_target(1);
+    // Without ids, nodes are named by index: a count change renames nodes, so only then is there nothing to key on.
+    const bool renamed = nodes.ids.empty() && tn != target_ids_.size();
+    if (!settings_.geomorph || !has_state_ || T.closed || target_.closed || t_index.size() != tn || renamed) return show_target(1);
 
     std::unordered_map<uint32_t, std::size_t> prev_index, rend_index;
     for (std::size_t i = 0; i < target_ids_.size(); ++i) prev_index.emplace(target_ids_[i], i);

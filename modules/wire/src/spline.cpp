@@ -335,9 +335,11 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
                     const dvec3 mix = (1.0 - s) * dir_c + s * dir_s;
                     const double lm = glm::length(mix);
                     const dvec3 dir = lm > 0.0 ? mix / lm : dir_c;
-                    const double lmin = std::min(lin, lout);
-                    start = ((1.0 - s) * ls + s * kHug * keep * lmin) * dir;
-                    end = ((1.0 - s) * glm::length(end) + s * kHug * keep * lmin) * dir;
+                    // A taut wire runs straight between its nodes: from 1% to 5% stretch the rounding shrinks
+                    // to a tenth (still G1: the tangent never vanishes, unlike tension 1).
+                    const double h = kHug * (1.0 - 0.9 * smoothstep(1.01, 1.05, st)) * std::min(lin, lout);
+                    start = ((1.0 - s) * ls + s * keep * h) * dir;
+                    end = ((1.0 - s) * glm::length(end) + s * keep * h) * dir;
                 }
             }
             if (has_out) tg.t0[kout] = start;

@@ -56,6 +56,22 @@ inline WireNodes stretched_bend_nodes(float stretch) {
     return n;
 }
 
+/// A taut wire whose nodes zig-zag +-2 cm off a straight 20 m line (nodes every 2 m, turning ~2.3 degrees):
+/// with stretch > 1 the truth is the node polyline (a stretched cable runs straight between its nodes).
+inline WireNodes kinked_taut_nodes(float stretch) {
+    WireNodes n;
+    for (int i = 0; i <= 10; ++i) n.positions.emplace_back(2.0 * i, (i % 2 ? 0.02 : -0.02), 0.0);
+    n.stretch.assign(n.positions.size(), stretch);
+    return n;
+}
+
+/// Max distance from the curve to the polyline through its nodes.
+inline double polyline_deviation_m(const Curve& c, const WireNodes& n) {
+    double worst = 0.0;
+    for (const glm::dvec3& p : sample_curve(c, 128)) worst = std::max(worst, distance_to_polyline(p, n.positions));
+    return worst;
+}
+
 struct BendNumbers {
     double straight_dev_m = 0.0;  ///< max distance off the line y = z = 0 over the straight run's segments 0..4
     double overshoot_m = 0.0;     ///< max distance past the corner line x = 10 (over the whole curve)

@@ -373,6 +373,17 @@ TEST(WireCurveAutomatic, StretchedRunThenTightBendStaysOnTheLine) {
     }
 }
 
+TEST(WireCurveAutomatic, TautWireRunsStraightBetweenItsNodes) {
+    // Nodes zig-zag +-2 cm every 2 m; stretched 6% the truth is the node polyline. Chordal/centripetal bulge
+    // 5.9 mm off it whatever the stretch; automatic: 1.6 mm at 3%, 0.30 mm at 6%, and stays G1.
+    Curve chordal, automatic;
+    const WireNodes n = kinked_taut_nodes(1.06f);
+    ASSERT_TRUE(build_curve(n, {.alpha = 1.0}, chordal).ok);
+    ASSERT_TRUE(build_curve(n, {.kind = SplineKind::automatic}, automatic).ok);
+    EXPECT_LT(polyline_deviation_m(automatic, n) * 10.0, polyline_deviation_m(chordal, n));
+    EXPECT_LT(max_kink_rad(automatic), 1e-9);
+}
+
 TEST(WireCurveAutomatic, SmoothSagIsExactlyChordalInTheInterior) {
     const Catenary cable = hanging_cable();
     const WireNodes n = cable_nodes(cable, 16);

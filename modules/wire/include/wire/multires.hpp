@@ -21,8 +21,9 @@
 // to a point of the previous frame, which bounds the measured jump. rate = max_step_m / max_t |D(t)|, clamped
 // to [1/max_blend_frames, 1/blend_frames], keeps every frame's jump under max_step_m unless the morph would
 // take longer than max_blend_frames. |D(t)| includes sliding along the curve, so the bound is conservative.
-// Not remedied (the new curve is shown at once): closed loops, changes before the first or after the last
-// common node (a wire's end node replaced), duplicate ids, a change of spline settings.
+// Not remedied (the new curve is shown at once): closed loops, a wire's end node replaced (nothing to anchor
+// on beyond it), duplicate ids, ids that change order, and a node count change when WireNodes::ids is empty
+// (nodes are then named by index). Cost per state: O(n) plus, per restarted run, O(run nodes^2) projections.
 #pragma once
 
 #include "wire/curve.hpp"

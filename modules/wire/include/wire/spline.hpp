@@ -27,8 +27,11 @@
 //              s = 0: chordal Catmull-Rom (with a quadratic "Bessel" end tangent instead of the phantom node).
 //              s > 0: the node tangent's direction blends toward (l_in^2 e_in + l_out^2 e_out) (the longer
 //              neighbour dominates, so a long straight run stays on its line) and both sides' magnitudes blend
-//              toward min(l_in, l_out) (a bend rounds within the short segment). Both sides keep one direction:
-//              G1 everywhere, C1 where s = 0. Tension (wire, node, curvature) applies as for catmull_rom.
+//              toward h = 0.5 min(l_in, l_out) (a bend rounds within the short segment, overshooting the node by
+//              at most (4/27) h), and h shrinks to a tenth between 1% and 5% stretch (a taut wire runs straight
+//              between its nodes). Both sides keep one direction: G1 everywhere (no tangent ever vanishes), C1
+//              where s = 0. Tension (wire, node, curvature) applies as for catmull_rom; bias/continuity do not.
+//              The thresholds (0.35..1.2 rad, 1..2% and 1..5% stretch, 0.5) are tunable constants in spline.cpp.
 // linear       b1, b2 at 1/3 and 2/3 of the chord.
 #pragma once
 
