@@ -18,6 +18,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "engine/gfx/debug.hpp"
 #include "engine/gfx/lit_renderer.hpp"
 #include "engine/platform/capture.hpp"
 #include "engine/platform/context.hpp"
@@ -631,6 +632,31 @@ TEST(WireRendererTest, HundredWiresBytesAndFrameTime) {
     EXPECT_EQ(cpu_stats.multi_draw_calls, 1u);
     EXPECT_GE(static_cast<double>(cpu_stats.bytes_uploaded),
               6.0 * static_cast<double>(gpu_stats.bytes_uploaded));
+}
+
+// The driver reports no error through KHR_debug for a debug context running both paths, growth included.
+TEST(WireRendererTest, NoDebugOutputErrors) {
+    auto context = platform::create_headless_context({.backend = platform::Backend::headless,
+                                                      .width = kWidth,
+                                                      .height = kHeight,
+                                                      .debug = true,
+                                                      .quiet = true});
+    ASSERT_TRUE(context.ok()) << context.error().message;
+    platform::Context& ctx = *context.value();
+    std::vector<std::string> errors;
+    engine::gfx::enable_debug_output(
+        {.min_severity = engine::gfx::DebugSeverity::low, .sink = [&](const engine::gfx::DebugMessage& m) {
+             if (m.type == "error" || m.severity == engine::gfx::DebugSeverity::high)
+                 errors.push_back(m.text);
+         }});
+    WireRenderer renderer = make_renderer({.region_bytes = 1024});
+    const Scene scene = test_scene();
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+        for (int frame = 0; frame < 4; ++frame) render(ctx, renderer, scene.list(path), scene_camera());
+        render(ctx, renderer, scene.list(path), scene_camera(), {.wireframe = true});
+    }
+    engine::gfx::disable_debug_output();
+    for (const std::string& e : errors) ADD_FAILURE() << e;
 }
 
 }  // namespace
