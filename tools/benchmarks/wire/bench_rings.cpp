@@ -117,6 +117,25 @@ void BM_RingsAndTube(benchmark::State& state) {
     report(state, s);
 }
 
+/// The same on the first 16 wires only (~6 MB of output, mostly cache-resident): the compute-bound rate.
+void BM_RingsAndTubeCacheResident(benchmark::State& state) {
+    Scene& s = scene();
+    constexpr int kFew = 16;
+    for (auto _ : state) {
+        for (int w = 0; w < kFew; ++w) {
+            s.rings(w);
+            s.tube(w);
+        }
+        benchmark::DoNotOptimize(s.vertices.data());
+        benchmark::ClobberMemory();
+    }
+    const auto vertices = static_cast<int64_t>(s.vertex_offset[kFew]);
+    const auto bytes = vertices * static_cast<int64_t>(sizeof(wire::TubeVertex)) +
+                       static_cast<int64_t>(s.index_offset[kFew] * sizeof(uint32_t));
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * vertices);
+    state.SetBytesProcessed(static_cast<int64_t>(state.iterations()) * bytes);
+}
+
 /// The same with non-temporal vertex stores (TubeSettings::streaming_stores), as for a mapped GPU arena.
 void BM_RingsAndTubeStreaming(benchmark::State& state) {
     Scene& s = scene();
@@ -171,6 +190,7 @@ void BM_MemsetSameBytes(benchmark::State& state) {
 }
 
 BENCHMARK(BM_RingsAndTube)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RingsAndTubeCacheResident)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RingsAndTubeStreaming)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RingsOnly)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TubeOnly)->ArgName("streaming")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
