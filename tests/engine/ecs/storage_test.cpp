@@ -174,5 +174,34 @@ TEST(StorageChanges, StampingWhileWalkingVisitsEachOnceAndDefersNewStamps) {
     for (const Entity e : es) EXPECT_EQ(s.get(e), 1);
 }
 
+struct Scratch {
+    int v = 0;
+};
+
+}  // namespace
+
+template <>
+inline constexpr bool track_changes_v<Scratch> = false;
+
+namespace {
+
+TEST(StorageChanges, UntrackedTypeStampsNothingButWorks) {
+    std::uint64_t clock = 0;
+    Storage<Scratch> s{&clock};
+    std::vector<Entity> es;
+    for (std::uint32_t i = 0; i < 10; ++i) {
+        es.push_back(make_entity(i, 0));
+        s.emplace(es.back(), static_cast<int>(i));
+    }
+    s.patch(es[3]).v = 30;
+    s.mark_changed(es[4]);
+    s.remove(es[0]);
+    EXPECT_EQ(clock, 0u) << "no stamps for an untracked type";
+    EXPECT_EQ(s.change_log_size(), 0u);
+    EXPECT_EQ(s.get(es[3]).v, 30);
+    EXPECT_EQ(s.get(es[9]).v, 9) << "swap-remove still moves components";
+    EXPECT_EQ(s.size(), 9u);
+}
+
 }  // namespace
 }  // namespace engine::ecs

@@ -16,6 +16,13 @@ namespace engine::ecs {
 template <class T>
 class Storage;
 
+// Whether stamps of T are recorded (true by default). A high-churn component that no system watches can opt
+// out, saving the per-component tick and the change log (16 B per stamp):
+//   template <> inline constexpr bool engine::ecs::track_changes_v<ScratchData> = false;
+// Stamping calls then do nothing, and changed<T>() / changed_tick() do not compile.
+template <class T>
+inline constexpr bool track_changes_v = true;
+
 // Entities whose T component was stamped (emplace, replace, patch, mark_changed) after tick `since` and up to
 // the clock value when the range was made; each entity at most once, in stamp order. Entities that lost the
 // component since are skipped. Stamping T while walking the range is allowed; those new stamps are outside
@@ -101,7 +108,7 @@ public:
         } else {
             components_.emplace_back(std::forward<Args>(args)...);
         }
-        ticks_.push_back(0);
+        if constexpr (track_changes_v<T>) ticks_.push_back(0);
         const std::size_t pos = push(e);
         stamp(pos);
         return components_[pos];
@@ -151,11 +158,17 @@ public:
     void mark_changed(Entity e) { stamp(index_of(e)); }
 
     // The tick of e's T's latest stamp. Asserts e has T.
-    [[nodiscard]] std::uint64_t changed_tick(Entity e) const noexcept { return ticks_[index_of(e)]; }
+    [[nodiscard]] std::uint64_t changed_tick(Entity e) const noexcept {
+        static_assert(track_changes_v<T>, "changed_tick: change tracking is off for this component type");
+        return ticks_[index_of(e)];
+    }
     // The clock's current value: every stamp so far has a tick <= clock(). A system stores it after running.
     [[nodiscard]] std::uint64_t clock() const noexcept { return *clock_; }
     // Entities whose T was stamped after `since`; cost is proportional to the stamps since then, not size().
-    [[nodiscard]] ChangedRange<T> changed(std::uint64_t since) const { return ChangedRange<T>{*this, since}; }
+    [[nodiscard]] ChangedRange<T> changed(std::uint64_t since) const {
+        static_assert(track_changes_v<T>, "changed: change tracking is off for this component type");
+        return ChangedRange<T>{*this, since};
+    }
 
     // Removes e's T if present, swapping the last component into its place. Returns whether it was present.
     bool remove(Entity e) final {
@@ -164,10 +177,10 @@ public:
         const std::size_t pos = found;
         if (pos + 1 != components_.size()) {
             components_[pos] = std::move(components_.back());
-            ticks_[pos] = ticks_.back();
+            if constexpr (track_changes_v<T>) ticks_[pos] = ticks_.back();
         }
         components_.pop_back();
-        ticks_.pop_back();
+        if constexpr (track_changes_v<T>) ticks_.pop_back();
         pop_swap(pos);
         return true;
     }
@@ -181,7 +194,7 @@ public:
     void reserve(std::size_t n) final {
         SparseSet::reserve(n);
         components_.reserve(n);
-        ticks_.reserve(n);
+        if constexpr (track_changes_v<T>) ticks_.reserve(n);
     }
 
     // Components in dense order (parallel to entities()).
@@ -201,18 +214,22 @@ private:
     };
 
     void stamp(std::size_t pos) {
-        const std::uint64_t t = ++*clock_;
-        const Entity e = at(pos);
-        // Dedupe: the same component stamped twice in a row keeps one log entry, moved to the new tick.
-        if (!log_.empty() && log_.back().entity == e && log_.back().tick == ticks_[pos]) {
-            log_.back().tick = t;
+        if constexpr (track_changes_v<T>) {
+            const std::uint64_t t = ++*clock_;
+            const Entity e = at(pos);
+            // Dedupe: the same component stamped twice in a row keeps one log entry, moved to the new tick.
+            if (!log_.empty() && log_.back().entity == e && log_.back().tick == ticks_[pos]) {
+                log_.back().tick = t;
+            } else {
+                log_.push_back({e, t});
+            }
+            ticks_[pos] = t;
+            // Superseded entries (component restamped or removed) are dropped once the log is twice the live
+            // size: each entity then has at most one entry, so the cost is amortized O(1) per stamp.
+            if (log_.size() >= 2 * size() + 64) compact_log();
         } else {
-            log_.push_back({e, t});
+            (void)pos;
         }
-        ticks_[pos] = t;
-        // Superseded entries (component restamped or removed) are dropped once the log is twice the live
-        // size: each entity then has at most one entry, so the cost is amortized O(1) per stamp.
-        if (log_.size() >= 2 * size() + 64) compact_log();
     }
     [[nodiscard]] bool log_entry_live(const LogEntry& le) const noexcept {
         const std::uint32_t pos = find(le.entity);
