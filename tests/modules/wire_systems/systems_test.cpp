@@ -363,6 +363,33 @@ TEST(WireSystems, InsertedNodeIsBlendedInWithoutAPop) {
     EXPECT_GT(rendered_jump_m(raw_before, raw.registry.get<WireCurve>(r).curve), 2.0 * worst_jump);
 }
 
+TEST(WireSystems, InsertAndRemoveNodeKeepArraysAndIds) {
+    World w;
+    WireNodes n = cable(6, {-1, 0, 0}, 2.0, 0.2);
+    n.stretch.assign(6, 1.0f);
+    n.radius_m = {0.01f, 0.02f, 0.03f, 0.04f, 0.05f, 0.06f};
+    const Entity e = spawn_wire(w.registry, n);
+    w.run();
+    const uint32_t id = insert_node(w.registry, e, 2, glm::dvec3(-0.4, -0.1, 0.0));
+    EXPECT_EQ(id, 6u);  // ids were implicit (0..5): made explicit, the new one is max + 1
+    const WireNodes& now = w.registry.get<Nodes>(e);
+    ASSERT_EQ(now.positions.size(), 7u);
+    EXPECT_EQ(now.ids, (std::vector<uint32_t>{0, 1, 6, 2, 3, 4, 5}));
+    EXPECT_EQ(now.stretch.size(), 7u);
+    EXPECT_EQ(now.radius_m.size(), 7u);
+    EXPECT_EQ(now.radius_m[2], 0.03f);
+    EXPECT_TRUE(now.kb_tension.empty());
+    w.run();
+    EXPECT_EQ(w.ctx.stats.curves_built, 1u);
+    EXPECT_EQ(wire_error(w.registry, e), nullptr);
+    remove_node(w.registry, e, 4);  // id 3
+    EXPECT_EQ(w.registry.get<Nodes>(e).ids, (std::vector<uint32_t>{0, 1, 6, 2, 4, 5}));
+    EXPECT_EQ(w.registry.get<Nodes>(e).radius_m.size(), 6u);
+    w.run();
+    EXPECT_EQ(wire_error(w.registry, e), nullptr);
+    EXPECT_EQ(w.ctx.draw_list.items.size(), 1u);
+}
+
 TEST(WireSystems, FirstFrameIsCarriedOver) {
     // The wire's first tangent sweeps through the world axes while it turns slowly: a re-seeded first normal
     // would jump; the carried one turns as little as the tangent does.
