@@ -62,13 +62,13 @@ Mirrors mirrors(const Sample& a, const Sample& b, double noise, glm::dvec3& w1, 
             return Mirrors::degenerate;
         }
     }
-    const glm::dvec3 tl = a.t - (2.0 / c1) * glm::dot(v1, a.t) * v1;
+    w1 = v1 * std::sqrt(2.0 / c1);
+    const glm::dvec3 tl = a.t - glm::dot(w1, a.t) * w1;  // t0 reflected: t0 - (2/c1)(v1.t0) v1
     const glm::dvec3 v2 = b.t - tl;
     const double c2 = glm::dot(v2, v2);
     if (c2 < 1e-20) {
         return Mirrors::degenerate;
     }
-    w1 = v1 * std::sqrt(2.0 / c1);
     w2 = v2 * std::sqrt(2.0 / c2);
     // Hairpin guard. c2 ~ 0: the tangent turns "the wrong way" within the step (a loop), the second mirror is
     // ill-conditioned. A turn of more than 45 degrees in one step (a hairpin under coarse sampling): the

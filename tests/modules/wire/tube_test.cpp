@@ -65,6 +65,24 @@ TEST(Tube, OpenWithCapsIsWatertightAndOutward) {
     }
 }
 
+// A cone (radius 0.1 -> 0.2 over 1 m): side normals tilt against the radius slope, n.t = -slope / sqrt(1 + slope^2).
+TEST(Tube, ConeNormalsTiltWithRadiusSlope) {
+    Curve cone = polyline_curve({{0, 0, 0}, {0, 0, 1}}, 0.1f);
+    cone.radius_m = {0.1f, 0.2f};
+    const RingSet set = rings_for(cone, 8);
+    EXPECT_NEAR(set.rings[4].radius_m, 0.15f, 1e-6f);  // two nodes: the monotone Hermite radius is linear
+    TubeMesh mesh;
+    build_tube(set, TubeSettings{.sides = 8, .caps = false}, mesh);
+    const double expected = -0.1 / std::sqrt(1.0 + 0.01);
+    for (const TubeVertex& v : mesh.vertices) {
+        EXPECT_NEAR(v.normal.z, expected, 1e-5);
+        EXPECT_NEAR(glm::length(v.normal), 1.0f, 1e-6f);
+    }
+    TubeMesh flat;
+    build_tube(set, TubeSettings{.sides = 8, .caps = false, .tilt_normals = false}, flat);
+    for (const TubeVertex& v : flat.vertices) EXPECT_NEAR(v.normal.z, 0.0f, 1e-7f);
+}
+
 TEST(Tube, WithoutCapsHasTwoOpenEnds) {
     const RingSet set = rings_for(helix_curve(1.0, 0.3, 1, 8), 2);
     TubeMesh mesh;

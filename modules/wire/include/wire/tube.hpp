@@ -13,7 +13,9 @@
 
 namespace wire {
 
-/// Interleaved float32 vertex, 32 bytes. Positions are relative to the wire's origin (RingSet::origin_m).
+/// Interleaved float32 vertex, 32 bytes. Positions are relative to the wire's origin (RingSet::origin_m), so they
+/// resolve about 6e-8 of the wire's extent wherever the wire is; a radius below a few of those (1e-6 m on a 100 m
+/// wire) collapses rings to points: the output stays finite, its triangles degenerate.
 struct TubeVertex {
     glm::vec3 position{};
     glm::vec3 normal{};
