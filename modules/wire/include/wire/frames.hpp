@@ -41,7 +41,7 @@ struct FrameSettings {
 struct FrameStats {
     double holonomy_rad = 0.0;         ///< closed wires: signed angle (about t0) of the transported frame after one loop
     uint32_t subdivided_steps = 0;     ///< steps the hairpin guard split
-    uint32_t degenerate_tangents = 0;  ///< rings whose derivative vanished (cusp, zero-length segment)
+    uint32_t degenerate_tangents = 0;  ///< rings with no tangent (on a one-point segment): took a neighbour's
     uint32_t fallback_steps = 0;       ///< steps that fell back to the rotation method (hairpin at max depth)
     bool seeded_from_previous = false; ///< first normal carried over from FrameSettings::previous_normal
 };
