@@ -3,6 +3,7 @@
 #include "wire/lod.hpp"
 
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
@@ -28,9 +29,25 @@ struct HullDepth {
     double k = 1.0;
 };
 
-HullDepth hull_depth(const CubicBezier& c, const LodView& view) {
-    const std::array<glm::dvec3, 4> p = {view.to_view(c.b0), view.to_view(c.b1), view.to_view(c.b2),
-                                         view.to_view(c.b3)};
+// A segment's four control points in view space (x right, y up, z depth).
+using ViewHull = std::array<glm::dvec3, 4>;
+
+// World -> view as a rotation and a translation (lookAt is rigid), taken once per wire.
+struct ViewTransform {
+    glm::dmat3 rotation;
+    glm::dvec3 translation;
+    explicit ViewTransform(const LodView& view)
+        : rotation(view.view_from_world), translation(view.view_from_world[3]) {}
+    [[nodiscard]] glm::dvec3 operator()(const glm::dvec3& p) const {
+        const glm::dvec3 q = rotation * p + translation;
+        return {q.x, q.y, -q.z};
+    }
+    [[nodiscard]] ViewHull hull(const CubicBezier& c) const {
+        return {(*this)(c.b0), (*this)(c.b1), (*this)(c.b2), (*this)(c.b3)};
+    }
+};
+
+HullDepth hull_depth(const ViewHull& p, const LodView& view) {
     double z_min = std::numeric_limits<double>::infinity();
     double a = 0.0;
     double b = 0.0;
@@ -57,26 +74,28 @@ HullDepth hull_depth(const CubicBezier& c, const LodView& view) {
     return h;
 }
 
-bool points_visible(std::span<const glm::dvec3> points, double radius_m, const LodView& view) {
-    if (points.empty()) return false;
-    for (const glm::dvec4& plane : view.planes) {
-        const glm::dvec3 n(plane);
-        bool all_outside = true;
-        for (const glm::dvec3& p : points) {
-            if (glm::dot(n, p) + plane.w >= -radius_m) {
-                all_outside = false;
-                break;
-            }
-        }
-        if (all_outside) return false;
+// The frustum planes in view space, tested against points inflated by a radius: bit i is set when the point is
+// farther than radius_m outside plane i (left, right, bottom, top, near, far: the planes of LodView::planes).
+struct PlaneTest {
+    double tx, ty, rx, ry, r, near, far;
+    PlaneTest(const LodView& view, double radius_m)
+        : tx(view.tan_half_x), ty(view.tan_half_y), rx(radius_m * std::sqrt(1.0 + tx * tx)),
+          ry(radius_m * std::sqrt(1.0 + ty * ty)), r(radius_m), near(view.near_m), far(view.far_m) {}
+    [[nodiscard]] unsigned outside(const glm::dvec3& q) const {
+        unsigned m = 0;
+        m |= (q.x + q.z * tx < -rx) ? 1u : 0u;
+        m |= (q.z * tx - q.x < -rx) ? 2u : 0u;
+        m |= (q.y + q.z * ty < -ry) ? 4u : 0u;
+        m |= (q.z * ty - q.y < -ry) ? 8u : 0u;
+        m |= (q.z - near < -r) ? 16u : 0u;
+        m |= (far - q.z < -r) ? 32u : 0u;
+        return m;
     }
-    return true;
-}
-
-bool segment_visible(const CubicBezier& c, double radius_m, const LodView& view) {
-    const std::array<glm::dvec3, 4> p = {c.b0, c.b1, c.b2, c.b3};
-    return points_visible(p, radius_m, view);
-}
+    // Planes that all four points are outside of (0: the inflated hull may meet the frustum).
+    [[nodiscard]] unsigned outside(const ViewHull& h) const {
+        return outside(h[0]) & outside(h[1]) & outside(h[2]) & outside(h[3]);
+    }
+};
 
 uint32_t wang_px(const CubicBezier& c, const HullDepth& h, const LodView& view, double tolerance_px,
                  uint32_t max_rings, bool* clamped) {
@@ -147,24 +166,19 @@ glm::dvec2 LodView::view_to_px(const glm::dvec3& view) const {
 
 bool hull_visible(std::span<const CubicBezier> segments, double radius_m, const LodView& view) {
     if (segments.empty()) return false;
-    for (const glm::dvec4& plane : view.planes) {
-        const glm::dvec3 n(plane);
-        bool all_outside = true;
-        for (const CubicBezier& c : segments) {
-            if (glm::dot(n, c.b0) + plane.w >= -radius_m || glm::dot(n, c.b1) + plane.w >= -radius_m ||
-                glm::dot(n, c.b2) + plane.w >= -radius_m || glm::dot(n, c.b3) + plane.w >= -radius_m) {
-                all_outside = false;
-                break;
-            }
-        }
-        if (all_outside) return false;
+    const ViewTransform tf(view);
+    const PlaneTest planes(view, radius_m);
+    unsigned all = 63u;
+    for (const CubicBezier& c : segments) {
+        all &= planes.outside(tf.hull(c));
+        if (all == 0) return true;
     }
-    return true;
+    return false;
 }
 
 uint32_t segment_ring_count_px(const CubicBezier& segment, const LodView& view, double tolerance_px,
                                uint32_t max_rings) {
-    return wang_px(segment, hull_depth(segment, view), view, tolerance_or_default(tolerance_px),
+    return wang_px(segment, hull_depth(ViewTransform(view).hull(segment), view), view, tolerance_or_default(tolerance_px),
                    max_rings ? max_rings : default_max_rings, nullptr);
 }
 
@@ -200,7 +214,22 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
     lod.clamped_segments = 0;
     lod.changed_counts = 0;
     lod.visible_segments = 0;
-    if (n == 0 || !hull_visible(curve.segments, radius, view)) {
+
+    // The hull test: every control point to view space once, the planes each segment's hull is entirely outside
+    // of, and their intersection over the wire (non-zero: the whole wire is outside one plane: culled).
+    thread_local std::vector<ViewHull> hulls;
+    thread_local std::vector<unsigned char> outside;
+    hulls.resize(n);
+    outside.resize(n);
+    const ViewTransform tf(view);
+    const PlaneTest planes(view, radius);
+    unsigned wire_outside = 63u;
+    for (std::size_t i = 0; i < n; ++i) {
+        hulls[i] = tf.hull(curve.segments[i]);
+        outside[i] = static_cast<unsigned char>(planes.outside(hulls[i]));
+        wire_outside &= outside[i];
+    }
+    if (n == 0 || wire_outside != 0) {
         const bool changed = lod.visible || !lod.counts.empty();
         lod.visible = false;
         lod.counts.clear();
@@ -222,9 +251,9 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
     for (std::size_t i = 0; i < n; ++i) {
         const CubicBezier& c = curve.segments[i];
         uint32_t raw = 1;
-        const bool seg_visible = segment_visible(c, radius, view);
+        const bool seg_visible = outside[i] == 0;
         if (seg_visible || !settings.coarse_offscreen_segments) {
-            const HullDepth h = hull_depth(c, view);
+            const HullDepth h = hull_depth(hulls[i], view);
             bool clamped = false;
             raw = wang_px(c, h, view, eps, max_rings, &clamped);
             lod.clamped_segments += clamped ? 1u : 0u;

@@ -423,6 +423,44 @@ TEST(LodCulling, CulledWireGetsNoRings) {
     EXPECT_TRUE(hull_visible(curve.segments, 0.0, orbit_camera(0.0, 3.0)));
 }
 
+// The culling runs in view space; it must agree with the world-space frustum planes of LodView.
+TEST(LodCulling, ViewSpaceTestAgreesWithWorldPlanes) {
+    Rng rng(17);
+    int visible = 0, culled = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const LodView view = LodView::perspective(random_unit(rng) * uniform(rng, 0.0, 5.0), random_unit(rng) * 3.0,
+                                                  glm::dvec3(0, 1, 0), kFov, kWidth, kHeight, 0.1, 20.0);
+        const glm::dvec3 base = random_unit(rng) * uniform(rng, 0.0, 25.0);
+        const double size = uniform(rng, 0.01, 2.0);
+        const CubicBezier c{base, base + random_unit(rng) * size, base + random_unit(rng) * size,
+                            base + random_unit(rng) * size};
+        const double r = uniform(rng, 0.0, 0.5);
+        bool expected = true;
+        for (const glm::dvec4& plane : view.planes) {
+            bool all_out = true;
+            for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
+                all_out = all_out && glm::dot(glm::dvec3(plane), p) + plane.w < -r;
+            }
+            if (all_out) expected = false;
+        }
+        const CubicBezier segs[] = {c};
+        const bool got = hull_visible(segs, r, view);
+        // Both are the same planes; allow disagreement only within rounding of a plane distance.
+        if (got != expected) {
+            double closest = std::numeric_limits<double>::infinity();
+            for (const glm::dvec4& plane : view.planes) {
+                for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
+                    closest = std::min(closest, std::abs(glm::dot(glm::dvec3(plane), p) + plane.w + r));
+                }
+            }
+            EXPECT_LT(closest, 1e-9) << "case " << i;
+        }
+        (got ? visible : culled) += 1;
+    }
+    EXPECT_GT(visible, 400);
+    EXPECT_GT(culled, 400);
+}
+
 TEST(LodCulling, OffscreenSegmentsAreCoarse) {
     // A long straight-ish cable passing beside and behind the camera: segments off screen get 1 ring.
     WireNodes nodes;

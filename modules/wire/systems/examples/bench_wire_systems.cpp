@@ -1,6 +1,9 @@
 // Informational benchmark of the wire systems: 1,000 hanging wires of 64 nodes seen by a moving camera at
 // 1920x1080, both upload paths, 1 and 2 threads; CPU ms per frame per system, counts, and the vertex count of
 // the adaptive LOD against a uniform tessellation with the same maximum screen error.
+// Each system is called directly (in install() order) so that both wall and process CPU time can be taken per
+// system: on a loaded machine wall time is inflated by other processes, CPU time is not (with 2 threads it is
+// the sum over both). An application reads the same wall times from Schedule::stats().
 // Usage: example_bench_wire_systems [frames=120] [wires=1000]
 #include "wire/systems/api.hpp"
 #include "wire/systems/systems.hpp"
@@ -11,6 +14,8 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -61,9 +66,35 @@ void place_camera(Scene& s, int frame) {
     s.ctx.camera.target = s.ctx.camera.position + glm::vec3(0.4f * std::sin(0.01f * t), -0.15f, -1.0f);
 }
 
+double cpu_ms() {  // CPU time of the whole process (all threads): robust against other load on the machine
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+double wall_ms() {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// One frame of the five systems in install() order, timed one by one (wall and CPU).
+void run_frame(Scene& s, uint64_t& since, std::vector<double>& wall, std::vector<double>& cpu) {
+    using namespace wire::systems;
+    auto timed = [&](std::size_t i, auto&& fn) {
+        const double w0 = wall_ms(), c0 = cpu_ms();
+        fn();
+        wall[i] += wall_ms() - w0;
+        cpu[i] += cpu_ms() - c0;
+    };
+    timed(0, [&] { curve_system(s.registry, s.ctx, since); });
+    since = s.registry.tick();
+    timed(1, [&] { lod_system(s.registry, s.ctx); });
+    timed(2, [&] { rings_system(s.registry, s.ctx); });
+    timed(3, [&] { mesh_system(s.registry, s.ctx); });
+    timed(4, [&] { draw_list_system(s.registry, s.ctx); });
+}
+
 struct Timing {
-    std::vector<double> sum_ms;
-    double frame_ms = 0.0;
+    std::vector<double> sum_ms, cpu_ms;
+    double frame_ms = 0.0, frame_cpu_ms = 0.0;
     double first_frame_ms = 0.0;
     wire::systems::FrameStats last{};
     double mean_visible = 0, mean_rings = 0, mean_vertices = 0;
@@ -74,7 +105,10 @@ Timing run(int threads, wire::UploadPath path, int frames, int count, bool movin
     Scene s;
     build(s, count, path);
     Timing t;
-    t.sum_ms.assign(s.schedule.size(), 0.0);
+    t.sum_ms.assign(5, 0.0);
+    t.cpu_ms.assign(5, 0.0);
+    uint64_t since = 0;
+    std::vector<double> wall(5), cpu(5);
     for (int f = 0; f < frames; ++f) {
         place_camera(s, f);
         if (moving_nodes && f > 0) {
@@ -86,20 +120,28 @@ Timing run(int threads, wire::UploadPath path, int frames, int count, bool movin
                 }
             }
         }
-        s.schedule.run(s.registry, 1.0 / 60.0);
+        std::fill(wall.begin(), wall.end(), 0.0);
+        std::fill(cpu.begin(), cpu.end(), 0.0);
+        run_frame(s, since, wall, cpu);
         if (f == 0) {
-            t.first_frame_ms = s.schedule.last_frame_ms();
+            for (double v : wall) t.first_frame_ms += v;
             continue;
         }
-        for (std::size_t i = 0; i < s.schedule.size(); ++i) t.sum_ms[i] += s.schedule.stats()[i].last_ms;
-        t.frame_ms += s.schedule.last_frame_ms();
+        for (std::size_t i = 0; i < 5; ++i) {
+            t.sum_ms[i] += wall[i];
+            t.cpu_ms[i] += cpu[i];
+            t.frame_ms += wall[i];
+            t.frame_cpu_ms += cpu[i];
+        }
         t.mean_visible += static_cast<double>(s.ctx.stats.visible_wires);
         t.mean_rings += static_cast<double>(s.ctx.stats.rings);
         t.mean_vertices += static_cast<double>(s.ctx.stats.vertices);
     }
     const double n = frames - 1;
     for (double& v : t.sum_ms) v /= n;
+    for (double& v : t.cpu_ms) v /= n;
     t.frame_ms /= n;
+    t.frame_cpu_ms /= n;
     t.mean_visible /= n;
     t.mean_rings /= n;
     t.mean_vertices /= n;
@@ -172,12 +214,12 @@ int main(int argc, char** argv) {
         for (wire::UploadPath path : {wire::UploadPath::cpu_mesh, wire::UploadPath::gpu_rings}) {
             for (int threads : {1, 2}) {
                 const Timing t = run(threads, path, frames, count, moving);
-                std::printf("%-9s %-14s %d thread%s: frame %.2f ms (first %.1f ms) |",
+                std::printf("%-9s %-13s %d thr: wall %6.2f ms, cpu %6.2f ms (first frame wall %.1f) | wall/cpu:",
                             path == wire::UploadPath::cpu_mesh ? "cpu_mesh" : "gpu_rings",
-                            moving ? "nodes moving" : "nodes at rest", threads, threads == 1 ? " " : "s",
-                            t.frame_ms, t.first_frame_ms);
+                            moving ? "nodes moving" : "nodes at rest", threads, t.frame_ms, t.frame_cpu_ms,
+                            t.first_frame_ms);
                 const char* names[] = {"curve", "lod", "rings", "mesh", "draw"};
-                for (std::size_t i = 0; i < t.sum_ms.size(); ++i) std::printf(" %s %.2f", names[i], t.sum_ms[i]);
+                for (std::size_t i = 0; i < 5; ++i) std::printf(" %s %.2f/%.2f", names[i], t.sum_ms[i], t.cpu_ms[i]);
                 std::printf(" | visible %.0f, rings %.0f, vertices %.0f\n", t.mean_visible, t.mean_rings,
                             t.mean_vertices);
             }

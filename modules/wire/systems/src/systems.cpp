@@ -6,6 +6,8 @@
 #include "wire/systems/components.hpp"
 #include "wire/systems/view.hpp"
 
+#include "wire/spline.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -121,13 +123,31 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             c.spline = spline;
             c.geomorph = pop_free;
         }
+        const WireNodes& nodes = *job.nodes;
+        const WireNodes& prev = c.previous_nodes;
+        const bool same_ids = c.generation > 0 && !c.blending && nodes.ids == prev.ids &&
+                              (!nodes.ids.empty() || nodes.size() == prev.size());
+        if (!pop_free || same_ids) {
+            // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
+            job.status = build_curve(nodes, spline, c.scratch);
+            if (job.status.ok) std::swap(c.curve, c.scratch);
+            c.multires_stale = true;
+        } else {
+            if (c.multires_stale) {
+                // Re-prime the pop-free state with the last valid nodes (what is on screen now), then step.
+                c.multires.reset();
+                (void)c.multires.update(prev, c.scratch);
+                c.multires_stale = false;
+            }
+            job.status = c.multires.update(nodes, c.curve);
+        }
         ++c.builds;
-        job.status = c.multires.update(*job.nodes, c.curve);
         if (job.status.ok) {
             ++c.generation;
             job.changed = true;
+            c.previous_nodes = nodes;
         }
-        c.blending = job.status.ok && c.multires.blending();
+        c.blending = job.status.ok && !c.multires_stale && c.multires.blending();
     });
 
     // Serial, in entity order: errors (reported once per distinct message), work lists.

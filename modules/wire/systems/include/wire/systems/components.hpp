@@ -40,6 +40,12 @@ struct WireCurve {
     uint64_t builds = 0;               ///< times the curve stage ran for this wire (test/statistics counter)
     bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
     bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
+    // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
+    // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
+    // `previous_nodes` (the last valid state) when the ids change.
+    WireNodes previous_nodes;
+    Curve scratch;
+    bool multires_stale = false;
 };
 
 /// LOD stage: visibility, per-segment ring counts and sides for the context's camera.
