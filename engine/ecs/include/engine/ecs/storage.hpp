@@ -1,5 +1,6 @@
 // Component storage: a sparse set of entities with the components packed in the same dense order, plus
-// per-component change ticks and a change log so systems can visit only what changed since they last ran.
+// a change log (stamps sorted by tick, one live entry per component) so systems can visit only what changed
+// since they last ran.
 #pragma once
 
 #include <engine/ecs/sparse_set.hpp>
@@ -17,7 +18,7 @@ template <class T>
 class Storage;
 
 // Whether stamps of T are recorded (true by default). A high-churn component that no system watches can opt
-// out, saving the per-component tick and the change log (16 B per stamp):
+// out, saving the per-component log index and the change log (16 B per stamp):
 //   template <> inline constexpr bool engine::ecs::track_changes_v<ScratchData> = false;
 // Stamping calls then do nothing, and changed<T>() / changed_tick() do not compile.
 template <class T>
@@ -61,8 +62,8 @@ public:
         [[nodiscard]] bool done() const noexcept { return s_ == nullptr; }
         void settle() {
             for (; pos_ < s_->log_.size() && s_->log_[pos_].tick <= end_tick_; ++pos_) {
-                if (s_->log_entry_live(s_->log_[pos_])) {
-                    entity_ = s_->log_[pos_].entity;
+                if (s_->log_[pos_].pos != SparseSet::npos) {
+                    entity_ = s_->at(s_->log_[pos_].pos);
                     tick_ = s_->log_[pos_].tick;
                     return;
                 }
@@ -108,7 +109,7 @@ public:
         } else {
             components_.emplace_back(std::forward<Args>(args)...);
         }
-        if constexpr (track_changes_v<T>) ticks_.push_back(0);
+        if constexpr (track_changes_v<T>) log_pos_.push_back(npos);
         const std::size_t pos = push(e);
         stamp(pos);
         return components_[pos];
@@ -160,7 +161,7 @@ public:
     // The tick of e's T's latest stamp. Asserts e has T.
     [[nodiscard]] std::uint64_t changed_tick(Entity e) const noexcept {
         static_assert(track_changes_v<T>, "changed_tick: change tracking is off for this component type");
-        return ticks_[index_of(e)];
+        return log_[log_pos_[index_of(e)]].tick;
     }
     // The clock's current value: every stamp so far has a tick <= clock(). A system stores it after running.
     [[nodiscard]] std::uint64_t clock() const noexcept { return *clock_; }
@@ -177,24 +178,31 @@ public:
         const std::size_t pos = found;
         if (pos + 1 != components_.size()) {
             components_[pos] = std::move(components_.back());
-            if constexpr (track_changes_v<T>) ticks_[pos] = ticks_.back();
+        }
+        if constexpr (track_changes_v<T>) {
+            // The removed component's log entry dies; the moved one's entry follows it to `pos`.
+            log_[log_pos_[pos]].pos = npos;
+            if (pos + 1 != log_pos_.size()) {
+                log_pos_[pos] = log_pos_.back();
+                log_[log_pos_[pos]].pos = static_cast<std::uint32_t>(pos);
+            }
+            log_pos_.pop_back();
         }
         components_.pop_back();
-        if constexpr (track_changes_v<T>) ticks_.pop_back();
         pop_swap(pos);
         return true;
     }
     void clear() final {
         SparseSet::clear();
         components_.clear();
-        ticks_.clear();
+        log_pos_.clear();
         log_.clear();
         ++log_generation_;
     }
     void reserve(std::size_t n) final {
         SparseSet::reserve(n);
         components_.reserve(n);
-        if constexpr (track_changes_v<T>) ticks_.reserve(n);
+        if constexpr (track_changes_v<T>) log_pos_.reserve(n);
     }
 
     // Components in dense order (parallel to entities()).
@@ -208,32 +216,31 @@ public:
 
 private:
     friend class ChangedRange<T>;
+    // One stamp: the dense position of the component it stamped (kept up to date by swap-remove), or npos
+    // once superseded by a newer stamp or by removal.
     struct LogEntry {
-        Entity entity;
+        std::uint32_t pos;
         std::uint64_t tick;
     };
 
     void stamp(std::size_t pos) {
         if constexpr (track_changes_v<T>) {
             const std::uint64_t t = ++*clock_;
-            const Entity e = at(pos);
-            // Dedupe: the same component stamped twice in a row keeps one log entry, moved to the new tick.
-            if (!log_.empty() && log_.back().entity == e && log_.back().tick == ticks_[pos]) {
-                log_.back().tick = t;
-            } else {
-                log_.push_back({e, t});
+            const std::uint32_t old = log_pos_[pos];
+            // Dedupe: a component whose entry is the newest just moves that entry to the new tick.
+            if (old != npos && old + 1 == log_.size()) {
+                log_[old].tick = t;
+                return;
             }
-            ticks_[pos] = t;
-            // Superseded entries (component restamped or removed) are dropped once the log is twice the live
-            // size: each entity then has at most one entry, so the cost is amortized O(1) per stamp.
+            if (old != npos) log_[old].pos = npos;
+            log_pos_[pos] = static_cast<std::uint32_t>(log_.size());
+            log_.push_back({static_cast<std::uint32_t>(pos), t});
+            // Superseded entries are dropped once the log is twice the live size (each component has
+            // exactly one live entry), so the cost is amortized O(1) per stamp. The scan is sequential.
             if (log_.size() >= 2 * size() + 64) compact_log();
         } else {
             (void)pos;
         }
-    }
-    [[nodiscard]] bool log_entry_live(const LogEntry& le) const noexcept {
-        const std::uint32_t pos = find(le.entity);
-        return pos != npos && ticks_[pos] == le.tick;
     }
     // First log position whose tick is >= tick (the log is sorted by tick).
     [[nodiscard]] std::size_t log_lower_bound(std::uint64_t tick) const noexcept {
@@ -243,12 +250,18 @@ private:
             log_.begin());
     }
     void compact_log() {
-        std::erase_if(log_, [this](const LogEntry& le) { return !log_entry_live(le); });
+        std::size_t w = 0;
+        for (const LogEntry& le : log_) {
+            if (le.pos == npos) continue;
+            log_pos_[le.pos] = static_cast<std::uint32_t>(w);
+            log_[w++] = le;
+        }
+        log_.resize(w);
         ++log_generation_;
     }
 
     std::vector<T> components_;
-    std::vector<std::uint64_t> ticks_;
+    std::vector<std::uint32_t> log_pos_;  // per dense component: index of its live log entry
     std::vector<LogEntry> log_;
     std::uint64_t log_generation_ = 0;
     std::uint64_t own_clock_ = 0;
