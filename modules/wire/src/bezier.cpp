@@ -52,28 +52,45 @@ double directed_distance(const std::vector<glm::dvec3>& from, const std::vector<
         for (const glm::dvec3& p : from) worst2 = std::max(worst2, glm::dot(p - to[0], p - to[0]));
         return std::sqrt(worst2);
     }
-    // Exact, but fast on curves that follow each other: scan outward from the previous point's nearest piece and
-    // stop as soon as this point cannot raise the maximum.
-    const std::size_t pieces = to.size() - 1;
+    // Exact, with pruning: pieces are grouped in blocks with bounding spheres; blocks are visited outward from
+    // the block that held the previous point's nearest piece, skipped when their sphere is farther than the
+    // best distance so far, and the scan stops once this point cannot raise the maximum.
+    constexpr std::size_t kBlock = 16;
+    const std::size_t pieces = to.size() - 1, blocks = (pieces + kBlock - 1) / kBlock;
+    std::vector<glm::dvec3> centre(blocks);
+    std::vector<double> radius(blocks);
+    for (std::size_t b = 0; b < blocks; ++b) {
+        const std::size_t first = b * kBlock, last = std::min(pieces, first + kBlock);  // points first..last
+        glm::dvec3 lo = to[first], hi = to[first];
+        for (std::size_t i = first; i <= last; ++i) lo = glm::min(lo, to[i]), hi = glm::max(hi, to[i]);
+        centre[b] = 0.5 * (lo + hi);
+        radius[b] = 0.5 * glm::length(hi - lo);
+    }
     std::size_t hint = 0;
     for (const glm::dvec3& p : from) {
         double best2 = std::numeric_limits<double>::infinity();
-        std::size_t best_i = hint;
-        for (std::size_t step = 0; step < 2 * pieces; ++step) {
+        std::size_t best_block = hint;
+        bool done = false;
+        for (std::size_t step = 0; step < 2 * blocks && !done; ++step) {
             const std::size_t off = (step + 1) / 2;
-            std::size_t i;
+            std::size_t b;
             if (step % 2 == 0) {
-                if (hint + off >= pieces) continue;
-                i = hint + off;
+                if (hint + off >= blocks) continue;
+                b = hint + off;
             } else {
                 if (off > hint) continue;
-                i = hint - off;
+                b = hint - off;
             }
-            const double d2 = point_segment_distance2(p, to[i], to[i + 1]);
-            if (d2 < best2) best2 = d2, best_i = i;
-            if (best2 <= worst2) break;  // cannot raise the maximum any more
+            const double lb = std::max(0.0, glm::length(p - centre[b]) - radius[b]);
+            if (lb * lb >= best2) continue;
+            const std::size_t first = b * kBlock, last = std::min(pieces, first + kBlock);
+            for (std::size_t i = first; i < last; ++i) {
+                const double d2 = point_segment_distance2(p, to[i], to[i + 1]);
+                if (d2 < best2) best2 = d2, best_block = b;
+            }
+            done = best2 <= worst2;  // cannot raise the maximum any more
         }
-        hint = best_i;
+        hint = best_block;
         worst2 = std::max(worst2, best2);
     }
     return std::sqrt(worst2);

@@ -39,10 +39,19 @@ struct Chain {
         if (k >= count) k = count - 1;
         return sub_segment(seg[k], p0 - static_cast<double>(k), std::min(1.0, p1 - static_cast<double>(k)));
     }
-    // Chain parameter of the point nearest to p, strictly inside (0, count) or -1 if it lands on an end.
+    // Chain parameter of the point nearest to p. Segments are visited by a lower bound on their distance (each
+    // lies inside the bounding sphere of its control points) and skipped once that bound exceeds the best.
     [[nodiscard]] double project(const dvec3& p) const {
-        double best = std::numeric_limits<double>::infinity(), best_param = -1.0;
+        std::vector<std::pair<double, std::size_t>> order(count);
         for (std::size_t k = 0; k < count; ++k) {
+            const CubicBezier& c = seg[k];
+            const dvec3 lo = glm::min(glm::min(c.b0, c.b1), glm::min(c.b2, c.b3)), hi = glm::max(glm::max(c.b0, c.b1), glm::max(c.b2, c.b3));
+            order[k] = {std::max(0.0, glm::length(p - 0.5 * (lo + hi)) - 0.5 * glm::length(hi - lo)), k};
+        }
+        std::sort(order.begin(), order.end());
+        double best = std::numeric_limits<double>::infinity(), best_param = -1.0;
+        for (const auto& [bound, k] : order) {
+            if (bound >= best) break;
             const double u = closest_parameter(seg[k], p);
             const double d = glm::length(position(seg[k], u) - p);
             if (d < best) best = d, best_param = static_cast<double>(k) + u;

@@ -203,7 +203,7 @@ TEST(WireCurveContinuity, CatmullRomIsC1ForAnyAlphaAndC2IsC2) {
     for (double alpha : {0.0, 0.25, 0.5, 1.0, 1.5}) {
         for (bool closed : {false, true}) {
             Curve c;
-            ASSERT_TRUE(build_curve(n, {.alpha = alpha, .tension = 0.3, .closed = closed}, c).ok);
+            ASSERT_TRUE(build_curve(n, {.alpha = alpha, .tension = 0.3, .bias = 0.2, .closed = closed}, c).ok);
             expect_valid_interpolating(c, n, "cr");
             EXPECT_LT(max_c1_mismatch(c, alpha), 1e-9) << "alpha " << alpha << " closed " << closed;
         }

@@ -15,8 +15,8 @@
 //              give the true centripetal limit (tangent -> 0), never 0/0. Open ends: phantom P[-1] = 2P[0]-P[1].
 //              Tension t = 1 - (1 - t_wire_or_node) * (1 - t_curvature); the thesis' t_curvature = 0 for R > 100,
 //              else 1 - tanh(R/50) (note: that formula steps from 0.036 to 0 at R = 100, as published).
-//              C1 for |c| = 0 and t < 1 (tension scales both sides of a node alike, so the knot-ratio C1
-//              condition still holds); t = 1 gives a corner, c != 0 a deliberate kink.
+//              C1 for c = 0, any bias, t < 1 (tension and bias scale both sides of a node alike, so the
+//              knot-ratio C1 condition still holds); t = 1 gives a corner, c != 0 a deliberate kink.
 // c2           Chordal knots; tangents from the global C2 system (rows normalized, diagonally dominant,
 //              Thomas algorithm O(n)); open ends not-a-knot (O(h^4) on smooth sag, where natural ends force
 //              zero curvature that a hanging cable does not have); 3 nodes: the interpolating parabola;
@@ -29,8 +29,9 @@
 //              neighbour dominates, so a long straight run stays on its line) and both sides' magnitudes blend
 //              toward h = 0.5 min(l_in, l_out) (a bend rounds within the short segment, overshooting the node by
 //              at most (4/27) h), and h shrinks to a tenth between 1% and 5% stretch (a taut wire runs straight
-//              between its nodes). Both sides keep one direction: G1 everywhere (no tangent ever vanishes), C1
-//              where s = 0. Tension (wire, node, curvature) applies as for catmull_rom; bias/continuity do not.
+//              between its nodes). Both sides keep one direction: G1 everywhere (no tangent vanishes unless
+//              tension reaches 1), C1 where s = 0. Tension (wire, node, curvature) applies as for catmull_rom;
+//              bias and continuity do not.
 //              The thresholds (0.35..1.2 rad, 1..2% and 1..5% stretch, 0.5) are tunable constants in spline.cpp.
 // linear       b1, b2 at 1/3 and 2/3 of the chord.
 #pragma once
