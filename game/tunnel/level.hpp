@@ -1,0 +1,152 @@
+// The tunnel level: a chain of curved-space segments whose bends animate slowly, the tunnel pieces
+// (wall, ribs, walkway, cable hooks) instanced along it and bent on the GPU at the subdivision level each piece
+// needs, cables fixed along the bent walls, hanging cables simulated as ropes that refine and coarsen
+// themselves, and a camera flying along the bent centre line. Everything runs as named systems of one
+// engine::ecs::Schedule (timed per system):
+//   tunnel.animate  segment angles at time t -> Chain; fly camera; wire context camera/viewport
+//   tunnel.ropes    rope ends on the bent anchors, Verlet/PBD step, node insertion/removal
+//   tunnel.cables   wall cables (bent by the CPU transform) and rope nodes -> wire entities
+//   wire.curve .. wire.draw_list   (wire::systems::install)
+//   tunnel.pieces   clear, per-piece subdivision level, bent instanced pieces (GL)
+//   wire.render     WireRenderer draws the frame's DrawList (GL)
+// Needs a current GL 4.5 context (engine::platform::Context) for create() and frame().
+#pragma once
+
+#include "tunnel/rope.hpp"
+
+#include <curved_space/chain.hpp>
+#include <engine/ecs/entity.hpp>
+#include <engine/ecs/schedule.hpp>
+#include <engine/platform/expected.hpp>
+#include <engine/scene/camera.hpp>
+#include <wire/draw.hpp>
+#include <wire/nodes.hpp>
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tunnel {
+
+using engine::platform::Error;
+using engine::platform::Expected;
+
+/// Fixed at creation. Zero means default.
+struct LevelSettings {
+    int pieces = 0;                  ///< tunnel pieces of 4 m (= curved-space segments); 0 -> 16
+    uint32_t seed = 0;               ///< phases of the bend animation; 0 -> 1
+    double bend_scale = 0.0;         ///< multiplies the base bend angles; 0 -> 1
+    std::string asset_dir{};         ///< folder of straight_section.glb, wall_details.glb, cable_hooks.glb,
+                                     ///< anchors.json; empty -> the repository's assets/tunnel
+    int max_subdivision_level = -1;  ///< highest refinement level cached; -1 -> 3
+    double prewarm_s = 0.0;          ///< rope simulation before frame 0 (settles the cables); 0 -> 3 s
+};
+
+enum class CameraMode { fly, free };
+
+/// Changeable at run time (debug panel).
+struct LevelOptions {
+    wire::SplineKind spline = wire::SplineKind::catmull_rom;
+    double lod_tolerance_px = 0.5;
+    wire::UploadPath upload_path = wire::UploadPath::cpu_mesh;
+    bool wireframe = false;
+    bool pop_free = true;
+    bool animate_bends = true;
+    bool simulate_ropes = true;
+    bool adapt_ropes = true;        ///< node insertion/removal on the hanging cables
+    bool draw_pieces = true;
+    bool draw_wires = true;
+    double subdivision_tolerance_px = 1.0;
+    int max_subdivision_level = 3;  ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
+    double flight_speed_mps = 2.5;
+    CameraMode camera_mode = CameraMode::fly;
+};
+
+/// Counts and costs of one frame.
+struct LevelFrameStats {
+    uint64_t frame = 0;
+    double time_s = 0.0;
+    std::size_t wires = 0;
+    std::size_t wires_drawn = 0;       ///< draw items the wire renderer drew
+    std::size_t wire_vertices = 0;     ///< cpu_mesh: uploaded; gpu_rings: expanded by the vertex shader
+    std::size_t wire_triangles = 0;
+    std::size_t wire_bytes_uploaded = 0;
+    std::size_t segment_bytes_uploaded = 0;  ///< curved-space segment records (SSBO)
+    std::size_t piece_triangles = 0;   ///< tunnel triangles drawn
+    std::size_t piece_vertices = 0;    ///< tunnel vertices drawn (bent by the vertex shader)
+    std::size_t rope_nodes = 0;        ///< nodes of all hanging cables
+    int nodes_inserted = 0;            ///< by the rope adaptation this frame
+    int nodes_removed = 0;
+    std::array<int, 8> piece_levels{};  ///< pieces per subdivision level (wall)
+    std::size_t curves_built = 0;
+    std::size_t rings = 0;
+};
+
+/// A cable of the level, for tests and the debug panel.
+struct CableInfo {
+    engine::ecs::Entity entity{};
+    bool hanging = false;  ///< rope-simulated (else fixed along the wall)
+    int rope = -1;         ///< index into the ropes when hanging
+    uint32_t material = 0;
+    float radius_m = 0.0f;
+};
+
+class Level {
+public:
+    /// Loads the pieces, refines and uploads the cached subdivision levels, compiles the shaders, spawns the
+    /// cables and pre-simulates the ropes. Errors name the file or shader that failed.
+    static Expected<std::unique_ptr<Level>> create(const LevelSettings& settings = {});
+    ~Level();
+    Level(const Level&) = delete;
+    Level& operator=(const Level&) = delete;
+
+    /// Framebuffer size the frame is rendered at (camera aspect, LOD).
+    void set_viewport(int width_px, int height_px);
+    /// Advances by dt_s (use a fixed step for reproducible images) and renders into the bound framebuffer.
+    void frame(double dt_s);
+    /// Renders the current state again without advancing (e.g. after toggling draw_wires).
+    void render();
+
+    LevelOptions& options() { return options_; }
+    /// The camera of the last frame; in CameraMode::free the game moves it.
+    engine::scene::Camera& camera() { return camera_; }
+    [[nodiscard]] const curved_space::Chain& chain() const { return chain_; }
+    [[nodiscard]] const LevelFrameStats& stats() const { return stats_; }
+    [[nodiscard]] std::span<const engine::ecs::SystemStats> system_stats() const { return schedule_.stats(); }
+    [[nodiscard]] const std::vector<CableInfo>& cables() const { return cables_; }
+    [[nodiscard]] const std::vector<Rope>& ropes() const { return ropes_; }
+    /// The nodes the wire systems currently hold for a cable.
+    [[nodiscard]] const wire::WireNodes& cable_nodes(std::size_t cable) const;
+    /// Bent world position of an anchor of piece `piece` (anchor index as in anchors.json).
+    [[nodiscard]] glm::dvec3 anchor_world(int piece, std::size_t anchor) const;
+    [[nodiscard]] int piece_count() const;
+    [[nodiscard]] double piece_length_m() const;
+    /// The tunnel wall radius (m) of the pieces.
+    [[nodiscard]] double wall_radius_m() const;
+
+private:
+    struct State;
+    Level();
+    void animate(double time_s);
+    void update_ropes(double dt_s);
+    void update_cables();
+    void draw_pieces();
+    void draw_wires();
+    void apply_options();
+
+    std::unique_ptr<State> state_;
+    LevelOptions options_{};
+    LevelOptions applied_{};
+    engine::scene::Camera camera_{};
+    curved_space::Chain chain_{};
+    engine::ecs::Schedule schedule_{};
+    LevelFrameStats stats_{};
+    std::vector<CableInfo> cables_;
+    std::vector<Rope> ropes_;
+};
+
+}  // namespace tunnel

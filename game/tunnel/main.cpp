@@ -1,0 +1,262 @@
+// build/bin/tunnel: the tunnel level. In a window: fly-through (Tab: free camera), debug panel, F12 screenshot.
+// Headless (--headless, or automatically without a display): renders N frames at a fixed step, writes PNGs of
+// chosen frames and DIR/stats.json (see tunnel/stats_json.hpp).
+//   tunnel [--headless] [--frames N] [--out DIR] [--capture-every K] [--width W] [--height H]
+#include "tunnel/debug_ui.hpp"
+#include "tunnel/level.hpp"
+#include "tunnel/stats_json.hpp"
+
+#include <engine/platform/capture.hpp>
+#include <engine/platform/context.hpp>
+
+#include <CLI/CLI.hpp>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace platform = engine::platform;
+
+struct Args {
+    bool headless = false;
+    int frames = 120;
+    std::string out = "out/tunnel";
+    int capture_every = 0;
+    int width = 1280;
+    int height = 720;
+    double dt_s = 1.0 / 30.0;
+    int pieces = 16;
+    uint32_t seed = 1;
+    std::string path = "cpu";
+    std::string spline = "catmull-rom";
+    double lod_tolerance_px = 0.5;
+    bool wireframe = false;
+};
+
+std::string frame_png(const std::string& dir, uint64_t frame) {
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%04llu.png", static_cast<unsigned long long>(frame));
+    return (std::filesystem::path(dir) / name).string();
+}
+
+// Mouse-look and WASD camera (right mouse button held to look; Q/E down/up; shift: faster).
+struct FreeCamera {
+    glm::vec3 position{0.0f};
+    float yaw = 0.0f;
+    float pitch = 0.0f;
+
+    void take(const engine::scene::Camera& c) {
+        position = c.position;
+        const glm::vec3 f = glm::normalize(c.target - c.position);
+        pitch = std::asin(glm::clamp(f.y, -1.0f, 1.0f));
+        yaw = std::atan2(f.x, -f.z);
+    }
+    void update(const platform::Input& in, double dt, bool mouse_free, bool keys_free, engine::scene::Camera& c) {
+        if (mouse_free && in.down(platform::MouseButton::right)) {
+            yaw += 0.003f * static_cast<float>(in.mouse_dx_px);
+            pitch = glm::clamp(pitch - 0.003f * static_cast<float>(in.mouse_dy_px), -1.5f, 1.5f);
+        }
+        const glm::vec3 f(std::cos(pitch) * std::sin(yaw), std::sin(pitch), -std::cos(pitch) * std::cos(yaw));
+        const glm::vec3 r = glm::normalize(glm::cross(f, glm::vec3(0, 1, 0)));
+        if (keys_free) {
+            const float speed = (in.down(platform::Key::left_shift) ? 12.0f : 3.0f) * static_cast<float>(dt);
+            using K = platform::Key;
+            if (in.down(K::w) || in.down(K::up)) position += f * speed;
+            if (in.down(K::s) || in.down(K::down)) position -= f * speed;
+            if (in.down(K::d) || in.down(K::right)) position += r * speed;
+            if (in.down(K::a) || in.down(K::left)) position -= r * speed;
+            if (in.down(K::e)) position.y += speed;
+            if (in.down(K::q)) position.y -= speed;
+        }
+        c.position = position;
+        c.target = position + f;
+        c.up = {0.0f, 1.0f, 0.0f};
+    }
+};
+
+int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args) {
+    std::set<int> capture = {0, args.frames / 2, args.frames - 1};
+    if (args.capture_every > 0)
+        for (int f = 0; f < args.frames; f += args.capture_every) capture.insert(f);
+    std::filesystem::create_directories(args.out);
+    nlohmann::json frames = nlohmann::json::array();
+    int non_finite = 0;
+    std::vector<std::string> written;
+    int inserted = 0;
+    int removed = 0;
+    double frame_ms_sum = 0.0;
+    for (int f = 0; f < args.frames; ++f) {
+        ctx.begin_frame();
+        const auto start = std::chrono::steady_clock::now();
+        level.frame(args.dt_s);
+        frame_ms_sum += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        frames.push_back(tunnel::frame_record(level.stats(), level.system_stats(), non_finite));
+        inserted += level.stats().nodes_inserted;
+        removed += level.stats().nodes_removed;
+        if (capture.count(f) != 0) {
+            const std::string path = frame_png(args.out, static_cast<uint64_t>(f));
+            if (auto s = platform::capture_png(ctx, path); !s) {
+                std::fprintf(stderr, "tunnel: %s\n", s.error().message.c_str());
+                return 1;
+            }
+            written.push_back(path);
+        }
+        ctx.end_frame();
+    }
+    nlohmann::json mean = nlohmann::json::object();
+    nlohmann::json max = nlohmann::json::object();
+    for (const engine::ecs::SystemStats& st : level.system_stats()) {
+        mean[st.name] = std::isfinite(st.mean_ms) ? st.mean_ms : -1.0;
+        max[st.name] = std::isfinite(st.max_ms) ? st.max_ms : -1.0;
+    }
+    const nlohmann::json doc = {
+        {"frames", frames},
+        {"summary",
+         {{"frames", args.frames},
+          {"width", ctx.framebuffer_size().width},
+          {"height", ctx.framebuffer_size().height},
+          {"dt_s", args.dt_s},
+          {"systems_mean_ms", mean},
+          {"systems_max_ms", max},
+          {"frame_ms_mean", args.frames > 0 ? frame_ms_sum / args.frames : 0.0},
+          {"nodes_inserted", inserted},
+          {"nodes_removed", removed},
+          {"non_finite", non_finite},
+          {"images", written},
+          {"gl_renderer", ctx.gl_renderer()}}}};
+    const std::string stats_path = (std::filesystem::path(args.out) / "stats.json").string();
+    std::ofstream out(stats_path);
+    out << doc.dump(1) << "\n";
+    if (!out) {
+        std::fprintf(stderr, "tunnel: %s: write failed\n", stats_path.c_str());
+        return 1;
+    }
+    std::printf("tunnel: %d frames at %dx%d on %s\n", args.frames, ctx.framebuffer_size().width,
+                ctx.framebuffer_size().height, ctx.gl_renderer().c_str());
+    for (const engine::ecs::SystemStats& st : level.system_stats())
+        std::printf("  %-16s mean %7.3f ms  max %7.3f ms\n", st.name.c_str(), st.mean_ms, st.max_ms);
+    std::printf("  rope nodes inserted %d, removed %d\n", inserted, removed);
+    for (const std::string& p : written) std::printf("wrote %s\n", p.c_str());
+    std::printf("wrote %s\n", stats_path.c_str());
+    return non_finite == 0 ? 0 : 1;
+}
+
+int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
+    auto ui = tunnel::DebugUi::create(ctx);
+    std::printf("tunnel: window %dx%d on %s, panel: %s\n"
+                "  keys: Tab free/fly camera, WASD/arrows + right mouse drag (free camera), Q/E down/up, shift fast,\n"
+                "        P pause bends, F1 wireframe, F12 screenshot (%s), Esc quit\n",
+                ctx.framebuffer_size().width, ctx.framebuffer_size().height, ctx.gl_renderer().c_str(), ui->kind(),
+                args.out.c_str());
+    FreeCamera free_camera;
+    auto last = std::chrono::steady_clock::now();
+    double frame_ms = 0.0;
+    int shots = 0;
+    while (!ctx.should_close()) {
+        ctx.poll_events();
+        const platform::Input& in = ctx.input();
+        const bool keys = !ui->wants_keyboard();
+        tunnel::LevelOptions& o = level.options();
+        if (keys && in.pressed(platform::Key::escape)) ctx.request_close();
+        if (keys && in.pressed(platform::Key::tab)) {
+            o.camera_mode = o.camera_mode == tunnel::CameraMode::fly ? tunnel::CameraMode::free : tunnel::CameraMode::fly;
+            if (o.camera_mode == tunnel::CameraMode::free) free_camera.take(level.camera());
+        }
+        if (keys && in.pressed(platform::Key::p)) o.animate_bends = !o.animate_bends;
+        if (keys && in.pressed(platform::Key::f1)) o.wireframe = !o.wireframe;
+        const auto now = std::chrono::steady_clock::now();
+        const double dt = std::min(0.1, std::chrono::duration<double>(now - last).count());
+        last = now;
+        if (o.camera_mode == tunnel::CameraMode::free)
+            free_camera.update(in, dt, !ui->wants_mouse(), keys, level.camera());
+
+        const platform::Extent size = ctx.framebuffer_size();
+        level.set_viewport(size.width, size.height);
+        ctx.begin_frame();
+        const auto start = std::chrono::steady_clock::now();
+        level.frame(dt);
+        frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        tunnel::UiRequests requests;
+        requests.screenshot = keys && in.pressed(platform::Key::f12);
+        if (requests.screenshot) {  // the scene without the panel
+            char name[64];
+            std::snprintf(name, sizeof name, "screenshot_%03d.png", shots++);
+            const std::string path = (std::filesystem::path(args.out) / name).string();
+            if (auto s = platform::capture_png(ctx, path); !s) {
+                std::fprintf(stderr, "tunnel: %s\n", s.error().message.c_str());
+            } else {
+                std::printf("wrote %s\n", path.c_str());
+            }
+            requests.screenshot = false;
+        }
+        ui->draw(level, frame_ms, requests);
+        if (requests.screenshot) {  // the panel's button: the frame with the panel
+            char name[64];
+            std::snprintf(name, sizeof name, "screenshot_%03d.png", shots++);
+            const std::string path = (std::filesystem::path(args.out) / name).string();
+            if (auto s = platform::capture_png(ctx, path); s) std::printf("wrote %s\n", path.c_str());
+        }
+        ctx.end_frame();
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    Args args;
+    CLI::App app{"tunnel: bent tunnel pieces with simulated and fixed cables (wire runtime demo level)"};
+    app.add_flag("--headless", args.headless, "render off-screen (automatic when there is no display)");
+    app.add_option("--frames", args.frames, "headless: frames to render (default 120)")->check(CLI::PositiveNumber);
+    app.add_option("--out", args.out, "headless: folder of the PNGs and stats.json; window: screenshots (default out/tunnel)");
+    app.add_option("--capture-every", args.capture_every, "headless: also capture every K-th frame")->check(CLI::NonNegativeNumber);
+    app.add_option("--width", args.width, "framebuffer width (default 1280)")->check(CLI::PositiveNumber);
+    app.add_option("--height", args.height, "framebuffer height (default 720)")->check(CLI::PositiveNumber);
+    app.add_option("--dt", args.dt_s, "headless: fixed time step in seconds (default 1/30)")->check(CLI::PositiveNumber);
+    app.add_option("--pieces", args.pieces, "tunnel pieces of 4 m (default 16)")->check(CLI::Range(2, 256));
+    app.add_option("--seed", args.seed, "seed of the bend animation (default 1)");
+    app.add_option("--path", args.path, "wire upload path: cpu (meshes) or gpu (ring records)")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    app.add_option("--spline", args.spline, "catmull-rom, c2, automatic or linear")
+        ->check(CLI::IsMember({"catmull-rom", "c2", "automatic", "linear"}));
+    app.add_option("--lod-tolerance", args.lod_tolerance_px, "wire LOD screen error in pixels (default 0.5)")
+        ->check(CLI::PositiveNumber);
+    app.add_flag("--wireframe", args.wireframe, "draw wireframe");
+    CLI11_PARSE(app, argc, argv);
+
+    platform::ContextDesc desc{.backend = args.headless ? platform::Backend::headless : platform::Backend::automatic,
+                               .width = args.width,
+                               .height = args.height,
+                               .title = "tunnel"};
+    auto ctx = platform::create_context(desc);
+    if (!ctx) {
+        std::fprintf(stderr, "tunnel: %s\n", ctx.error().message.c_str());
+        return 1;
+    }
+    auto level = tunnel::Level::create({.pieces = args.pieces, .seed = args.seed});
+    if (!level) {
+        std::fprintf(stderr, "tunnel: %s\n", level.error().message.c_str());
+        return 1;
+    }
+    tunnel::LevelOptions& o = level.value()->options();
+    o.upload_path = args.path == "gpu" ? wire::UploadPath::gpu_rings : wire::UploadPath::cpu_mesh;
+    o.spline = args.spline == "c2"          ? wire::SplineKind::c2
+               : args.spline == "automatic" ? wire::SplineKind::automatic
+               : args.spline == "linear"    ? wire::SplineKind::linear
+                                            : wire::SplineKind::catmull_rom;
+    o.lod_tolerance_px = args.lod_tolerance_px;
+    o.wireframe = args.wireframe;
+    const platform::Extent size = ctx.value()->framebuffer_size();
+    level.value()->set_viewport(size.width, size.height);
+    if (ctx.value()->headless()) return run_headless(*ctx.value(), *level.value(), args);
+    return run_window(*ctx.value(), *level.value(), args);
+}
