@@ -252,7 +252,7 @@ std::vector<std::vector<unsigned char>> run_scene(int threads, UploadPath path) 
     for (int frame = 0; frame < 12; ++frame) {
         w.ctx.camera.position = {0.3f * std::sin(0.2f * frame), 0.1f * frame, 5.0f - 0.5f * frame};
         for (std::size_t i = frame % 3; i < wires.size(); i += 3) {
-            edit_nodes(w.registry, wires[i]).positions[5].y += 0.01;
+            if (w.registry.valid(wires[i])) edit_nodes(w.registry, wires[i]).positions[5].y += 0.01;
         }
         if (frame == 4) insert_node(w.registry, wires[10], 6, glm::dvec3(0.0, 0.0, -3.0));
         if (frame == 6) w.registry.destroy(wires[20]);
