@@ -14,6 +14,7 @@
 #include <wire/systems/systems.hpp>
 
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
@@ -70,6 +71,7 @@ struct RopeEnds {
     std::size_t anchor_b = 0;
     std::size_t cable = 0;
     glm::dmat4 world_from_piece{1.0};  // the piece's frame when the rope was last moved with it
+    double inset_m = 0.0;              // ends moved this far from the hook toward the axis (festoons)
 };
 
 // Deterministic [0, 1) from an integer (no library distribution: the same phases everywhere).
@@ -124,12 +126,21 @@ struct Level::State {
     int height_px = 720;
     double time_s = 0.0;
     double fly_distance_m = 0.0;
+    double rope_time_s = 0.0;  // simulated rope time since frame 0 (drives the gusts)
     wire::render::FrameStats wire_stats{};
     std::vector<float> bucket;
 };
 
 Level::Level() : state_(std::make_unique<State>()) {}
 Level::~Level() = default;
+
+glm::dvec3 Level::rope_end(int piece, std::size_t anchor, double inset_m) const {
+    glm::dvec3 p = state_->anchors[anchor];
+    p.x -= p.x < 0.0 ? -inset_m : inset_m;
+    p.y += inset_m > 0.0 ? 0.03 : 0.0;
+    p.z += kPieceLength * piece;
+    return chain_.transform_point(p);
+}
 
 int Level::piece_count() const { return static_cast<int>(state_->segments.size()); }
 double Level::piece_length_m() const { return kPieceLength; }
@@ -269,15 +280,17 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
     }
 
     // ---- hanging cables: festoons between the hooks of each wall, and a few across the tunnel ----
-    auto add_rope = [&](int pa, std::size_t aa, int pb, std::size_t ab, double slack, uint32_t material, float radius) {
-        const glm::dvec3 a = level->anchor_world(pa, aa);
-        const glm::dvec3 b = level->anchor_world(pb, ab);
+    auto add_rope = [&](int pa, std::size_t aa, int pb, std::size_t ab, double inset, double slack, uint32_t material,
+                        float radius) {
+        const glm::dvec3 a = level->rope_end(pa, aa, inset);
+        const glm::dvec3 b = level->rope_end(pb, ab, inset);
         const double length = glm::length(b - a) * slack;
         level->ropes_.emplace_back(a, b, length, 8);
         wire::WireNodes nodes;
         level->ropes_.back().write_nodes(nodes);
         const auto e = wire::systems::spawn_wire(s.registry, std::move(nodes), {.radius_m = radius, .material = material});
-        s.rope_ends.push_back({pa, aa, pb, ab, level->cables_.size(), level->chain_.world_from_segment(static_cast<std::size_t>(pa))});
+        s.rope_ends.push_back({pa, aa, pb, ab, level->cables_.size(),
+                               level->chain_.world_from_segment(static_cast<std::size_t>(pa)), inset});
         level->cables_.push_back({.entity = e,
                                   .hanging = true,
                                   .rope = static_cast<int>(level->ropes_.size() - 1),
@@ -285,14 +298,23 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
                                   .radius_m = radius});
     };
     for (int k = 0; k < settings.pieces; ++k) {
-        add_rope(k, 0, k, 3, 1.12 + 0.04 * hash01(static_cast<uint32_t>(k) + 101u), k % 2 == 0 ? orange : rubber, 0.02f);
-        add_rope(k, 4, k, 7, 1.10 + 0.05 * hash01(static_cast<uint32_t>(k) + 202u), k % 2 == 0 ? rubber : yellow, 0.02f);
-        if (k % 3 == 1) add_rope(k, 1, k, 5, 1.10, k % 2 == 0 ? orange : yellow, 0.025f);
+        // Festoons hang from the hook lips, shallow enough to stay clear of the ribs (inner radius ~2.2 m).
+        add_rope(k, 0, k, 3, 0.1, 1.03 + 0.02 * hash01(static_cast<uint32_t>(k) + 101u), k % 2 == 0 ? orange : rubber,
+                 0.02f);
+        add_rope(k, 4, k, 7, 0.1, 1.03 + 0.02 * hash01(static_cast<uint32_t>(k) + 202u), k % 2 == 0 ? rubber : red,
+                 0.02f);
+        // Cables across the tunnel (every other piece), and a diagonal one now and then.
+        if (k % 2 == 1) add_rope(k, 1 + static_cast<std::size_t>(k % 4 == 1), k, 5 + static_cast<std::size_t>(k % 4 == 1), 0.0,
+                                 1.10, k % 4 == 1 ? yellow : orange, 0.025f);
+        if (k % 4 == 2) add_rope(k, 0, k, 7, 0.0, 1.06, blue, 0.02f);
     }
 
     // Settle the ropes (fixed step, so every run starts from the same state).
     const double prewarm_dt = 1.0 / 60.0;
+    level->options_.gusts = false;
     for (double t = 0.0; t < settings.prewarm_s; t += prewarm_dt) level->update_ropes(prewarm_dt);
+    level->options_.gusts = true;
+    s.rope_time_s = 0.0;
     level->update_cables();
     level->applied_ = level->options_;
     level->applied_.spline = wire::SplineKind::catmull_rom;
@@ -374,6 +396,15 @@ void Level::update_ropes(double dt_s) {
     stats_.rope_nodes = 0;
     wire::SplineSettings spline;
     spline.kind = options_.spline;
+    // A gust front travels down the tunnel at kGustSpeed, one every period; ropes it passes are pushed toward
+    // the tunnel axis (festoons) or along the tunnel (cross cables), bend, refine, straighten and coarsen.
+    constexpr double kGustSpeed = 6.0;
+    constexpr double kGustAccel = 24.0;
+    constexpr double kGustWidth = 1.4;
+    const double period = (chain_.total_length_m() + 16.0) / kGustSpeed;
+    const double gust_z = -6.0 + kGustSpeed * std::fmod(s.rope_time_s, period);
+    const bool gusting = options_.gusts && options_.simulate_ropes && s.rope_time_s > 0.0;
+    if (options_.simulate_ropes) s.rope_time_s += dt_s;
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
         RopeEnds& e = s.rope_ends[r];
         // Carry the rope with its piece as the tunnel bends (the simulation sees only the motion relative to
@@ -381,10 +412,27 @@ void Level::update_ropes(double dt_s) {
         const glm::dmat4& now = chain_.world_from_segment(static_cast<std::size_t>(e.piece_a));
         ropes_[r].transform(now * glm::inverse(e.world_from_piece));
         e.world_from_piece = now;
-        const glm::dvec3 a = anchor_world(e.piece_a, e.anchor_a);
-        const glm::dvec3 b = anchor_world(e.piece_b, e.anchor_b);
+        const glm::dvec3 a = rope_end(e.piece_a, e.anchor_a, e.inset_m);
+        const glm::dvec3 b = rope_end(e.piece_b, e.anchor_b, e.inset_m);
         ropes_[r].set_ends(a, b);
-        if (options_.simulate_ropes) ropes_[r].step(dt_s);
+        if (options_.simulate_ropes) {
+            Rope::AccelerationField field;
+            const double z0 = kPieceLength * e.piece_a;
+            if (gusting && std::abs(z0 + 2.0 - gust_z) < 2.0 + 4.0 * kGustWidth) {
+                const glm::dmat4 piece_from_world = glm::inverse(now);
+                const glm::dvec3 anchor = s.anchors[e.anchor_a];
+                const bool across = e.anchor_b >= 4 && e.anchor_a < 4;  // from one wall to the other
+                const glm::dvec3 local_dir =
+                    glm::normalize(across ? glm::dvec3(0.0, 0.5, 1.0) : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
+                const glm::dvec3 dir = glm::dmat3(now) * local_dir;
+                field = [piece_from_world, dir, z0, gust_z](const glm::dvec3& p) {
+                    const double z = z0 + (piece_from_world * glm::dvec4(p, 1.0)).z;
+                    const double u = (z - gust_z) / kGustWidth;
+                    return dir * (kGustAccel * std::exp(-u * u));
+                };
+            }
+            ropes_[r].step(dt_s, field);
+        }
         if (options_.adapt_ropes) {
             const AdaptResult changed = ropes_[r].adapt(spline);
             stats_.nodes_inserted += changed.inserted;

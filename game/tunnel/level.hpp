@@ -58,6 +58,7 @@ struct LevelOptions {
     bool animate_bends = true;
     bool simulate_ropes = true;
     bool adapt_ropes = true;        ///< node insertion/removal on the hanging cables
+    bool gusts = true;              ///< gusts of wind travel down the tunnel and swing the hanging cables
     bool draw_pieces = true;
     bool draw_wires = true;
     double subdivision_tolerance_px = 1.0;
@@ -137,6 +138,7 @@ private:
     void draw_pieces();
     void draw_wires();
     void apply_options();
+    glm::dvec3 rope_end(int piece, std::size_t anchor, double inset_m) const;
 
     std::unique_ptr<State> state_;
     LevelOptions options_{};

@@ -20,7 +20,7 @@ RopeSettings with_defaults(RopeSettings s) {
     if (s.substeps == 0) s.substeps = 4;
     if (s.iterations == 0) s.iterations = 12;
     if (s.refine_angle_rad == 0.0) s.refine_angle_rad = 0.30;
-    if (s.coarsen_angle_rad == 0.0) s.coarsen_angle_rad = 0.06;
+    if (s.coarsen_angle_rad == 0.0) s.coarsen_angle_rad = 0.12;
     if (s.min_element_m == 0.0) s.min_element_m = 0.08;
     if (s.max_element_m == 0.0) s.max_element_m = 1.2;
     if (s.max_nodes == 0) s.max_nodes = 96;
@@ -73,7 +73,7 @@ void Rope::set_ends(const glm::dvec3& a, const glm::dvec3& b) {
     prev_.back() = b;
 }
 
-void Rope::step(double dt_s) {
+void Rope::step(double dt_s, const AccelerationField& field) {
     if (dt_s <= 0.0) return;
     const double h = dt_s / s_.substeps;
     const double keep = std::pow(s_.damping, h);
@@ -84,6 +84,7 @@ void Rope::step(double dt_s) {
             const glm::dvec3 v = (x_[i] - prev_[i]) * keep;
             prev_[i] = x_[i];
             x_[i] += v + g;
+            if (field) x_[i] += field(prev_[i]) * (h * h);
         }
         for (int it = 0; it < s_.iterations; ++it) {
             // Alternate the sweep direction so neither end is favoured.

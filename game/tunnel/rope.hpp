@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace tunnel {
@@ -23,7 +24,8 @@ struct RopeSettings {
     int substeps = 0;                  ///< per step(), 0 -> 4
     int iterations = 0;                ///< constraint passes per substep, 0 -> 12
     double refine_angle_rad = 0.0;     ///< insert where consecutive elements turn more than this; 0 -> 0.30
-    double coarsen_angle_rad = 0.0;    ///< remove a node whose elements (and neighbours') turn less; 0 -> 0.06
+    double coarsen_angle_rad = 0.0;    ///< remove a node whose elements (and neighbours') turn less; 0 -> 0.12
+                                       ///< (merging two such elements turns < 2 * 0.12 < refine: no thrashing)
     double min_element_m = 0.0;        ///< never split an element below 2 * this; 0 -> 0.08
     double max_element_m = 0.0;        ///< never merge into an element longer than this; 0 -> 1.2
     std::size_t max_nodes = 0;         ///< 0 -> 96
@@ -47,8 +49,10 @@ public:
     void transform(const glm::dmat4& delta);
     /// Moves the pinned ends (e.g. anchors bent by the tunnel's curved space this frame).
     void set_ends(const glm::dvec3& a, const glm::dvec3& b);
+    /// Extra acceleration (m/s^2, world) at a node position, e.g. a gust of wind; empty: none.
+    using AccelerationField = std::function<glm::dvec3(const glm::dvec3& position_m)>;
     /// Advances the simulation by dt_s (fixed-step callers get bit-identical results).
-    void step(double dt_s);
+    void step(double dt_s, const AccelerationField& field = {});
     /// Inserts nodes where the cable bends and removes them where it is straight (at most
     /// max_changes_per_adapt changes). New nodes lie on the curve `spline` builds through the current nodes.
     AdaptResult adapt(const wire::SplineSettings& spline);
