@@ -30,6 +30,10 @@ std::string node_prefix(std::size_t i) { return "node " + std::to_string(i) + ":
 // basis maximum); 0.5 halves the overshoot of a uniform-like 1.0 while keeping the corner visibly round.
 constexpr double kHug = 0.5;
 
+// Largest accepted |coordinate| (metres): the tube's float vertices (relative to ring 0) and squared chord
+// lengths must stay finite; 1e12 m is far beyond any scene (DESIGN §5 asks for 1e6 m from the origin).
+constexpr double kMaxCoordinate_m = 1e12;
+
 double smoothstep(double e0, double e1, double x) {
     const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);
@@ -81,6 +85,9 @@ Status check_nodes(const WireNodes& w, bool use_physics) {
         for (int a = 0; a < 3; ++a) {
             const double v = w.positions[i][a];
             if (!std::isfinite(v)) return Status::error(node_prefix(i) + "position." + kAxis[a] + " is " + describe(v), static_cast<int>(i));
+            if (std::abs(v) > kMaxCoordinate_m)
+                return Status::error(node_prefix(i) + "position." + kAxis[a] + " is " + describe(v) +
+                                         " (beyond the supported range of +-1e12 m)", static_cast<int>(i));
         }
         if (!w.stretch.empty() && !(w.stretch[i] > 0.0f && std::isfinite(w.stretch[i]))) {
             return Status::error(node_prefix(i) + "stretch is " + describe(w.stretch[i]) + " (must be finite and > 0)", static_cast<int>(i));
@@ -374,8 +381,13 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         bz.b1 = p0 + tg.t0[k] / 3.0;
         bz.b2 = p1 - tg.t1[k] / 3.0;
         bz.b3 = p1;
-        const bool finite = std::isfinite(bz.b1.x) && std::isfinite(bz.b1.y) && std::isfinite(bz.b1.z) &&
-                            std::isfinite(bz.b2.x) && std::isfinite(bz.b2.y) && std::isfinite(bz.b2.z);
+        // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the
+        // tube's float vertices downstream.
+        constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
+        const auto in_range = [](const dvec3& b) {
+            return std::abs(b.x) <= kMaxControl_m && std::abs(b.y) <= kMaxControl_m && std::abs(b.z) <= kMaxControl_m;
+        };
+        const bool finite = in_range(bz.b1) && in_range(bz.b2);  // false for NaN too
         if (!finite) {
             const uint32_t src = m.first[k];
             out = Curve{};
