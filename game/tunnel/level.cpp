@@ -293,6 +293,7 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
                                level->chain_.world_from_segment(static_cast<std::size_t>(pa)), inset});
         level->cables_.push_back({.entity = e,
                                   .hanging = true,
+                                  .across = (aa < 4) != (ab < 4),
                                   .rope = static_cast<int>(level->ropes_.size() - 1),
                                   .material = material,
                                   .radius_m = radius});

@@ -91,6 +91,7 @@ struct LevelFrameStats {
 struct CableInfo {
     engine::ecs::Entity entity{};
     bool hanging = false;  ///< rope-simulated (else fixed along the wall)
+    bool across = false;   ///< hanging from one wall to the other (else a festoon along one wall)
     int rope = -1;         ///< index into the ropes when hanging
     uint32_t material = 0;
     float radius_m = 0.0f;

@@ -1,0 +1,337 @@
+// Headless system test of the tunnel level (game/tunnel, target tunnel_level): runs frames in-process on Mesa
+// llvmpipe at a fixed step and checks
+//   - walls: points on the bent wall (chain.transform_point, between the ribs) project onto concrete-coloured
+//     pixels, and an empty frame (pieces and wires off) is pure background there;
+//   - cables: the rendered curve of the nearest cable across the tunnel and of a fixed wall cable, projected,
+//     covers pixels that change when the wires are switched off;
+//   - stats: every per-frame record is finite and counts are plausible;
+//   - ropes: the hanging cables insert and remove nodes (new stable ids, placed on the current curve);
+//   - determinism: two runs give byte-equal images.
+// If no EGL context can be created the test fails: CI machines have Mesa.
+#include "tunnel/level.hpp"
+#include "tunnel/rope.hpp"
+#include "tunnel/stats_json.hpp"
+
+#include <engine/platform/capture.hpp>
+#include <engine/platform/context.hpp>
+#include <wire/curve.hpp>
+#include <wire/spline.hpp>
+
+#include <gtest/gtest.h>
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <set>
+#include <vector>
+
+namespace platform = engine::platform;
+
+namespace {
+
+constexpr int kWidth = 640;
+constexpr int kHeight = 360;
+constexpr double kDt = 1.0 / 30.0;
+constexpr double kPi = 3.14159265358979323846;
+
+std::unique_ptr<platform::Context> make_context() {
+    auto ctx = platform::create_headless_context({.width = kWidth, .height = kHeight, .quiet = true});
+    if (!ctx) {
+        ADD_FAILURE() << "no headless GL context: " << ctx.error().message;
+        return nullptr;
+    }
+    return std::move(ctx).value();
+}
+
+std::unique_ptr<tunnel::Level> make_level() {
+    auto level = tunnel::Level::create({});
+    if (!level) {
+        ADD_FAILURE() << "Level::create: " << level.error().message;
+        return nullptr;
+    }
+    level.value()->set_viewport(kWidth, kHeight);
+    return std::move(level).value();
+}
+
+// Pixel of a world point, or nothing when it is behind the camera or outside the image (with a margin).
+struct Pixel {
+    int x = 0;
+    int y = 0;
+    double depth_m = 0.0;
+    bool ok = false;
+};
+
+Pixel project(const engine::scene::Camera& camera, const glm::dvec3& p, int margin = 4) {
+    const glm::vec4 clip = camera.view_projection() * glm::vec4(glm::vec3(p), 1.0f);
+    Pixel px;
+    if (clip.w <= camera.near_m) return px;
+    const double nx = clip.x / clip.w;
+    const double ny = clip.y / clip.w;
+    px.x = static_cast<int>(std::floor((nx * 0.5 + 0.5) * kWidth));
+    px.y = static_cast<int>(std::floor((1.0 - (ny * 0.5 + 0.5)) * kHeight));
+    px.depth_m = clip.w;
+    px.ok = px.x >= margin && px.x < kWidth - margin && px.y >= margin && px.y < kHeight - margin;
+    return px;
+}
+
+int difference(const platform::Image& a, const platform::Image& b, int x, int y) {
+    const std::uint8_t* p = a.pixel(x, y);
+    const std::uint8_t* q = b.pixel(x, y);
+    return std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]);
+}
+
+// Largest difference in the 3x3 block around (x, y): tolerant of a one-pixel projection offset.
+int block_difference(const platform::Image& a, const platform::Image& b, int x, int y) {
+    int best = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) best = std::max(best, difference(a, b, x + dx, y + dy));
+    return best;
+}
+
+// Dense samples of the curve the wire systems build through `nodes` (same default spline settings).
+std::vector<glm::dvec3> rendered_curve(const wire::WireNodes& nodes) {
+    wire::Curve curve;
+    std::vector<glm::dvec3> out;
+    if (!wire::build_curve(nodes, wire::SplineSettings{}, curve).ok) return out;
+    for (const wire::CubicBezier& segment : curve.segments)
+        for (int i = 0; i < 16; ++i) out.push_back(wire::position(segment, i / 16.0));
+    return out;
+}
+
+struct Frames {
+    platform::Image full;      // pieces and wires
+    platform::Image no_wires;  // pieces only
+    platform::Image empty;     // neither
+};
+
+// Runs `frames` frames, then renders the last state three ways.
+Frames run(platform::Context& ctx, tunnel::Level& level, int frames) {
+    for (int f = 0; f < frames; ++f) {
+        ctx.begin_frame();
+        level.frame(kDt);
+        ctx.end_frame();
+    }
+    Frames out;
+    ctx.begin_frame();
+    level.render();
+    out.full = platform::read_pixels(ctx);
+    level.options().draw_wires = false;
+    level.render();
+    out.no_wires = platform::read_pixels(ctx);
+    level.options().draw_pieces = false;
+    level.render();
+    out.empty = platform::read_pixels(ctx);
+    level.options().draw_wires = true;
+    level.options().draw_pieces = true;
+    ctx.end_frame();
+    return out;
+}
+
+TEST(TunnelSystem, WallsAndCablesWhereExpected) {
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    auto level = make_level();
+    ASSERT_TRUE(level);
+    const Frames img = run(*ctx, *level, 20);
+    const engine::scene::Camera& camera = level->camera();
+    const curved_space::Chain& chain = level->chain();
+
+    // The empty frame is the clear colour everywhere.
+    const std::uint8_t* bg = img.empty.pixel(0, 0);
+    int background_pixels = 0;
+    for (int y = 0; y < kHeight; y += 4)
+        for (int x = 0; x < kWidth; x += 4) {
+            const std::uint8_t* c = img.empty.pixel(x, y);
+            background_pixels += c[0] == bg[0] && c[1] == bg[1] && c[2] == bg[2];
+        }
+    EXPECT_EQ(background_pixels, (kHeight / 4) * (kWidth / 4));
+
+    // Wall probes: upper half of the wall (clear of walkway and hooks), between the ribs, 3..7 m ahead of the
+    // camera along the unbent axis. The camera flies at unbent z = 3 + 2.5 t.
+    const double camera_z = 3.0 + 2.5 * (20 * kDt);
+    int probes = 0;
+    int wall_coloured = 0;
+    for (double ahead = 3.0; ahead <= 7.0; ahead += 1.0) {
+        const double z = std::floor(camera_z + ahead) + 0.6;
+        for (double deg : {25.0, 50.0, 75.0, 105.0, 130.0, 155.0}) {
+            const double a = deg * kPi / 180.0;
+            const glm::dvec3 p = chain.transform_point({2.3 * std::cos(a), 2.3 * std::sin(a), z});
+            const Pixel px = project(camera, p);
+            if (!px.ok) continue;
+            ++probes;
+            const std::uint8_t* c = img.no_wires.pixel(px.x, px.y);
+            const int lum = c[0] + c[1] + c[2];
+            // Concrete: a warm grey, clearly brighter than the background, red >= blue.
+            const bool concrete = difference(img.no_wires, img.empty, px.x, px.y) > 60 && lum > 120 &&
+                                  c[0] + 4 >= c[2] && std::abs(c[0] - c[2]) < 80;
+            wall_coloured += concrete;
+            if (!concrete)
+                std::printf("wall probe at %d,%d (z %.1f, %.0f deg): rgb %d %d %d\n", px.x, px.y, z, deg, c[0], c[1], c[2]);
+        }
+    }
+    EXPECT_GE(probes, 20);
+    EXPECT_GE(wall_coloured, probes * 9 / 10) << wall_coloured << " of " << probes << " wall probes are concrete";
+
+    // Cables: the nearest cable across the tunnel in front of the camera, and the high fixed cables.
+    auto coverage = [&](std::size_t cable, int& samples) {
+        int covered = 0;
+        samples = 0;
+        for (const glm::dvec3& p : rendered_curve(level->cable_nodes(cable))) {
+            const Pixel px = project(camera, p, 6);
+            if (!px.ok || px.depth_m > 14.0) continue;
+            ++samples;
+            covered += block_difference(img.full, img.no_wires, px.x, px.y) > 24;
+        }
+        return samples > 0 ? static_cast<double>(covered) / samples : 0.0;
+    };
+    int checked_across = 0;
+    int checked_fixed = 0;
+    for (std::size_t c = 0; c < level->cables().size(); ++c) {
+        const tunnel::CableInfo& info = level->cables()[c];
+        int samples = 0;
+        const double cov = coverage(c, samples);
+        if (samples < 30) continue;
+        if (info.hanging && info.across) {
+            EXPECT_GE(cov, 0.85) << "cable " << c << " across the tunnel: " << samples << " samples";
+            ++checked_across;
+        }
+        std::printf("cable %zu (%s): coverage %.2f of %d samples\n", c,
+                    info.hanging ? (info.across ? "across" : "festoon") : "fixed", cov, samples);
+        if (!info.hanging) {
+            // Fixed cables run through the ribs (20% of the length) and past the hooks.
+            EXPECT_GE(cov, 0.5) << "fixed cable " << c << ": " << samples << " samples";
+            ++checked_fixed;
+        }
+    }
+    EXPECT_GE(checked_across, 1) << "no cable across the tunnel in view";
+    EXPECT_GE(checked_fixed, 2) << "fixed wall cables not in view";
+}
+
+TEST(TunnelSystem, StatsFiniteAndPlausible) {
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    auto level = make_level();
+    ASSERT_TRUE(level);
+    for (int f = 0; f < 12; ++f) {
+        ctx->begin_frame();
+        level->frame(kDt);
+        ctx->end_frame();
+        int non_finite = 0;
+        const nlohmann::json record = tunnel::frame_record(level->stats(), level->system_stats(), non_finite);
+        EXPECT_EQ(non_finite, 0);
+        EXPECT_TRUE(tunnel::all_finite(record)) << record.dump();
+        const tunnel::LevelFrameStats& s = level->stats();
+        EXPECT_EQ(s.frame, static_cast<uint64_t>(f));
+        EXPECT_GT(s.wires_drawn, 10u);
+        EXPECT_LE(s.wires_drawn, s.wires);
+        EXPECT_GT(s.wire_vertices, 1000u);
+        EXPECT_GT(s.wire_bytes_uploaded, 0u);
+        EXPECT_GT(s.segment_bytes_uploaded, 0u);
+        EXPECT_GT(s.piece_triangles, 1000u);
+        EXPECT_GT(s.rope_nodes, 0u);
+        int pieces_drawn = 0;
+        for (int n : s.piece_levels) pieces_drawn += n;
+        EXPECT_GT(pieces_drawn, 3);
+        EXPECT_LE(pieces_drawn, level->piece_count());
+        EXPECT_GT(pieces_drawn - s.piece_levels[0], 0) << "no piece refined";  // near bent pieces refine
+        for (const engine::ecs::SystemStats& st : level->system_stats()) {
+            EXPECT_TRUE(std::isfinite(st.last_ms)) << st.name;
+            EXPECT_GE(st.last_ms, 0.0) << st.name;
+        }
+    }
+    EXPECT_EQ(level->system_stats().size(), 10u);
+}
+
+TEST(TunnelSystem, RopesInsertAndRemoveNodesWithNewIds) {
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    auto level = make_level();
+    ASSERT_TRUE(level);
+    level->options().draw_pieces = false;  // simulation only: fast
+    level->options().draw_wires = false;
+    std::vector<std::set<uint32_t>> seen(level->ropes().size());
+    std::vector<uint32_t> max_id(level->ropes().size(), 0);
+    for (std::size_t r = 0; r < level->ropes().size(); ++r) {
+        const auto& ids = level->ropes()[r].ids();
+        seen[r].insert(ids.begin(), ids.end());
+        max_id[r] = *std::max_element(ids.begin(), ids.end());
+    }
+    int inserted = 0;
+    int removed = 0;
+    for (int f = 0; f < 150; ++f) {
+        ctx->begin_frame();
+        level->frame(kDt);
+        ctx->end_frame();
+        inserted += level->stats().nodes_inserted;
+        removed += level->stats().nodes_removed;
+        for (std::size_t r = 0; r < level->ropes().size(); ++r) {
+            const tunnel::Rope& rope = level->ropes()[r];
+            const std::set<uint32_t> ids(rope.ids().begin(), rope.ids().end());
+            ASSERT_EQ(ids.size(), rope.size()) << "rope " << r << " has repeated ids";
+            for (uint32_t id : ids) {
+                // An id that appears now is either known or brand new (larger than any seen): never reused.
+                if (seen[r].count(id) == 0) {
+                    EXPECT_GT(id, max_id[r]) << "rope " << r << " reused id " << id;
+                }
+            }
+            for (uint32_t id : ids) {
+                seen[r].insert(id);
+                max_id[r] = std::max(max_id[r], id);
+            }
+            for (const glm::dvec3& p : rope.positions()) ASSERT_TRUE(std::isfinite(p.x + p.y + p.z));
+        }
+    }
+    EXPECT_GT(inserted, 10) << "the gusts should bend the ropes enough to refine them";
+    EXPECT_GT(removed, 10) << "the ropes should coarsen again as they straighten";
+}
+
+TEST(TunnelSystem, RopeInsertsNodesOnTheCurrentCurve) {
+    // A slack rope pulled into a V: adapt() refines the bend; every new node lies on the curve the wire
+    // systems built through the nodes before the insertion.
+    tunnel::Rope rope({0.0, 0.0, 0.0}, {3.0, 0.0, 0.0}, 4.5, 5, {.max_changes_per_adapt = 1});
+    for (int i = 0; i < 20; ++i) rope.step(1.0 / 60.0);
+    int insertions = 0;
+    for (int round = 0; round < 20; ++round) {
+        wire::WireNodes before;
+        rope.write_nodes(before);
+        wire::Curve curve;
+        ASSERT_TRUE(wire::build_curve(before, wire::SplineSettings{}, curve).ok);
+        const std::vector<uint32_t> old_ids = rope.ids();
+        const tunnel::AdaptResult r = rope.adapt(wire::SplineSettings{});
+        if (r.inserted == 0) continue;
+        ++insertions;
+        for (std::size_t i = 0; i < rope.size(); ++i) {
+            if (std::find(old_ids.begin(), old_ids.end(), rope.ids()[i]) != old_ids.end()) continue;
+            EXPECT_GT(rope.ids()[i], *std::max_element(old_ids.begin(), old_ids.end()));
+            double best = 1e30;
+            for (const wire::CubicBezier& seg : curve.segments)
+                for (int k = 0; k <= 2000; ++k) best = std::min(best, glm::length(wire::position(seg, k / 2000.0) - rope.positions()[i]));
+            EXPECT_LT(best, 2e-3) << "new node " << rope.ids()[i] << " is off the curve";
+        }
+    }
+    EXPECT_GT(insertions, 0);
+}
+
+TEST(TunnelSystem, TwoRunsRenderByteEqualImages) {
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    std::vector<platform::Image> images;
+    for (int run_index = 0; run_index < 2; ++run_index) {
+        auto level = make_level();
+        ASSERT_TRUE(level);
+        for (int f = 0; f < 8; ++f) {
+            ctx->begin_frame();
+            level->frame(kDt);
+            if (f == 7) images.push_back(platform::read_pixels(*ctx));
+            ctx->end_frame();
+        }
+    }
+    ASSERT_EQ(images.size(), 2u);
+    ASSERT_EQ(images[0].rgba.size(), images[1].rgba.size());
+    EXPECT_TRUE(images[0].rgba == images[1].rgba) << "the tunnel is not reproducible at a fixed step";
+}
+
+}  // namespace
