@@ -39,6 +39,7 @@ packages=(
   libglm-dev
   libgmock-dev
   libgtest-dev
+  libimgui-dev
   libosd-dev
   libstb-dev
   libtbb-dev
