@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     };
     add(wiretool::add_mesh_command);
     add(wiretool::add_bend_command);
+    add(wiretool::add_bench_command);
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,43 @@
+// `wiretool bench`: standard scenes through the wire systems (bench.csv, bench.md). A contract: see README and
+// docs/speed_vs_error.md.
+#include "bench_common.hpp"
+#include "commands.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <system_error>
+
+namespace wiretool {
+namespace {
+
+int run_bench(const bench::Options& o) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.out_dir, ec);
+    if (ec || !std::filesystem::is_directory(o.out_dir)) {
+        std::fprintf(stderr, "wiretool bench: cannot create output directory %s\n", o.out_dir.c_str());
+        return exit_failure;
+    }
+    if (!o.skip_systems) {
+        if (const int st = bench::run_systems_bench(o); st != exit_ok) return st;
+    }
+    std::fprintf(stderr, "wiretool bench: wrote %s\n", o.out_dir.c_str());
+    return exit_ok;
+}
+
+}  // namespace
+
+Action add_bench_command(CLI::App& app) {
+    auto o = std::make_shared<bench::Options>();
+    CLI::App* cmd = app.add_subcommand(
+        "bench", "Runs the standard scenes and writes DIR/bench.csv and DIR/bench.md (see docs/speed_vs_error.md).");
+    cmd->add_option("--out", o->out_dir, "Output directory (created if missing)")->required();
+    cmd->add_flag("--quick", o->quick, "Fewer frames (finishes in under a minute); the CSV keeps its layout");
+    cmd->add_option("--threads", o->threads, "Worker threads for the bench rows (tbb::global_control)")
+        ->check(CLI::Range(1, 64));
+    cmd->add_option("--scenes", o->scenes, "Only these scenes (standard, offscreen, swaying)")->delimiter(',');
+    return [o] { return run_bench(*o); };
+}
+
+}  // namespace wiretool

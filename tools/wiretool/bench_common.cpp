@@ -1,0 +1,110 @@
+// `wiretool bench`: shared helpers (clocks, medians, upload sizes, tables).
+#include "bench_common.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <fstream>
+
+namespace wiretool::bench {
+
+double cpu_ms() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
+}
+
+double wall_ms() {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    const std::size_t mid = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
+    if (v.size() % 2 == 1) return v[mid];
+    const double hi = v[mid];
+    return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
+}
+
+namespace {
+constexpr std::size_t kDrawRecordBytes = 32;     // detail::GpuDraw
+constexpr std::size_t kElementsCommandBytes = 20;  // DrawElementsIndirectCommand
+constexpr std::size_t kArraysCommandBytes = 16;    // DrawArraysIndirectCommand
+}  // namespace
+
+std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices) {
+    return items * (kDrawRecordBytes + kElementsCommandBytes) + vertices * sizeof(wire::TubeVertex) +
+           indices * sizeof(uint32_t);
+}
+
+std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings) {
+    return items * (kDrawRecordBytes + kArraysCommandBytes) + rings * sizeof(wire::Ring);
+}
+
+std::size_t upload_bytes(const wire::DrawList& list) {
+    std::size_t items = 0, vertices = 0, indices = 0, rings = 0;
+    for (const wire::DrawItem& item : list.items) {
+        if (list.path == wire::UploadPath::cpu_mesh) {
+            if (item.vertices.empty() || item.indices.empty()) continue;
+            ++items;
+            vertices += item.vertices.size();
+            indices += item.indices.size();
+        } else {
+            const bool draws = !item.rings.empty() && (item.rings.size() > 1 || item.closed || item.caps);
+            if (!draws) continue;
+            ++items;
+            rings += item.rings.size();
+        }
+    }
+    return list.path == wire::UploadPath::cpu_mesh ? cpu_mesh_bytes(items, vertices, indices)
+                                                   : gpu_rings_bytes(items, rings);
+}
+
+bool selected(const Options& o, const std::string& scene) {
+    return o.scenes.empty() || std::find(o.scenes.begin(), o.scenes.end(), scene) != o.scenes.end();
+}
+
+bool Table::write_csv(const std::filesystem::path& file) const {
+    std::ofstream out(file);
+    if (!out) return false;
+    auto line = [&](const std::vector<std::string>& cells) {
+        for (std::size_t i = 0; i < cells.size(); ++i) out << (i ? "," : "") << cells[i];
+        out << '\n';
+    };
+    line(header);
+    for (const auto& r : rows) line(r);
+    return static_cast<bool>(out);
+}
+
+std::string Table::markdown() const {
+    std::string s = "|";
+    for (const auto& h : header) s += " " + h + " |";
+    s += "\n|";
+    for (std::size_t i = 0; i < header.size(); ++i) s += " --- |";
+    s += "\n";
+    for (const auto& r : rows) {
+        s += "|";
+        for (const auto& c : r) s += " " + c + " |";
+        s += "\n";
+    }
+    return s;
+}
+
+std::string num(double v, int digits) {
+    if (!std::isfinite(v)) return "nan";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
+}
+
+std::string num(std::size_t v) { return std::to_string(v); }
+
+bool write_text(const std::filesystem::path& file, const std::string& text) {
+    std::ofstream out(file);
+    out << text;
+    return static_cast<bool>(out);
+}
+
+}  // namespace wiretool::bench

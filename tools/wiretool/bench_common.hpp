@@ -1,0 +1,67 @@
+// `wiretool bench`: what its parts share: options, clocks, medians, the exact upload size of a DrawList, and
+// CSV/Markdown writing. The bench parts: bench_systems.cpp (ECS scenes, bench.csv), bench_accuracy.cpp
+// (reference scenes, accuracy.csv, the plot), bench_stability.cpp (DESIGN §5 hard cases).
+#pragma once
+
+#include <wire/draw.hpp>
+
+#include <cstddef>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace wiretool::bench {
+
+struct Options {
+    bool quick = false;
+    std::filesystem::path out_dir;
+    int threads = 1;                 ///< tbb::global_control for the bench rows (the 1-vs-2 thread run is separate)
+    std::vector<std::string> scenes; ///< empty: all; else only these (bench.csv and accuracy.csv scene names)
+    bool skip_accuracy = false;      ///< only bench.csv/bench.md
+    bool skip_systems = false;       ///< only accuracy/stability outputs
+};
+
+/// Process CPU time (all threads), milliseconds: robust against other load on a shared machine.
+double cpu_ms();
+/// Monotonic wall time, milliseconds.
+double wall_ms();
+/// Median of `v` (0 for an empty vector). Takes a copy.
+double median(std::vector<double> v);
+
+/// Bytes WireRenderer::draw() memcpy's into its mapped buffer for `list` (wire_renderer.cpp): per drawn item a
+/// 32-byte draw record and a 20-byte (cpu-mesh, DrawElementsIndirect) or 16-byte (gpu-rings, DrawArraysIndirect)
+/// command, plus vertices (32 B) and indices (4 B) or ring records (48 B). Items without geometry are skipped.
+std::size_t upload_bytes(const wire::DrawList& list);
+/// The same for a cpu-mesh upload of `items` meshes with these totals.
+std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices);
+/// The same for a gpu-rings upload of `items` wires with `rings` rings in total.
+std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings);
+
+/// Whether `scene` is selected by the options.
+bool selected(const Options& o, const std::string& scene);
+
+/// A table written both as CSV (exact header) and as a Markdown table.
+struct Table {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    void add(std::vector<std::string> row) { rows.push_back(std::move(row)); }
+    [[nodiscard]] bool write_csv(const std::filesystem::path& file) const;
+    [[nodiscard]] std::string markdown() const;
+};
+
+/// Number formatting for the tables: general format with `digits` significant digits; non-finite -> "nan".
+std::string num(double v, int digits = 4);
+std::string num(std::size_t v);
+
+/// Writes `text` to `file`; false on failure.
+[[nodiscard]] bool write_text(const std::filesystem::path& file, const std::string& text);
+
+// The bench parts. Each writes its files into o.out_dir, prints progress to stderr and returns an exit status
+// (exit_ok, or exit_failure when a file could not be written).
+int run_systems_bench(const Options& o);    ///< bench.csv, bench.md
+int run_accuracy_bench(const Options& o);   ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
+/// The DESIGN §5 hard cases as a Markdown section (case, result, max error).
+std::string stability_report();
+
+}  // namespace wiretool::bench
