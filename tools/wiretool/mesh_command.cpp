@@ -21,75 +21,10 @@ struct MeshOptions {
     std::string input;
     std::string glb_out;
     std::string csv_out;
-    std::optional<std::string> spline;
-    std::optional<double> alpha;
-    std::optional<double> tension;
-    std::optional<uint32_t> rings_per_segment;
-    std::optional<double> tolerance_m;
-    std::optional<uint32_t> sides;
+    wire::io::SettingsOverrides overrides;
     uint32_t repeat = 0;
     bool no_caps = false;
 };
-
-/// Settings of one wire: command line over file over defaults, field by field.
-wire::Status resolve(const wire::io::WireSpec& spec, const MeshOptions& o, wire::PipelineSettings& out) {
-    wire::PipelineSettings s;  // defaults
-    const std::string type = o.spline ? *o.spline : spec.spline_type.value_or("centripetal");
-    if (type == "uniform" || type == "centripetal" || type == "chordal" || type == "catmull-rom") {
-        s.spline.kind = wire::SplineKind::catmull_rom;
-        const double implied = type == "uniform" ? 0.0 : type == "chordal" ? 1.0 : 0.5;
-        // A type named on the command line implies its alpha unless --alpha is given too.
-        s.spline.alpha = o.alpha ? *o.alpha : o.spline ? implied : spec.alpha.value_or(implied);
-    } else if (type == "c2") {
-        s.spline.kind = wire::SplineKind::c2;
-    } else if (type == "auto" || type == "automatic") {
-        s.spline.kind = wire::SplineKind::automatic;
-    } else if (type == "linear") {
-        s.spline.kind = wire::SplineKind::linear;
-    } else {
-        return wire::Status::error("unknown spline type '" + type +
-                                   "' (expected uniform, centripetal, chordal, catmull-rom, c2, auto or linear)");
-    }
-    if (o.alpha && !(s.spline.kind == wire::SplineKind::catmull_rom))
-        return wire::Status::error("--alpha applies to uniform/centripetal/chordal/catmull-rom, not '" + type + "'");
-    s.spline.tension = o.tension ? *o.tension : spec.tension.value_or(0.0);
-    s.spline.bias = spec.bias.value_or(0.0);
-    s.spline.continuity = spec.continuity.value_or(0.0);
-    s.spline.curvature_tension = spec.curvature_tension.value_or(!spec.physics.empty());
-    s.spline.closed = spec.closed.value_or(false);
-    if (spec.radius_m) s.spline.radius_m = static_cast<float>(*spec.radius_m);
-    if (o.tolerance_m) {
-        s.tessellate.tolerance_m = *o.tolerance_m;
-    } else {
-        s.tessellate.rings_per_segment = o.rings_per_segment.value_or(8);
-    }
-    s.tube.sides = o.sides ? *o.sides : static_cast<uint32_t>(spec.sides.value_or(12));
-    s.tube.caps = o.no_caps ? false : spec.caps.value_or(true);
-    out = s;
-    return wire::Status::success();
-}
-
-wire::WireNodes to_nodes(const wire::io::WireSpec& spec) {
-    wire::WireNodes n;
-    n.positions = spec.positions;
-    n.ids = spec.ids;
-    n.stretch = spec.stretch;
-    n.radius_m.resize(spec.radius.size());
-    for (std::size_t i = 0; i < spec.radius.size(); ++i) n.radius_m[i] = spec.radius[i] > 0 ? spec.radius[i] : 0.0f;
-    for (const wire::io::NodePhysics& p : spec.physics) {
-        n.theta_rad.push_back(p.theta);
-        n.iz_m4.push_back(p.Iz);
-        n.length_m.push_back(p.L);
-        n.delta_length_m.push_back(p.dL);
-        n.area_m2.push_back(p.A);
-    }
-    for (const glm::dvec3& tcb : spec.tcb) {
-        n.kb_tension.push_back(static_cast<float>(tcb.x));
-        n.kb_bias.push_back(static_cast<float>(tcb.y));
-        n.kb_continuity.push_back(static_cast<float>(tcb.z));
-    }
-    return n;
-}
 
 std::string where(const std::string& file, std::size_t frame, std::size_t frames, std::size_t wire_index) {
     std::string s = file + ": ";
@@ -145,7 +80,7 @@ wire::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::v
         const bool last = f + 1 == scene.frames.size();
         for (std::size_t w = 0; w < wires; ++w) {
             const wire::io::WireSpec& spec = scene.frames[f].wires[w];
-            wire::Status st = pipelines[w].update(to_nodes(spec), settings[f][w]);
+            wire::Status st = pipelines[w].update(wire::io::to_wire_nodes(spec), settings[f][w]);
             if (!st.ok) return wire::Status::error(where(o.input, f, scene.frames.size(), w) + ": " + st.message, st.node);
             out.vertices += pipelines[w].mesh().vertices.size();
             if (want_outputs) {
@@ -174,7 +109,8 @@ bool write_atomically(const std::string& path, const std::string& bytes, std::st
     return true;
 }
 
-int run_mesh(const MeshOptions& o) {
+int run_mesh(MeshOptions o) {
+    if (o.no_caps) o.overrides.caps = false;
     wire::io::SceneSpec scene;
     if (wire::Status st = wire::io::load_wire_json(o.input, scene); !st.ok) {
         std::cerr << "wiretool mesh: " << st.message << "\n";
@@ -184,7 +120,7 @@ int run_mesh(const MeshOptions& o) {
     for (std::size_t f = 0; f < scene.frames.size(); ++f)
         for (std::size_t w = 0; w < scene.frames[f].wires.size(); ++w) {
             wire::PipelineSettings s;
-            if (wire::Status st = resolve(scene.frames[f].wires[w], o, s); !st.ok) {
+            if (wire::Status st = wire::io::resolve_settings(scene.frames[f].wires[w], o.overrides, s); !st.ok) {
                 std::cerr << "wiretool mesh: " << where(o.input, f, scene.frames.size(), w) << ": " << st.message
                           << "\n";
                 return exit_bad_input;
@@ -238,20 +174,20 @@ Action add_mesh_command(CLI::App& app) {
     cmd->add_option("input", o->input, "Wire JSON file")->required();
     cmd->add_option("-o,--output", o->glb_out, "Write binary glTF: one mesh per wire (the last frame)");
     cmd->add_option("--csv", o->csv_out, "Write one row per ring (every frame)");
-    cmd->add_option("--spline", o->spline, "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear)")
+    cmd->add_option("--spline", o->overrides.spline_type, "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear)")
         ->check(CLI::IsMember({"uniform", "centripetal", "chordal", "c2", "auto", "automatic", "catmull-rom", "linear"}));
-    cmd->add_option("--alpha", o->alpha, "Catmull-Rom knot exponent (0 uniform, 0.5 centripetal, 1 chordal)")
+    cmd->add_option("--alpha", o->overrides.alpha, "Catmull-Rom knot exponent (0 uniform, 0.5 centripetal, 1 chordal)")
         ->check(CLI::Range(0.0, 1.0));
-    cmd->add_option("--tension", o->tension, "Cardinal tension (0 = Catmull-Rom, 1 = straight)")
+    cmd->add_option("--tension", o->overrides.tension, "Cardinal tension (0 = Catmull-Rom, 1 = straight)")
         ->check(CLI::Range(-1.0, 1.0));
-    auto* rps = cmd->add_option("--rings-per-segment", o->rings_per_segment,
+    auto* rps = cmd->add_option("--rings-per-segment", o->overrides.rings_per_segment,
                                 "Rings per node interval at t = k/N (default 8)")
                     ->check(CLI::Range(1u, 4096u));
-    auto* tol = cmd->add_option("--tolerance", o->tolerance_m,
+    auto* tol = cmd->add_option("--tolerance", o->overrides.tolerance_m,
                                 "Adaptive rings: no point of the curve farther than METRES from the ring polyline")
                     ->check(CLI::PositiveNumber);
     rps->excludes(tol);
-    cmd->add_option("--sides", o->sides, "Radial sides (default 12, or the file's \"sides\")")->check(CLI::Range(3u, 1024u));
+    cmd->add_option("--sides", o->overrides.sides, "Radial sides (default 12, or the file's \"sides\")")->check(CLI::Range(3u, 1024u));
     cmd->add_flag("--no-caps", o->no_caps, "Leave the ends of open wires open");
     cmd->add_option("--repeat", o->repeat,
                     "Generate R times and print 'vertices=<N> mean_ms=<X>' to stderr (one generation)")

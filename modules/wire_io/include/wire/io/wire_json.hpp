@@ -57,3 +57,33 @@ Status parse_wire_json(std::string_view text, const std::string& source, SceneSp
 Status load_wire_json(const std::string& path, SceneSpec& out);
 
 }  // namespace wire::io
+
+#include <wire/pipeline.hpp>
+
+namespace wire::io {
+
+/// Settings given outside the file (e.g. on a command line); set fields override the file's.
+struct SettingsOverrides {
+    std::optional<std::string> spline_type;
+    std::optional<double> alpha;
+    std::optional<double> tension;
+    std::optional<uint32_t> rings_per_segment;
+    std::optional<double> tolerance_m;  ///< adaptive ring placement; excludes rings_per_segment
+    std::optional<uint32_t> sides;
+    std::optional<bool> caps;
+};
+
+/// Default ring count and side count of a wire whose file and overrides give none.
+inline constexpr uint32_t default_rings_per_segment = 8;
+inline constexpr uint32_t default_sides = 12;
+
+/// The pipeline settings of one wire: overrides over the file over the defaults, field by field. A spline type
+/// named in the overrides implies its alpha (uniform 0, centripetal 0.5, chordal 1) unless an alpha override is
+/// given too. Errors (without a location; the caller adds file and wire): an unknown spline type, an alpha
+/// override for a spline kind that has none.
+[[nodiscard]] Status resolve_settings(const WireSpec& spec, const SettingsOverrides& overrides, PipelineSettings& out);
+
+/// The wire's nodes as the curve stage takes them (a radius not given becomes 0: "use the wire's radius").
+[[nodiscard]] WireNodes to_wire_nodes(const WireSpec& spec);
+
+}  // namespace wire::io
