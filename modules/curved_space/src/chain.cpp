@@ -50,6 +50,7 @@ glm::dvec3 apply_vector(const glm::dmat4& m, const glm::dvec3& v) { return glm::
 }  // namespace
 
 Status validate(std::span<const Segment> segments) {
+    double total_m = 0.0;
     for (std::size_t i = 0; i < segments.size(); ++i) {
         const Segment& s = segments[i];
         const std::string where = "segment " + std::to_string(i) + ": ";
@@ -62,6 +63,14 @@ Status validate(std::span<const Segment> segments) {
             return Status::error(where + "angle must be finite, got " + format_number(s.angle_rad), index);
         if (!std::isfinite(s.direction_rad))
             return Status::error(where + "direction must be finite, got " + format_number(s.direction_rad), index);
+        if (!std::isfinite(s.angle_rad / s.length_m))
+            return Status::error(where + "curvature angle/length overflows (angle " + format_number(s.angle_rad) +
+                                     ", length " + format_number(s.length_m) + ")", index);
+        total_m += s.length_m;
+        // Bounded so the accumulated matrices stay finite (the wire module's coordinate range too).
+        if (!(total_m <= 1e12))
+            return Status::error(where + "the chain's total length exceeds 1e12 m (" + format_number(total_m) + ")",
+                                 index);
     }
     return Status::success();
 }

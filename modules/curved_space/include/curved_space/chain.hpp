@@ -22,7 +22,8 @@ struct Aabb {
 
 class Chain;
 
-/// Checks every segment: length finite and > 0, angle and direction finite. The first problem found is
+/// Checks every segment: length finite and > 0, angle and direction finite, curvature angle/length finite, the
+/// total length at most 1e12 m. The first problem found is
 /// reported as e.g. "segment 3: length must be positive, got -1" or "segment 0: angle must be finite, got nan".
 [[nodiscard]] Status validate(std::span<const Segment> segments);
 
