@@ -202,7 +202,9 @@ Aabb Chain::bounds(const Aabb& box) const {
         const double zb = std::min(hi, z_start_[i + 1]);
         if (za <= zb) cover(i, kappa_[i], za - z_start_[i], zb - z_start_[i]);
     }
-    if (hi > z_start_[n]) cover(n, 0.0, std::max(lo, z_start_[n]) - z_start_[n], hi - z_start_[n]);
+    // An empty chain has no segment to cover a flat box at z = 0: the end record does.
+    if (hi > z_start_[n] || (n == 0 && lo >= 0.0))
+        cover(n, 0.0, std::max(lo, z_start_[n]) - z_start_[n], hi - z_start_[n]);
     return result;
 }
 
