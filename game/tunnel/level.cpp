@@ -400,7 +400,7 @@ void Level::update_ropes(double dt_s) {
     // A gust front travels down the tunnel at kGustSpeed, one every period; ropes it passes are pushed toward
     // the tunnel axis (festoons) or along the tunnel (cross cables), bend, refine, straighten and coarsen.
     constexpr double kGustSpeed = 6.0;
-    constexpr double kGustAccel = 24.0;
+    constexpr double kGustAccel = 15.0;
     constexpr double kGustWidth = 1.4;
     const double period = (chain_.total_length_m() + 16.0) / kGustSpeed;
     const double gust_z = -6.0 + kGustSpeed * std::fmod(s.rope_time_s, period);
@@ -424,7 +424,7 @@ void Level::update_ropes(double dt_s) {
                 const glm::dvec3 anchor = s.anchors[e.anchor_a];
                 const bool across = e.anchor_b >= 4 && e.anchor_a < 4;  // from one wall to the other
                 const glm::dvec3 local_dir =
-                    glm::normalize(across ? glm::dvec3(0.0, 0.5, 1.0) : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
+                    glm::normalize(across ? glm::dvec3(0.0, 0.25, 1.0) : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
                 const glm::dvec3 dir = glm::dmat3(now) * local_dir;
                 field = [piece_from_world, dir, z0, gust_z](const glm::dvec3& p) {
                     const double z = z0 + (piece_from_world * glm::dvec4(p, 1.0)).z;
@@ -507,9 +507,11 @@ void Level::draw_pieces() {
         }
         ++stats_.piece_levels[static_cast<std::size_t>(levels[static_cast<std::size_t>(k)][0])];
     }
-    for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    // Front to back for early depth rejection (llvmpipe shades only what survives): details in front of the
+    // wall first, the wall last; near pieces (high levels) before far ones, instances in chain order.
+    for (std::size_t g : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{0}}) {
         const Group& group = s.groups[g];
-        for (int lvl = 0; lvl <= max_level; ++lvl) {
+        for (int lvl = max_level; lvl >= 0; --lvl) {
             s.bucket.clear();
             for (int k = 0; k < n; ++k)
                 if (levels[static_cast<std::size_t>(k)][g] == lvl) s.bucket.push_back(static_cast<float>(kPieceLength * k));
