@@ -40,6 +40,8 @@ struct Args {
     std::string spline = "catmull-rom";
     double lod_tolerance_px = 0.5;
     bool wireframe = false;
+    bool frames_given = false;   // window: close after `frames` frames
+    int screenshot_frame = -1;   // window: screenshot (with the panel) at this frame
 };
 
 std::string frame_png(const std::string& dir, uint64_t frame) {
@@ -161,7 +163,9 @@ int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
     auto last = std::chrono::steady_clock::now();
     double frame_ms = 0.0;
     int shots = 0;
+    int frame_index = 0;
     while (!ctx.should_close()) {
+        if (args.frames_given && frame_index >= args.frames) break;
         ctx.poll_events();
         const platform::Input& in = ctx.input();
         const bool keys = !ui->wants_keyboard();
@@ -199,6 +203,7 @@ int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
             requests.screenshot = false;
         }
         ui->draw(level, frame_ms, requests);
+        if (frame_index++ == args.screenshot_frame) requests.screenshot = true;
         if (requests.screenshot) {  // the panel's button: the frame with the panel
             char name[64];
             std::snprintf(name, sizeof name, "screenshot_%03d.png", shots++);
@@ -216,7 +221,10 @@ int main(int argc, char** argv) {
     Args args;
     CLI::App app{"tunnel: bent tunnel pieces with simulated and fixed cables (wire runtime demo level)"};
     app.add_flag("--headless", args.headless, "render off-screen (automatic when there is no display)");
-    app.add_option("--frames", args.frames, "headless: frames to render (default 120)")->check(CLI::PositiveNumber);
+    CLI::Option* frames = app.add_option("--frames", args.frames,
+                                         "frames to render (headless default 120; window: close after N frames)")
+                              ->check(CLI::PositiveNumber);
+    app.add_option("--screenshot-frame", args.screenshot_frame, "window: screenshot with the panel at frame K");
     app.add_option("--out", args.out, "headless: folder of the PNGs and stats.json; window: screenshots (default out/tunnel)");
     app.add_option("--capture-every", args.capture_every, "headless: also capture every K-th frame")->check(CLI::NonNegativeNumber);
     app.add_option("--width", args.width, "framebuffer width (default 1280)")->check(CLI::PositiveNumber);
@@ -232,6 +240,7 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_flag("--wireframe", args.wireframe, "draw wireframe");
     CLI11_PARSE(app, argc, argv);
+    args.frames_given = frames->count() > 0;
 
     platform::ContextDesc desc{.backend = args.headless ? platform::Backend::headless : platform::Backend::automatic,
                                .width = args.width,
