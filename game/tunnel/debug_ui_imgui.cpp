@@ -4,9 +4,9 @@
 #include "tunnel/debug_ui.hpp"
 
 #include <GLFW/glfw3.h>
-#include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 #include <cstdio>
 
@@ -45,7 +45,8 @@ public:
         const char* splines[] = {"Catmull-Rom (centripetal)", "C2 interpolating", "automatic", "linear"};
         if (ImGui::Combo("spline", &spline, splines, 4)) o.spline = static_cast<wire::SplineKind>(spline);
         float tolerance = static_cast<float>(o.lod_tolerance_px);
-        if (ImGui::SliderFloat("LOD tolerance px", &tolerance, 0.1f, 8.0f, "%.2f", ImGuiSliderFlags_Logarithmic))
+        if (ImGui::SliderFloat("LOD tolerance px", &tolerance, 0.1f, 8.0f, "%.2f",
+                               ImGuiSliderFlags_Logarithmic))
             o.lod_tolerance_px = tolerance;
         int path = o.upload_path == wire::UploadPath::gpu_rings ? 1 : 0;
         ImGui::RadioButton("cpu mesh", &path, 0);
@@ -65,7 +66,8 @@ public:
         float speed = static_cast<float>(o.flight_speed_mps);
         if (ImGui::SliderFloat("flight m/s", &speed, 0.0f, 10.0f)) o.flight_speed_mps = speed;
         float subdiv = static_cast<float>(o.subdivision_tolerance_px);
-        if (ImGui::SliderFloat("subdiv tolerance px", &subdiv, 0.25f, 16.0f, "%.2f", ImGuiSliderFlags_Logarithmic))
+        if (ImGui::SliderFloat("subdiv tolerance px", &subdiv, 0.25f, 16.0f, "%.2f",
+                               ImGuiSliderFlags_Logarithmic))
             o.subdivision_tolerance_px = subdiv;
         ImGui::SliderInt("max subdiv level", &o.max_subdivision_level, 0, 3);
         ImGui::Checkbox("pieces", &o.draw_pieces);
@@ -79,15 +81,17 @@ public:
         }
         if (ImGui::CollapsingHeader("counts", ImGuiTreeNodeFlags_DefaultOpen)) {
             ImGui::Text("wires %zu, drawn %zu, curves built %zu", s.wires, s.wires_drawn, s.curves_built);
-            ImGui::Text("wire vertices %zu, triangles %zu, rings %zu", s.wire_vertices, s.wire_triangles, s.rings);
+            ImGui::Text("wire vertices %zu, triangles %zu, rings %zu", s.wire_vertices, s.wire_triangles,
+                        s.rings);
             ImGui::Text("uploaded %.1f KiB (wires %.1f, segments %.1f)",
                         static_cast<double>(s.wire_bytes_uploaded + s.segment_bytes_uploaded) / 1024.0,
                         static_cast<double>(s.wire_bytes_uploaded) / 1024.0,
                         static_cast<double>(s.segment_bytes_uploaded) / 1024.0);
             ImGui::Text("tunnel triangles %zu, vertices %zu", s.piece_triangles, s.piece_vertices);
-            ImGui::Text("pieces per level: %d %d %d %d %d", s.piece_levels[0], s.piece_levels[1], s.piece_levels[2],
-                        s.piece_levels[3], s.piece_levels[4]);
-            ImGui::Text("rope nodes %zu (+%d -%d this frame)", s.rope_nodes, s.nodes_inserted, s.nodes_removed);
+            ImGui::Text("pieces per level: %d %d %d %d %d", s.piece_levels[0], s.piece_levels[1],
+                        s.piece_levels[2], s.piece_levels[3], s.piece_levels[4]);
+            ImGui::Text("rope nodes %zu (+%d -%d this frame)", s.rope_nodes, s.nodes_inserted,
+                        s.nodes_removed);
         }
         ImGui::End();
         ImGui::Render();
@@ -103,9 +107,10 @@ public:
     void draw(Level& level, double frame_ms, UiRequests&) override {
         if (++frames_ % 60 != 0) return;
         const LevelFrameStats& s = level.stats();
-        std::printf("frame %llu: %.1f ms, %zu/%zu wires, %zu wire vertices, %zu tunnel triangles, %zu rope nodes\n",
-                    static_cast<unsigned long long>(s.frame), frame_ms, s.wires_drawn, s.wires, s.wire_vertices,
-                    s.piece_triangles, s.rope_nodes);
+        std::printf(
+            "frame %llu: %.1f ms, %zu/%zu wires, %zu wire vertices, %zu tunnel triangles, %zu rope nodes\n",
+            static_cast<unsigned long long>(s.frame), frame_ms, s.wires_drawn, s.wires, s.wire_vertices,
+            s.piece_triangles, s.rope_nodes);
     }
     bool wants_mouse() const override { return false; }
     bool wants_keyboard() const override { return false; }

@@ -12,9 +12,10 @@ public:
     void draw(Level& level, double frame_ms, UiRequests&) override {
         if (++frames_ % 60 != 0) return;
         const LevelFrameStats& s = level.stats();
-        std::printf("frame %llu: %.1f ms, %zu/%zu wires, %zu wire vertices, %zu tunnel triangles, %zu rope nodes\n",
-                    static_cast<unsigned long long>(s.frame), frame_ms, s.wires_drawn, s.wires, s.wire_vertices,
-                    s.piece_triangles, s.rope_nodes);
+        std::printf(
+            "frame %llu: %.1f ms, %zu/%zu wires, %zu wire vertices, %zu tunnel triangles, %zu rope nodes\n",
+            static_cast<unsigned long long>(s.frame), frame_ms, s.wires_drawn, s.wires, s.wire_vertices,
+            s.piece_triangles, s.rope_nodes);
     }
     bool wants_mouse() const override { return false; }
     bool wants_keyboard() const override { return false; }
@@ -26,6 +27,8 @@ private:
 
 }  // namespace
 
-std::unique_ptr<DebugUi> DebugUi::create(engine::platform::Context&) { return std::make_unique<TextUi>(); }
+std::unique_ptr<DebugUi> DebugUi::create(engine::platform::Context&) {
+    return std::make_unique<TextUi>();
+}
 
 }  // namespace tunnel

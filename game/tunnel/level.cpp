@@ -14,8 +14,8 @@
 #include <wire/systems/systems.hpp>
 
 #include <glm/geometric.hpp>
-#include <glm/mat3x3.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat3x3.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -46,7 +46,7 @@ struct Group {
     std::vector<engine::assets::ControlMesh> controls{};
     engine::assets::RefinementErrorModel model{};
     std::vector<PieceRenderer::MeshHandle> meshes{};  // per level
-    std::vector<std::size_t> vertices{};            // per level
+    std::vector<std::size_t> vertices{};              // per level
 };
 
 struct SegmentAnimation {
@@ -91,7 +91,8 @@ void append(engine::assets::MeshData& dst, const engine::assets::MeshData& src) 
             src.origin + glm::dvec3(src.positions[3 * v], src.positions[3 * v + 1], src.positions[3 * v + 2]);
         dst.positions.insert(dst.positions.end(),
                              {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)});
-        dst.normals.insert(dst.normals.end(), {src.normals[3 * v], src.normals[3 * v + 1], src.normals[3 * v + 2]});
+        dst.normals.insert(dst.normals.end(),
+                           {src.normals[3 * v], src.normals[3 * v + 1], src.normals[3 * v + 2]});
         if (src.uvs.size() == 2 * src.vertex_count()) {
             dst.uvs.insert(dst.uvs.end(), {src.uvs[2 * v], src.uvs[2 * v + 1]});
         } else {
@@ -142,9 +143,15 @@ glm::dvec3 Level::rope_end(int piece, std::size_t anchor, double inset_m) const 
     return chain_.transform_point(p);
 }
 
-int Level::piece_count() const { return static_cast<int>(state_->segments.size()); }
-double Level::piece_length_m() const { return kPieceLength; }
-double Level::wall_radius_m() const { return kWallRadius; }
+int Level::piece_count() const {
+    return static_cast<int>(state_->segments.size());
+}
+double Level::piece_length_m() const {
+    return kPieceLength;
+}
+double Level::wall_radius_m() const {
+    return kWallRadius;
+}
 
 const wire::WireNodes& Level::cable_nodes(std::size_t cable) const {
     return state_->registry.get<wire::systems::Nodes>(cables_[cable].entity);
@@ -163,7 +170,8 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
     if (settings.bend_scale == 0.0) settings.bend_scale = 1.0;
     if (settings.asset_dir.empty()) settings.asset_dir = TUNNEL_ASSET_DIR;
     if (settings.max_subdivision_level < 0) settings.max_subdivision_level = 3;
-    settings.max_subdivision_level = std::min(settings.max_subdivision_level, engine::assets::kMaxSubdivisionLevel);
+    settings.max_subdivision_level =
+        std::min(settings.max_subdivision_level, engine::assets::kMaxSubdivisionLevel);
     if (settings.prewarm_s == 0.0) settings.prewarm_s = 3.0;
 
     std::unique_ptr<Level> level(new Level());
@@ -187,11 +195,11 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
                 {.name = "walkway", .surface = Surface::grating, .albedo = {0.55f, 0.50f, 0.42f}},
                 {.name = "hooks", .surface = Surface::steel, .albedo = {0.90f, 0.72f, 0.12f}}};
     for (const engine::assets::MeshData& m : meshes) {
-        Group* g = m.name == "tunnel_wall"            ? &s.groups[0]
-                   : m.name.rfind("rib_", 0) == 0     ? &s.groups[1]
-                   : m.name == "walkway"              ? &s.groups[2]
-                   : m.name.rfind("anchor_", 0) == 0  ? &s.groups[3]
-                                                      : nullptr;
+        Group* g = m.name == "tunnel_wall"           ? &s.groups[0]
+                   : m.name.rfind("rib_", 0) == 0    ? &s.groups[1]
+                   : m.name == "walkway"             ? &s.groups[2]
+                   : m.name.rfind("anchor_", 0) == 0 ? &s.groups[3]
+                                                     : nullptr;
         if (g == nullptr) continue;
         engine::assets::ControlMesh control;
         if (auto st = engine::assets::make_control_mesh(m, control); !st.ok()) return Error{st.message};
@@ -267,28 +275,34 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
         uint32_t material;
         float radius;
     };
-    const FixedSpec fixed_specs[] = {
-        {hook.x, hook.y, rubber, 0.035f},  {-hook.x, hook.y, blue, 0.03f},
-        {hook.x + 0.02, hook.y + 0.075, copper, 0.022f}, {-hook.x - 0.02, hook.y + 0.075, red, 0.022f},
-        {-2.02, 1.05, yellow, 0.025f},      {2.02, 1.05, rubber, 0.03f}};
+    const FixedSpec fixed_specs[] = {{hook.x, hook.y, rubber, 0.035f},
+                                     {-hook.x, hook.y, blue, 0.03f},
+                                     {hook.x + 0.02, hook.y + 0.075, copper, 0.022f},
+                                     {-hook.x - 0.02, hook.y + 0.075, red, 0.022f},
+                                     {-2.02, 1.05, yellow, 0.025f},
+                                     {2.02, 1.05, rubber, 0.03f}};
     for (const FixedSpec& f : fixed_specs) {
         wire::WireNodes nodes;
-        for (double z = 0.0; z <= total + 1e-9; z += 0.5) nodes.positions.push_back(level->chain_.transform_point({f.x, f.y, z}));
-        const auto e = wire::systems::spawn_wire(s.registry, std::move(nodes), {.radius_m = f.radius, .material = f.material});
+        for (double z = 0.0; z <= total + 1e-9; z += 0.5)
+            nodes.positions.push_back(level->chain_.transform_point({f.x, f.y, z}));
+        const auto e = wire::systems::spawn_wire(s.registry, std::move(nodes),
+                                                 {.radius_m = f.radius, .material = f.material});
         s.fixed.push_back({f.x, f.y, level->cables_.size()});
-        level->cables_.push_back({.entity = e, .hanging = false, .material = f.material, .radius_m = f.radius});
+        level->cables_.push_back(
+            {.entity = e, .hanging = false, .material = f.material, .radius_m = f.radius});
     }
 
     // ---- hanging cables: festoons between the hooks of each wall, and a few across the tunnel ----
-    auto add_rope = [&](int pa, std::size_t aa, int pb, std::size_t ab, double inset, double slack, uint32_t material,
-                        float radius) {
+    auto add_rope = [&](int pa, std::size_t aa, int pb, std::size_t ab, double inset, double slack,
+                        uint32_t material, float radius) {
         const glm::dvec3 a = level->rope_end(pa, aa, inset);
         const glm::dvec3 b = level->rope_end(pb, ab, inset);
         const double length = glm::length(b - a) * slack;
         level->ropes_.emplace_back(a, b, length, 8);
         wire::WireNodes nodes;
         level->ropes_.back().write_nodes(nodes);
-        const auto e = wire::systems::spawn_wire(s.registry, std::move(nodes), {.radius_m = radius, .material = material});
+        const auto e = wire::systems::spawn_wire(s.registry, std::move(nodes),
+                                                 {.radius_m = radius, .material = material});
         s.rope_ends.push_back({pa, aa, pb, ab, level->cables_.size(),
                                level->chain_.world_from_segment(static_cast<std::size_t>(pa)), inset});
         level->cables_.push_back({.entity = e,
@@ -300,13 +314,14 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
     };
     for (int k = 0; k < settings.pieces; ++k) {
         // Festoons hang from the hook lips, shallow enough to stay clear of the ribs (inner radius ~2.2 m).
-        add_rope(k, 0, k, 3, 0.1, 1.03 + 0.02 * hash01(static_cast<uint32_t>(k) + 101u), k % 2 == 0 ? orange : rubber,
-                 0.02f);
-        add_rope(k, 4, k, 7, 0.1, 1.03 + 0.02 * hash01(static_cast<uint32_t>(k) + 202u), k % 2 == 0 ? rubber : red,
-                 0.02f);
+        add_rope(k, 0, k, 3, 0.1, 1.03 + 0.02 * hash01(static_cast<uint32_t>(k) + 101u),
+                 k % 2 == 0 ? orange : rubber, 0.02f);
+        add_rope(k, 4, k, 7, 0.1, 1.03 + 0.02 * hash01(static_cast<uint32_t>(k) + 202u),
+                 k % 2 == 0 ? rubber : red, 0.02f);
         // Cables across the tunnel (every other piece), and a diagonal one now and then.
-        if (k % 2 == 1) add_rope(k, 1 + static_cast<std::size_t>(k % 4 == 1), k, 5 + static_cast<std::size_t>(k % 4 == 1), 0.0,
-                                 1.10, k % 4 == 1 ? yellow : orange, 0.025f);
+        if (k % 2 == 1)
+            add_rope(k, 1 + static_cast<std::size_t>(k % 4 == 1), k, 5 + static_cast<std::size_t>(k % 4 == 1),
+                     0.0, 1.10, k % 4 == 1 ? yellow : orange, 0.025f);
         if (k % 4 == 2) add_rope(k, 0, k, 7, 0.0, 1.06, blue, 0.02f);
     }
 
@@ -331,10 +346,13 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
     schedule.add("tunnel.ropes", [self](engine::ecs::Registry&, const engine::ecs::FrameContext& ctx) {
         self->update_ropes(ctx.dt_s);
     });
-    schedule.add("tunnel.cables", [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->update_cables(); });
+    schedule.add("tunnel.cables",
+                 [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->update_cables(); });
     wire::systems::install(schedule, s.context);
-    schedule.add("tunnel.pieces", [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->draw_pieces(); });
-    schedule.add("wire.render", [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->draw_wires(); });
+    schedule.add("tunnel.pieces",
+                 [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->draw_pieces(); });
+    schedule.add("wire.render",
+                 [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->draw_wires(); });
     level->schedule_ = std::move(schedule);
     return level;
 }
@@ -423,8 +441,8 @@ void Level::update_ropes(double dt_s) {
                 const glm::dmat4 piece_from_world = glm::inverse(now);
                 const glm::dvec3 anchor = s.anchors[e.anchor_a];
                 const bool across = e.anchor_b >= 4 && e.anchor_a < 4;  // from one wall to the other
-                const glm::dvec3 local_dir =
-                    glm::normalize(across ? glm::dvec3(0.0, 0.25, 1.0) : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
+                const glm::dvec3 local_dir = glm::normalize(
+                    across ? glm::dvec3(0.0, 0.25, 1.0) : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
                 const glm::dvec3 dir = glm::dmat3(now) * local_dir;
                 field = [piece_from_world, dir, z0, gust_z](const glm::dvec3& p) {
                     const double z = z0 + (piece_from_world * glm::dvec4(p, 1.0)).z;
@@ -473,8 +491,10 @@ void Level::draw_pieces() {
                      .wireframe = options_.wireframe};
     stats_.segment_bytes_uploaded = s.pieces.begin(frame);
 
-    // Per piece: visible? and the level its bend and its distance on screen need (the caches hold every level).
-    const engine::scene::Frustum frustum = engine::scene::Frustum::from_view_projection(camera_.view_projection());
+    // Per piece: visible? and the level its bend and its distance on screen need (the caches hold every
+    // level).
+    const engine::scene::Frustum frustum =
+        engine::scene::Frustum::from_view_projection(camera_.view_projection());
     const double focal_px = camera_.focal_px(static_cast<float>(s.height_px));
     const int max_level = std::clamp(options_.max_subdivision_level, 0, s.settings.max_subdivision_level);
     const int n = piece_count();
@@ -494,9 +514,11 @@ void Level::draw_pieces() {
             const glm::dvec3 v = eye - c;
             const double along = std::max(0.0, std::abs(glm::dot(v, t)) - 0.5 * kPieceLength / kSamples);
             const double radial = glm::length(v - glm::dot(v, t) * t);
-            distance = std::min(distance, std::sqrt(along * along + (kWallRadius - radial) * (kWallRadius - radial)));
+            distance = std::min(distance,
+                                std::sqrt(along * along + (kWallRadius - radial) * (kWallRadius - radial)));
         }
-        const double curvature = std::abs(chain_.segment(static_cast<std::size_t>(k)).angle_rad) / kPieceLength;
+        const double curvature =
+            std::abs(chain_.segment(static_cast<std::size_t>(k)).angle_rad) / kPieceLength;
         for (std::size_t g = 0; g < s.groups.size(); ++g) {
             levels[static_cast<std::size_t>(k)][g] = engine::assets::choose_subdivision_level(
                 s.groups[g].model, {.curvature_per_m = curvature,
@@ -514,7 +536,8 @@ void Level::draw_pieces() {
         for (int lvl = max_level; lvl >= 0; --lvl) {
             s.bucket.clear();
             for (int k = 0; k < n; ++k)
-                if (levels[static_cast<std::size_t>(k)][g] == lvl) s.bucket.push_back(static_cast<float>(kPieceLength * k));
+                if (levels[static_cast<std::size_t>(k)][g] == lvl)
+                    s.bucket.push_back(static_cast<float>(kPieceLength * k));
             if (s.bucket.empty()) continue;
             const PieceRenderer::MeshHandle mesh = group.meshes[static_cast<std::size_t>(lvl)];
             s.pieces.draw(mesh, group.surface, group.albedo, s.bucket);

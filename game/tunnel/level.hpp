@@ -1,6 +1,6 @@
 // The tunnel level: a chain of curved-space segments whose bends animate slowly, the tunnel pieces
-// (wall, ribs, walkway, cable hooks) instanced along it and bent on the GPU at the subdivision level each piece
-// needs, cables fixed along the bent walls, hanging cables simulated as ropes that refine and coarsen
+// (wall, ribs, walkway, cable hooks) instanced along it and bent on the GPU at the subdivision level each
+// piece needs, cables fixed along the bent walls, hanging cables simulated as ropes that refine and coarsen
 // themselves, and a camera flying along the bent centre line. Everything runs as named systems of one
 // engine::ecs::Schedule (timed per system):
 //   tunnel.animate  segment angles at time t -> Chain; fly camera; wire context camera/viewport
@@ -57,12 +57,13 @@ struct LevelOptions {
     bool pop_free = true;
     bool animate_bends = true;
     bool simulate_ropes = true;
-    bool adapt_ropes = true;        ///< node insertion/removal on the hanging cables
-    bool gusts = true;              ///< gusts of wind travel down the tunnel and swing the hanging cables
+    bool adapt_ropes = true;  ///< node insertion/removal on the hanging cables
+    bool gusts = true;        ///< gusts of wind travel down the tunnel and swing the hanging cables
     bool draw_pieces = true;
     bool draw_wires = true;
     double subdivision_tolerance_px = 1.0;
-    int max_subdivision_level = 3;  ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
+    int max_subdivision_level =
+        3;  ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
     double flight_speed_mps = 2.5;
     CameraMode camera_mode = CameraMode::fly;
 };
@@ -72,15 +73,15 @@ struct LevelFrameStats {
     uint64_t frame = 0;
     double time_s = 0.0;
     std::size_t wires = 0;
-    std::size_t wires_drawn = 0;       ///< draw items the wire renderer drew
-    std::size_t wire_vertices = 0;     ///< cpu_mesh: uploaded; gpu_rings: expanded by the vertex shader
+    std::size_t wires_drawn = 0;    ///< draw items the wire renderer drew
+    std::size_t wire_vertices = 0;  ///< cpu_mesh: uploaded; gpu_rings: expanded by the vertex shader
     std::size_t wire_triangles = 0;
     std::size_t wire_bytes_uploaded = 0;
     std::size_t segment_bytes_uploaded = 0;  ///< curved-space segment records (SSBO)
-    std::size_t piece_triangles = 0;   ///< tunnel triangles drawn
-    std::size_t piece_vertices = 0;    ///< tunnel vertices drawn (bent by the vertex shader)
-    std::size_t rope_nodes = 0;        ///< nodes of all hanging cables
-    int nodes_inserted = 0;            ///< by the rope adaptation this frame
+    std::size_t piece_triangles = 0;         ///< tunnel triangles drawn
+    std::size_t piece_vertices = 0;          ///< tunnel vertices drawn (bent by the vertex shader)
+    std::size_t rope_nodes = 0;              ///< nodes of all hanging cables
+    int nodes_inserted = 0;                  ///< by the rope adaptation this frame
     int nodes_removed = 0;
     std::array<int, 8> piece_levels{};  ///< pieces per subdivision level (wall)
     std::size_t curves_built = 0;

@@ -1,6 +1,6 @@
-// build/bin/tunnel: the tunnel level. In a window: fly-through (Tab: free camera), debug panel, F12 screenshot.
-// Headless (--headless, or automatically without a display): renders N frames at a fixed step, writes PNGs of
-// chosen frames and DIR/stats.json (see tunnel/stats_json.hpp).
+// build/bin/tunnel: the tunnel level. In a window: fly-through (Tab: free camera), debug panel, F12
+// screenshot. Headless (--headless, or automatically without a display): renders N frames at a fixed step,
+// writes PNGs of chosen frames and DIR/stats.json (see tunnel/stats_json.hpp).
 //   tunnel [--headless] [--frames N] [--out DIR] [--capture-every K] [--width W] [--height H]
 #include "tunnel/debug_ui.hpp"
 #include "tunnel/level.hpp"
@@ -40,8 +40,8 @@ struct Args {
     std::string spline = "catmull-rom";
     double lod_tolerance_px = 0.5;
     bool wireframe = false;
-    bool frames_given = false;   // window: close after `frames` frames
-    int screenshot_frame = -1;   // window: screenshot (with the panel) at this frame
+    bool frames_given = false;  // window: close after `frames` frames
+    int screenshot_frame = -1;  // window: screenshot (with the panel) at this frame
 };
 
 std::string frame_png(const std::string& dir, uint64_t frame) {
@@ -62,7 +62,8 @@ struct FreeCamera {
         pitch = std::asin(glm::clamp(f.y, -1.0f, 1.0f));
         yaw = std::atan2(f.x, -f.z);
     }
-    void update(const platform::Input& in, double dt, bool mouse_free, bool keys_free, engine::scene::Camera& c) {
+    void update(const platform::Input& in, double dt, bool mouse_free, bool keys_free,
+                engine::scene::Camera& c) {
         if (mouse_free && in.down(platform::MouseButton::right)) {
             yaw += 0.003f * static_cast<float>(in.mouse_dx_px);
             pitch = glm::clamp(pitch - 0.003f * static_cast<float>(in.mouse_dy_px), -1.5f, 1.5f);
@@ -100,7 +101,8 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
         ctx.begin_frame();
         const auto start = std::chrono::steady_clock::now();
         level.frame(args.dt_s);
-        frame_ms_sum += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        frame_ms_sum +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         frames.push_back(tunnel::frame_record(level.stats(), level.system_stats(), non_finite));
         inserted += level.stats().nodes_inserted;
         removed += level.stats().nodes_removed;
@@ -120,21 +122,20 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
         mean[st.name] = std::isfinite(st.mean_ms) ? st.mean_ms : -1.0;
         max[st.name] = std::isfinite(st.max_ms) ? st.max_ms : -1.0;
     }
-    const nlohmann::json doc = {
-        {"frames", frames},
-        {"summary",
-         {{"frames", args.frames},
-          {"width", ctx.framebuffer_size().width},
-          {"height", ctx.framebuffer_size().height},
-          {"dt_s", args.dt_s},
-          {"systems_mean_ms", mean},
-          {"systems_max_ms", max},
-          {"frame_ms_mean", args.frames > 0 ? frame_ms_sum / args.frames : 0.0},
-          {"nodes_inserted", inserted},
-          {"nodes_removed", removed},
-          {"non_finite", non_finite},
-          {"images", written},
-          {"gl_renderer", ctx.gl_renderer()}}}};
+    const nlohmann::json doc = {{"frames", frames},
+                                {"summary",
+                                 {{"frames", args.frames},
+                                  {"width", ctx.framebuffer_size().width},
+                                  {"height", ctx.framebuffer_size().height},
+                                  {"dt_s", args.dt_s},
+                                  {"systems_mean_ms", mean},
+                                  {"systems_max_ms", max},
+                                  {"frame_ms_mean", args.frames > 0 ? frame_ms_sum / args.frames : 0.0},
+                                  {"nodes_inserted", inserted},
+                                  {"nodes_removed", removed},
+                                  {"non_finite", non_finite},
+                                  {"images", written},
+                                  {"gl_renderer", ctx.gl_renderer()}}}};
     const std::string stats_path = (std::filesystem::path(args.out) / "stats.json").string();
     std::ofstream out(stats_path);
     out << doc.dump(1) << "\n";
@@ -154,11 +155,13 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
 
 int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
     auto ui = tunnel::DebugUi::create(ctx);
-    std::printf("tunnel: window %dx%d on %s, panel: %s\n"
-                "  keys: Tab free/fly camera, WASD/arrows + right mouse drag (free camera), Q/E down/up, shift fast,\n"
-                "        P pause bends, F1 wireframe, F12 screenshot (%s), Esc quit\n",
-                ctx.framebuffer_size().width, ctx.framebuffer_size().height, ctx.gl_renderer().c_str(), ui->kind(),
-                args.out.c_str());
+    std::printf(
+        "tunnel: window %dx%d on %s, panel: %s\n"
+        "  keys: Tab free/fly camera, WASD/arrows + right mouse drag (free camera), Q/E down/up, shift "
+        "fast,\n"
+        "        P pause bends, F1 wireframe, F12 screenshot (%s), Esc quit\n",
+        ctx.framebuffer_size().width, ctx.framebuffer_size().height, ctx.gl_renderer().c_str(), ui->kind(),
+        args.out.c_str());
     FreeCamera free_camera;
     auto last = std::chrono::steady_clock::now();
     double frame_ms = 0.0;
@@ -172,7 +175,8 @@ int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
         tunnel::LevelOptions& o = level.options();
         if (keys && in.pressed(platform::Key::escape)) ctx.request_close();
         if (keys && in.pressed(platform::Key::tab)) {
-            o.camera_mode = o.camera_mode == tunnel::CameraMode::fly ? tunnel::CameraMode::free : tunnel::CameraMode::fly;
+            o.camera_mode =
+                o.camera_mode == tunnel::CameraMode::fly ? tunnel::CameraMode::free : tunnel::CameraMode::fly;
             if (o.camera_mode == tunnel::CameraMode::free) free_camera.take(level.camera());
         }
         if (keys && in.pressed(platform::Key::p)) o.animate_bends = !o.animate_bends;
@@ -188,7 +192,8 @@ int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
         ctx.begin_frame();
         const auto start = std::chrono::steady_clock::now();
         level.frame(dt);
-        frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        frame_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         tunnel::UiRequests requests;
         requests.screenshot = keys && in.pressed(platform::Key::f12);
         if (requests.screenshot) {  // the scene without the panel
@@ -221,15 +226,20 @@ int main(int argc, char** argv) {
     Args args;
     CLI::App app{"tunnel: bent tunnel pieces with simulated and fixed cables (wire runtime demo level)"};
     app.add_flag("--headless", args.headless, "render off-screen (automatic when there is no display)");
-    CLI::Option* frames = app.add_option("--frames", args.frames,
-                                         "frames to render (headless default 120; window: close after N frames)")
-                              ->check(CLI::PositiveNumber);
-    app.add_option("--screenshot-frame", args.screenshot_frame, "window: screenshot with the panel at frame K");
-    app.add_option("--out", args.out, "headless: folder of the PNGs and stats.json; window: screenshots (default out/tunnel)");
-    app.add_option("--capture-every", args.capture_every, "headless: also capture every K-th frame")->check(CLI::NonNegativeNumber);
+    CLI::Option* frames =
+        app.add_option("--frames", args.frames,
+                       "frames to render (headless default 120; window: close after N frames)")
+            ->check(CLI::PositiveNumber);
+    app.add_option("--screenshot-frame", args.screenshot_frame,
+                   "window: screenshot with the panel at frame K");
+    app.add_option("--out", args.out,
+                   "headless: folder of the PNGs and stats.json; window: screenshots (default out/tunnel)");
+    app.add_option("--capture-every", args.capture_every, "headless: also capture every K-th frame")
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--width", args.width, "framebuffer width (default 1280)")->check(CLI::PositiveNumber);
     app.add_option("--height", args.height, "framebuffer height (default 720)")->check(CLI::PositiveNumber);
-    app.add_option("--dt", args.dt_s, "headless: fixed time step in seconds (default 1/30)")->check(CLI::PositiveNumber);
+    app.add_option("--dt", args.dt_s, "headless: fixed time step in seconds (default 1/30)")
+        ->check(CLI::PositiveNumber);
     app.add_option("--pieces", args.pieces, "tunnel pieces of 4 m (default 16)")->check(CLI::Range(2, 256));
     app.add_option("--seed", args.seed, "seed of the bend animation (default 1)");
     app.add_option("--path", args.path, "wire upload path: cpu (meshes) or gpu (ring records)")
@@ -242,10 +252,11 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     args.frames_given = frames->count() > 0;
 
-    platform::ContextDesc desc{.backend = args.headless ? platform::Backend::headless : platform::Backend::automatic,
-                               .width = args.width,
-                               .height = args.height,
-                               .title = "tunnel"};
+    platform::ContextDesc desc{
+        .backend = args.headless ? platform::Backend::headless : platform::Backend::automatic,
+        .width = args.width,
+        .height = args.height,
+        .title = "tunnel"};
     auto ctx = platform::create_context(desc);
     if (!ctx) {
         std::fprintf(stderr, "tunnel: %s\n", ctx.error().message.c_str());

@@ -152,7 +152,8 @@ PieceRenderer& PieceRenderer::operator=(PieceRenderer&&) noexcept = default;
 PieceRenderer::~PieceRenderer() = default;
 
 Expected<PieceRenderer> PieceRenderer::create() {
-    const std::string vertex = std::string(kVertexHead) + std::string(curved_space::glsl_bend_source()) + kVertexBody;
+    const std::string vertex =
+        std::string(kVertexHead) + std::string(curved_space::glsl_bend_source()) + kVertexBody;
     Expected<gfx::Program> program =
         gfx::make_program({.vertex = vertex, .fragment = kFragment, .label = "tunnel pieces"});
     if (!program) return program.error();
@@ -164,15 +165,16 @@ Expected<PieceRenderer> PieceRenderer::create() {
 }
 
 Expected<PieceRenderer::MeshHandle> PieceRenderer::add_mesh(const engine::assets::MeshData& mesh,
-                                                             std::string_view label) {
+                                                            std::string_view label) {
     const std::size_t n = mesh.vertex_count();
     std::vector<float> interleaved;
     interleaved.reserve(n * 8);
     for (std::size_t v = 0; v < n; ++v) {
         const glm::dvec3 p = mesh.origin + glm::dvec3(mesh.positions[3 * v], mesh.positions[3 * v + 1],
                                                       mesh.positions[3 * v + 2]);
-        interleaved.insert(interleaved.end(), {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
-                                               mesh.normals[3 * v], mesh.normals[3 * v + 1], mesh.normals[3 * v + 2]});
+        interleaved.insert(interleaved.end(),
+                           {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z),
+                            mesh.normals[3 * v], mesh.normals[3 * v + 1], mesh.normals[3 * v + 2]});
         if (mesh.uvs.size() == 2 * n) {
             interleaved.insert(interleaved.end(), {mesh.uvs[2 * v], mesh.uvs[2 * v + 1]});
         } else {
@@ -198,7 +200,9 @@ Expected<PieceRenderer::MeshHandle> PieceRenderer::add_mesh(const engine::assets
     return static_cast<MeshHandle>(state_->meshes.size() - 1);
 }
 
-std::size_t PieceRenderer::triangle_count(MeshHandle mesh) const { return state_->meshes[mesh].index_count / 3; }
+std::size_t PieceRenderer::triangle_count(MeshHandle mesh) const {
+    return state_->meshes[mesh].index_count / 3;
+}
 
 std::size_t PieceRenderer::begin(const PieceFrame& frame) {
     State& s = *state_;
@@ -230,7 +234,8 @@ std::size_t PieceRenderer::begin(const PieceFrame& frame) {
     return bytes;
 }
 
-void PieceRenderer::draw(MeshHandle mesh, Surface surface, const glm::vec3& albedo, std::span<const float> piece_z_m) {
+void PieceRenderer::draw(MeshHandle mesh, Surface surface, const glm::vec3& albedo,
+                         std::span<const float> piece_z_m) {
     State& s = *state_;
     const GpuPieceMesh& m = s.meshes[mesh];
     s.program.set("u_albedo", albedo);
@@ -238,7 +243,8 @@ void PieceRenderer::draw(MeshHandle mesh, Surface surface, const glm::vec3& albe
     m.vao.bind();
     for (std::size_t first = 0; first < piece_z_m.size(); first += kMaxInstances) {
         const std::size_t count = std::min<std::size_t>(kMaxInstances, piece_z_m.size() - first);
-        glProgramUniform1fv(s.program.id(), s.loc_piece_z, static_cast<GLsizei>(count), piece_z_m.data() + first);
+        glProgramUniform1fv(s.program.id(), s.loc_piece_z, static_cast<GLsizei>(count),
+                            piece_z_m.data() + first);
         glDrawElementsInstanced(GL_TRIANGLES, static_cast<GLsizei>(m.index_count), GL_UNSIGNED_INT, nullptr,
                                 static_cast<GLsizei>(count));
     }

@@ -1,7 +1,7 @@
-// Draws the tunnel's environment pieces bent along the curved space on the GPU: each refined piece mesh is laid
-// along +z once and drawn instanced, instance k shifted to its piece's start z and bent in the vertex shader by
-// curved_space's cs_bend() with the frame's segment records (camera-relative SSBO). The only tunnel file that
-// touches GL.
+// Draws the tunnel's environment pieces bent along the curved space on the GPU: each refined piece mesh is
+// laid along +z once and drawn instanced, instance k shifted to its piece's start z and bent in the vertex
+// shader by curved_space's cs_bend() with the frame's segment records (camera-relative SSBO). The only tunnel
+// file that touches GL.
 #pragma once
 
 #include <curved_space/gpu.hpp>
@@ -32,7 +32,7 @@ enum class Surface : int {
 /// The frame's lights and view. Lamps hang on the tunnel ceiling every lamp_spacing_m (unbent z), lighting
 /// the walls in warm pools; the camera carries a head lamp; fog fades toward fog_color.
 struct PieceFrame {
-    glm::mat4 clip_from_rel{1.0f};      ///< projection * camera rotation (positions are camera-relative)
+    glm::mat4 clip_from_rel{1.0f};  ///< projection * camera rotation (positions are camera-relative)
     std::span<const curved_space::GpuSegment> segments{};
     glm::vec3 to_light{0.3f, 1.0f, 0.5f};
     glm::vec3 fog_color{0.02f, 0.025f, 0.035f};

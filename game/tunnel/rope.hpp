@@ -19,17 +19,17 @@ namespace tunnel {
 
 /// Zero means default (the value in the comment).
 struct RopeSettings {
-    double gravity_mps2 = 0.0;         ///< 9.81, along -y
-    double damping = 0.0;              ///< velocity kept per second, 0 -> 0.35 (the rest decays)
-    int substeps = 0;                  ///< per step(), 0 -> 4
-    int iterations = 0;                ///< constraint passes per substep, 0 -> 12
-    double refine_angle_rad = 0.0;     ///< insert where consecutive elements turn more than this; 0 -> 0.30
-    double coarsen_angle_rad = 0.0;    ///< remove a node whose elements (and neighbours') turn less; 0 -> 0.12
-                                       ///< (merging two such elements turns < 2 * 0.12 < refine: no thrashing)
-    double min_element_m = 0.0;        ///< never split an element below 2 * this; 0 -> 0.08
-    double max_element_m = 0.0;        ///< never merge into an element longer than this; 0 -> 1.2
-    std::size_t max_nodes = 0;         ///< 0 -> 96
-    int max_changes_per_adapt = 0;     ///< insertions + removals per adapt(), 0 -> 2
+    double gravity_mps2 = 0.0;       ///< 9.81, along -y
+    double damping = 0.0;            ///< velocity kept per second, 0 -> 0.35 (the rest decays)
+    int substeps = 0;                ///< per step(), 0 -> 4
+    int iterations = 0;              ///< constraint passes per substep, 0 -> 12
+    double refine_angle_rad = 0.0;   ///< insert where consecutive elements turn more than this; 0 -> 0.30
+    double coarsen_angle_rad = 0.0;  ///< remove a node whose elements (and neighbours') turn less; 0 -> 0.12
+                                     ///< (merging two such elements turns < 2 * 0.12 < refine: no thrashing)
+    double min_element_m = 0.0;      ///< never split an element below 2 * this; 0 -> 0.08
+    double max_element_m = 0.0;      ///< never merge into an element longer than this; 0 -> 1.2
+    std::size_t max_nodes = 0;       ///< 0 -> 96
+    int max_changes_per_adapt = 0;   ///< insertions + removals per adapt(), 0 -> 2
 };
 
 /// What adapt() did.
@@ -42,7 +42,8 @@ class Rope {
 public:
     /// A rope of rest length `length_m` between `a` and `b` (both pinned) with `nodes` >= 2 nodes, laid on a
     /// parabola sagging below the chord. Ids are first_id, first_id + 1, ...
-    Rope(const glm::dvec3& a, const glm::dvec3& b, double length_m, int nodes, const RopeSettings& settings = {});
+    Rope(const glm::dvec3& a, const glm::dvec3& b, double length_m, int nodes,
+         const RopeSettings& settings = {});
 
     /// Moves every node rigidly by `delta` (e.g. the motion of the tunnel piece the rope hangs in since the
     /// last frame), velocities included: the rope then only reacts to motion relative to its piece.

@@ -1,10 +1,10 @@
-// stats.json of `tunnel --headless`: one record per frame (per-system milliseconds from the ECS schedule, wires
-// drawn, vertices, bytes uploaded, rope node changes, subdivision levels) plus the run's summary.
+// stats.json of `tunnel --headless`: one record per frame (per-system milliseconds from the ECS schedule,
+// wires drawn, vertices, bytes uploaded, rope node changes, subdivision levels) plus the run's summary.
 //   {"frames": [{"frame": 0, "time_s": 0.033, "systems_ms": {"tunnel.animate": 0.02, ...},
-//                "wires": 43, "wires_drawn": 38, "wire_vertices": 51234, "wire_triangles": ..., "piece_triangles": ...,
-//                "piece_vertices": ..., "bytes_uploaded": ..., "wire_bytes_uploaded": ...,
-//                "segment_bytes_uploaded": ..., "rope_nodes": ..., "nodes_inserted": 1, "nodes_removed": 0,
-//                "curves_built": ..., "rings": ..., "piece_levels": [0, 3, 2, 1, 0, 0, 0, 0]}, ...],
+//                "wires": 43, "wires_drawn": 38, "wire_vertices": 51234, "wire_triangles": ...,
+//                "piece_triangles": ..., "piece_vertices": ..., "bytes_uploaded": ..., "wire_bytes_uploaded":
+//                ..., "segment_bytes_uploaded": ..., "rope_nodes": ..., "nodes_inserted": 1, "nodes_removed":
+//                0, "curves_built": ..., "rings": ..., "piece_levels": [0, 3, 2, 1, 0, 0, 0, 0]}, ...],
 //    "summary": {"frames": 120, "width": 1280, "height": 720, "dt_s": 0.0333, "systems_mean_ms": {...},
 //                "systems_max_ms": {...}, "frame_ms_mean": ..., "nodes_inserted": ..., "nodes_removed": ...,
 //                "gl_renderer": "llvmpipe ..."}}
@@ -21,8 +21,8 @@
 namespace tunnel {
 
 /// One frame's record (see above). `non_finite` counts values that were not finite.
-[[nodiscard]] nlohmann::json frame_record(const LevelFrameStats& stats, std::span<const engine::ecs::SystemStats> systems,
-                                          int& non_finite);
+[[nodiscard]] nlohmann::json frame_record(const LevelFrameStats& stats,
+                                          std::span<const engine::ecs::SystemStats> systems, int& non_finite);
 
 /// True if every number in `doc` (recursively) is finite.
 [[nodiscard]] bool all_finite(const nlohmann::json& doc);

@@ -169,11 +169,13 @@ TEST(TunnelSystem, WallsAndCablesWhereExpected) {
                                   c[0] + 4 >= c[2] && std::abs(c[0] - c[2]) < 80;
             wall_coloured += concrete;
             if (!concrete)
-                std::printf("wall probe at %d,%d (z %.1f, %.0f deg): rgb %d %d %d\n", px.x, px.y, z, deg, c[0], c[1], c[2]);
+                std::printf("wall probe at %d,%d (z %.1f, %.0f deg): rgb %d %d %d\n", px.x, px.y, z, deg,
+                            c[0], c[1], c[2]);
         }
     }
     EXPECT_GE(probes, 20);
-    EXPECT_GE(wall_coloured, probes * 9 / 10) << wall_coloured << " of " << probes << " wall probes are concrete";
+    EXPECT_GE(wall_coloured, probes * 9 / 10)
+        << wall_coloured << " of " << probes << " wall probes are concrete";
 
     // Cables: the nearest cable across the tunnel in front of the camera, and the high fixed cables.
     auto coverage = [&](std::size_t cable, int& samples) {
@@ -308,7 +310,8 @@ TEST(TunnelSystem, RopeInsertsNodesOnTheCurrentCurve) {
             EXPECT_GT(rope.ids()[i], *std::max_element(old_ids.begin(), old_ids.end()));
             double best = 1e30;
             for (const wire::CubicBezier& seg : curve.segments)
-                for (int k = 0; k <= 2000; ++k) best = std::min(best, glm::length(wire::position(seg, k / 2000.0) - rope.positions()[i]));
+                for (int k = 0; k <= 2000; ++k)
+                    best = std::min(best, glm::length(wire::position(seg, k / 2000.0) - rope.positions()[i]));
             EXPECT_LT(best, 2e-3) << "new node " << rope.ids()[i] << " is off the curve";
         }
     }
