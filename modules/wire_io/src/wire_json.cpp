@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -40,10 +41,17 @@ struct Where {
 
 const char* type_name(const json& j) { return j.type_name(); }
 
+// A value as the user wrote it: %.9g, not std::to_string's fixed 6 decimals (which shows -1e-9 as -0.000000).
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
+}
+
 double finite_number(const json& j, const Where& at, const std::string& what) {
     if (!j.is_number()) at.fail(what + " must be a number, got " + type_name(j));
     const double v = j.get<double>();
-    if (!std::isfinite(v)) at.fail(what + " is not finite (" + std::to_string(v) + ")");
+    if (!std::isfinite(v)) at.fail(what + " is not finite (" + number(v) + ")");
     return v;
 }
 
@@ -93,7 +101,7 @@ WireSpec parse_wire(const json& j, Where at) {
     WireSpec w;
     if (j.contains("radius")) {
         const double r = finite_number(j["radius"], at, "radius");
-        if (!(r > 0)) at.fail("radius must be positive, got " + std::to_string(r));
+        if (!(r > 0)) at.fail("radius must be positive, got " + number(r));
         w.radius_m = r;
     }
     if (j.contains("closed")) w.closed = boolean(j["closed"], at, "closed");
@@ -143,12 +151,12 @@ WireSpec parse_wire(const json& j, Where at) {
         }
         if (nj.contains("stretch")) {
             const double s = finite_number(nj["stretch"], node_at, "stretch");
-            if (!(s > 0)) node_at.fail("stretch must be positive, got " + std::to_string(s));
+            if (!(s > 0)) node_at.fail("stretch must be positive, got " + number(s));
             w.stretch[i] = static_cast<float>(s);
         }
         if (nj.contains("radius")) {
             const double r = finite_number(nj["radius"], node_at, "radius");
-            if (!(r > 0)) node_at.fail("radius must be positive, got " + std::to_string(r));
+            if (!(r > 0)) node_at.fail("radius must be positive, got " + number(r));
             w.radius[i] = static_cast<float>(r);
         }
         if (nj.contains("physics")) {
@@ -165,7 +173,7 @@ WireSpec parse_wire(const json& j, Where at) {
             p.L = finite_number(ph["L"], node_at, "physics L");
             p.dL = finite_number(ph["dL"], node_at, "physics dL");
             p.A = finite_number(ph["A"], node_at, "physics A");
-            if (!(p.A > 0)) node_at.fail("physics A must be positive");
+            if (!(p.A > 0)) node_at.fail("physics A must be positive, got " + number(p.A));
         }
         if (nj.contains("tension") || nj.contains("bias") || nj.contains("continuity")) {
             if (!any_tcb) w.tcb.assign(n, glm::dvec3(0.0));

@@ -69,9 +69,9 @@ TEST(WireJson, ErrorsNameWhereAndWhat) {
                                                                        "[json.exception.out_of_range.406] number overflow"),
               std::string::npos);
     EXPECT_EQ(parse_error(R"({"radius": -1, "nodes": [[0,0,0],[1,0,0]]})"),
-              "in.json: radius must be positive, got -1.000000");
+              "in.json: radius must be positive, got -1");
     EXPECT_EQ(parse_error(R"({"nodes": [{"p": [0,0,0], "radius": -0.5}, [1,0,0]]})"),
-              "in.json: node 0: radius must be positive, got -0.500000");
+              "in.json: node 0: radius must be positive, got -0.5");
     EXPECT_EQ(parse_error(R"({"frames": [{"wires": [{"nodes": [[0,0,0],[1,0,0]]}]}, {"wires": [{"nodes": [{"p": [0,0,0], "id": 1}, {"p": [0,0,1], "id": 1}]}]}]})"),
               "in.json: frame 1, wire 0, node 1: id 1 is used twice");
     EXPECT_EQ(parse_error(R"({"nodes": [[0,0,0],[1,0,0]], "colour": 3})"), "in.json: unknown key 'colour' in wire");
