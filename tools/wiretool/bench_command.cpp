@@ -1,4 +1,5 @@
-// `wiretool bench`: standard scenes through the wire systems (bench.csv, bench.md). A contract: see README and
+// `wiretool bench`: standard scenes through the wire systems (bench.csv, bench.md) and speed against error on
+// reference scenes (accuracy.csv, accuracy.md, stability.md, speed_vs_error.png). A contract: see
 // docs/speed_vs_error.md.
 #include "bench_common.hpp"
 #include "commands.hpp"
@@ -22,6 +23,9 @@ int run_bench(const bench::Options& o) {
     if (!o.skip_systems) {
         if (const int st = bench::run_systems_bench(o); st != exit_ok) return st;
     }
+    if (!o.skip_accuracy) {
+        if (const int st = bench::run_accuracy_bench(o); st != exit_ok) return st;
+    }
     std::fprintf(stderr, "wiretool bench: wrote %s\n", o.out_dir.c_str());
     return exit_ok;
 }
@@ -31,12 +35,17 @@ int run_bench(const bench::Options& o) {
 Action add_bench_command(CLI::App& app) {
     auto o = std::make_shared<bench::Options>();
     CLI::App* cmd = app.add_subcommand(
-        "bench", "Runs the standard scenes and writes DIR/bench.csv and DIR/bench.md (see docs/speed_vs_error.md).");
+        "bench", "Runs the standard and reference scenes; writes DIR/bench.csv, bench.md, accuracy.csv, accuracy.md, "
+        "stability.md and speed_vs_error.png (see docs/speed_vs_error.md).");
     cmd->add_option("--out", o->out_dir, "Output directory (created if missing)")->required();
     cmd->add_flag("--quick", o->quick, "Fewer frames (finishes in under a minute); the CSV keeps its layout");
     cmd->add_option("--threads", o->threads, "Worker threads for the bench rows (tbb::global_control)")
         ->check(CLI::Range(1, 64));
-    cmd->add_option("--scenes", o->scenes, "Only these scenes (standard, offscreen, swaying)")->delimiter(',');
+    cmd->add_option("--scenes", o->scenes, "Only these scenes (standard, offscreen, swaying; catenary, helix, stretched_bend, hairpin, "
+                    "random_walk, churn)")
+        ->delimiter(',');
+    cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
+    cmd->add_flag("--no-systems", o->skip_systems, "Skip bench.csv/md (the ECS scenes)");
     return [o] { return run_bench(*o); };
 }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -62,36 +63,19 @@ const std::map<std::string, std::string>* find(const Rows& rows, const std::map<
     return nullptr;
 }
 
-// One quick run shared by the tests of this file (the bench is the expensive part; each test only reads).
-class WiretoolBench : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        dir_ = new fs::path(fs::temp_directory_path() / "wiretool_bench_test");
-        fs::remove_all(*dir_);
-        const std::string cmd = std::string(WIRETOOL_PATH) + " bench --quick --scenes " + kScenes + " --out " +
-                                dir_->string() + " > " + (fs::temp_directory_path() / "wiretool_bench_test.log").string() +
-                                " 2>&1";
-        const int raw = std::system(cmd.c_str());
-        status_ = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    }
-    static void TearDownTestSuite() {
-        fs::remove_all(*dir_);
-        delete dir_;
-    }
-    static constexpr const char* kScenes = "standard,offscreen,catenary,helix,stretched_bend,churn";
-    static fs::path* dir_;
-    static int status_;
-};
-fs::path* WiretoolBench::dir_ = nullptr;
-int WiretoolBench::status_ = -1;
+// The bench's outputs in a fresh directory (one run serves every check below: ctest runs each TEST in its own
+// process, so the checks are one TEST rather than a suite sharing a fixture).
+const fs::path& out_dir() {
+    static const fs::path dir = fs::temp_directory_path() / ("wiretool_bench_test_" + std::to_string(::getpid()));
+    return dir;
+}
 
-TEST_F(WiretoolBench, BenchCsvContract) {
-    ASSERT_EQ(status_, 0);
-    const Csv csv = read_csv(*dir_ / "bench.csv");
+void check_bench_csv(const fs::path& dir) {
+    const Csv csv = read_csv(dir / "bench.csv");
     EXPECT_EQ(csv.header,
               "scene,method,mode,tolerance_px,wires,visible_wires,rings,vertices,bytes_uploaded,cpu_ms_per_frame,"
               "ns_per_vertex,max_screen_error_px");
-    EXPECT_TRUE(fs::exists(*dir_ / "bench.md"));
+    EXPECT_TRUE(fs::exists(dir / "bench.md"));
     ASSERT_EQ(csv.rows.size(), 6u) << "2 scenes x {cpu-mesh, gpu-rings, uniform}";
     for (const auto& r : csv.rows) {
         for (const std::string& c : csv.columns) {
@@ -127,4 +111,117 @@ TEST_F(WiretoolBench, BenchCsvContract) {
     }
 }
 
+void check_accuracy_csv(const fs::path& dir) {
+    const Csv csv = read_csv(dir / "accuracy.csv");
+    EXPECT_EQ(csv.header,
+              "scene,method,tolerance_px,rings,sides,vertices,bytes_cpu_mesh,bytes_gpu_rings,ns_per_vertex,"
+              "us_per_wire_cpu_mesh,us_per_wire_gpu_rings,max_world_error_m,max_screen_error_px,max_twist_deg,"
+              "max_pop_m,max_pop_remedy_m");
+    EXPECT_TRUE(fs::exists(dir / "accuracy.md"));
+    EXPECT_TRUE(fs::exists(dir / "stability.md"));
+    const std::vector<std::string> scenes = {"catenary", "helix", "stretched_bend", "churn"};
+    const std::vector<std::string> methods = {"linear", "uniform", "centripetal", "chordal", "c2", "auto",
+                                              "curvature_tension", "centripetal+rotation", "centripetal+projection"};
+    const std::vector<std::string> tolerances = {"0.1", "0.25", "0.5", "1", "2"};
+    ASSERT_EQ(csv.rows.size(), scenes.size() * methods.size() * tolerances.size());
+    for (const auto& scene : scenes)
+        for (const auto& method : methods)
+            for (const auto& tol : tolerances)
+                EXPECT_NE(find(csv.rows, {{"scene", scene}, {"method", method}, {"tolerance_px", tol}}), nullptr)
+                    << scene << " " << method << " " << tol;
+    for (const auto& r : csv.rows) {
+        for (const std::string& c : csv.columns) {
+            if (c == "scene" || c == "method") continue;
+            const double v = number(r, c);
+            EXPECT_TRUE(std::isfinite(v) && v >= 0.0) << c << " in " << r.at("scene") << "/" << r.at("method");
+        }
+        EXPECT_GT(number(r, "rings"), 0.0);
+        EXPECT_LT(number(r, "bytes_gpu_rings"), number(r, "bytes_cpu_mesh"));
+        // The LOD's promise, measured: the drawn centre line is within the tolerance on screen.
+        EXPECT_LE(number(r, "max_screen_error_px"), number(r, "tolerance_px") * (1.0 + 1e-9))
+            << r.at("scene") << "/" << r.at("method") << " at " << r.at("tolerance_px");
+    }
+}
+
+// The issue's figures, as accuracy bounds: double reflection's twist error is at least 100x below the rotation
+// method's at equal rings (helix), the pop-free remedy keeps every frame's pop under 1 mm on the 20 m cable while
+// nodes come and go, and the automatic spline keeps a stretched run on its straight line.
+void check_accuracy_figures(const fs::path& dir) {
+    const Csv csv = read_csv(dir / "accuracy.csv");
+    for (const char* tol : {"0.1", "0.25", "0.5", "1", "2"}) {
+        const auto* dr = find(csv.rows, {{"scene", "helix"}, {"method", "centripetal"}, {"tolerance_px", tol}});
+        const auto* rot = find(csv.rows, {{"scene", "helix"}, {"method", "centripetal+rotation"}, {"tolerance_px", tol}});
+        const auto* proj =
+            find(csv.rows, {{"scene", "helix"}, {"method", "centripetal+projection"}, {"tolerance_px", tol}});
+        ASSERT_TRUE(dr && rot && proj);
+        EXPECT_EQ(number(*dr, "rings"), number(*rot, "rings")) << "equal rings";
+        EXPECT_LE(100.0 * number(*dr, "max_twist_deg"), number(*rot, "max_twist_deg")) << "at " << tol << " px";
+        EXPECT_LT(number(*rot, "max_twist_deg"), number(*proj, "max_twist_deg")) << "at " << tol << " px";
+    }
+    // Linear is left out: its remedy exceeds 1 mm in this churn (a known module issue, see docs/speed_vs_error.md).
+    for (const char* method : {"uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
+        const auto* r = find(csv.rows, {{"scene", "churn"}, {"method", method}, {"tolerance_px", "0.5"}});
+        ASSERT_TRUE(r);
+        EXPECT_LT(number(*r, "max_pop_remedy_m"), 1e-3) << method;
+        EXPECT_LT(number(*r, "max_pop_remedy_m"), number(*r, "max_pop_m")) << method;
+    }
+    for (const char* method : {"auto", "curvature_tension", "linear"}) {
+        const auto* r = find(csv.rows, {{"scene", "stretched_bend"}, {"method", method}, {"tolerance_px", "0.1"}});
+        ASSERT_TRUE(r);
+        EXPECT_LT(number(*r, "max_world_error_m"), 1e-4) << method << ": the stretched run leaves its line";
+    }
+    // Splines beat the node polyline on the hanging cable.
+    const auto* lin = find(csv.rows, {{"scene", "catenary"}, {"method", "linear"}, {"tolerance_px", "0.1"}});
+    const auto* c2 = find(csv.rows, {{"scene", "catenary"}, {"method", "c2"}, {"tolerance_px", "0.1"}});
+    ASSERT_TRUE(lin && c2);
+    EXPECT_LT(number(*c2, "max_world_error_m"), number(*lin, "max_world_error_m"));
+}
+
+void check_stability_and_plot(const fs::path& dir) {
+    std::ifstream in(dir / "stability.md");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string md = ss.str();
+    for (const char* c : {"| coincident nodes (exact) | ok", "| NaN in a node | error: node 2", "| 0 nodes | error:",
+                          "| 100,000-node wire", "| closed loop of 3 nodes | ok",
+                          "| 1,000 chained bend segments closing a full circle | ok"})
+        EXPECT_NE(md.find(c), std::string::npos) << c;
+    EXPECT_EQ(md.find("NON-FINITE"), std::string::npos);
+    if (std::system("gnuplot --version > /dev/null 2>&1") == 0) {
+        EXPECT_TRUE(fs::exists(dir / "speed_vs_error.png"));
+        EXPECT_GT(fs::file_size(dir / "speed_vs_error.png"), 1000u);
+    }
+}
+
 }  // namespace
+
+// `wiretool bench --quick` on a subset of scenes (keeps the test well under a minute), then every check.
+TEST(WiretoolBench, QuickRunHonoursTheContract) {
+    const fs::path& dir = out_dir();
+    fs::remove_all(dir);
+    const std::string cmd = std::string(WIRETOOL_PATH) +
+                            " bench --quick --scenes standard,offscreen,catenary,helix,stretched_bend,churn --out " +
+                            dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
+    const int raw = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "see " << dir.string() << ".log";
+    {
+        SCOPED_TRACE("bench.csv");
+        check_bench_csv(dir);
+    }
+    {
+        SCOPED_TRACE("accuracy.csv");
+        check_accuracy_csv(dir);
+    }
+    {
+        SCOPED_TRACE("accuracy figures");
+        check_accuracy_figures(dir);
+    }
+    {
+        SCOPED_TRACE("stability.md and plot");
+        check_stability_and_plot(dir);
+    }
+    if (!::testing::Test::HasFailure()) {
+        fs::remove_all(dir);
+        fs::remove(dir.string() + ".log");
+    }
+}
