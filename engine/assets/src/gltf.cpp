@@ -318,6 +318,44 @@ Status visit_node(const tinygltf::Model& model, int node_index, const glm::dmat4
 
 }  // namespace
 
+namespace {
+
+/// Meshes of a loaded model (default scene, or every mesh when there is no scene); `file` names it in errors.
+Status convert_model(const tinygltf::Model& model, const std::string& file, std::vector<MeshData>& out) {
+    Status s;
+    const glm::dmat4 identity(1.0);
+    if (!model.scenes.empty()) {
+        const int scene = model.defaultScene >= 0 && model.defaultScene < static_cast<int>(model.scenes.size())
+                              ? model.defaultScene
+                              : 0;
+        for (int n : model.scenes[scene].nodes)
+            if (s = visit_node(model, n, identity, file, out, 0); !s.ok()) break;
+    } else {
+        for (int m = 0; m < static_cast<int>(model.meshes.size()) && s.ok(); ++m)
+            s = convert_mesh(model, m, identity, file, out);
+    }
+    if (!s.ok()) {
+        out.clear();
+        return s;
+    }
+    if (out.empty()) return Status::failure(file + ": contains no triangle mesh");
+    return {};
+}
+
+// Filesystem callbacks for in-memory reading: there is no directory, so an external URI is an error.
+bool no_file_exists(const std::string&, void*) { return false; }
+std::string same_path(const std::string& path, void*) { return path; }
+bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+    if (err) *err += "external file '" + path + "' cannot be read from memory\n";
+    return false;
+}
+bool no_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "writing is not supported\n";
+    return false;
+}
+
+}  // namespace
+
 Status read_gltf(const std::string& path, std::vector<MeshData>& out) {
     out.clear();
     std::ifstream probe(path, std::ios::binary);
@@ -333,25 +371,26 @@ Status read_gltf(const std::string& path, std::vector<MeshData>& out) {
     const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
                            : loader.LoadASCIIFromFile(&model, &err, &warn, path);
     if (!ok) return Status::failure(path + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
+    return convert_model(model, path, out);
+}
 
-    Status s;
-    const glm::dmat4 identity(1.0);
-    if (!model.scenes.empty()) {
-        const int scene = model.defaultScene >= 0 && model.defaultScene < static_cast<int>(model.scenes.size())
-                              ? model.defaultScene
-                              : 0;
-        for (int n : model.scenes[scene].nodes)
-            if (s = visit_node(model, n, identity, path, out, 0); !s.ok()) break;
-    } else {
-        for (int m = 0; m < static_cast<int>(model.meshes.size()) && s.ok(); ++m)
-            s = convert_mesh(model, m, identity, path, out);
-    }
-    if (!s.ok()) {
-        out.clear();
-        return s;
-    }
-    if (out.empty()) return Status::failure(path + ": contains no triangle mesh");
-    return {};
+Status read_gltf_memory(std::span<const std::byte> bytes, const std::string& name, std::vector<MeshData>& out) {
+    out.clear();
+    if (bytes.size() > std::numeric_limits<unsigned int>::max())
+        return Status::failure(name + ": larger than 4 GiB");
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    const auto size = static_cast<unsigned int>(bytes.size());
+    const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{&no_file_exists, &same_path, &no_read, &no_write, nullptr});
+    std::string err, warn;
+    const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, size, "")
+                           : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(data),
+                                                        size, "");
+    if (!ok) return Status::failure(name + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
+    return convert_model(model, name, out);
 }
 
 }  // namespace engine::assets

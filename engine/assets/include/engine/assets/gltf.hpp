@@ -3,6 +3,7 @@
 
 #include <engine/assets/mesh_data.hpp>
 
+#include <cstddef>
 #include <span>
 #include <string>
 #include <vector>
@@ -20,5 +21,9 @@ Status write_glb(const std::string& path, std::span<const MeshData> meshes);
 /// positions and normals (origin stays 0). Accepts any index component type and float vertex
 /// attributes; a missing NORMAL is computed from the faces. Errors name the file and what is wrong.
 Status read_gltf(const std::string& path, std::vector<MeshData>& out);
+
+/// read_gltf for a .glb or .gltf already in memory; `name` stands for the file in every message. Buffers and
+/// images must be embedded (GLB chunk or data: URI): an external URI is an error, nothing is read from disk.
+Status read_gltf_memory(std::span<const std::byte> bytes, const std::string& name, std::vector<MeshData>& out);
 
 }  // namespace engine::assets
