@@ -30,6 +30,7 @@ packages=(
   cmake
   gnuplot-nox
   libbenchmark-dev
+  libclang-rt-14-dev
   libcli11-dev
   libegl-dev
   libegl-mesa0

@@ -1,0 +1,362 @@
+// Exact error messages of every load and input path: each names the file (or mesh), the frame, wire, node or
+// segment, and what is wrong. A changed message is a visible change for users (wiretool prints them as is).
+#include <curved_space/segments_json.hpp>
+#include <engine/assets/gltf.hpp>
+#include <engine/assets/subdivide.hpp>
+#include <wire/io/wire_json.hpp>
+#include <wire/pipeline.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string wire_json_error(const std::string& text) {
+    wire::io::SceneSpec scene;
+    const wire::Status st = wire::io::parse_wire_json(text, "cable.json", scene);
+    EXPECT_FALSE(st.ok);
+    EXPECT_TRUE(scene.frames.empty());
+    return st.message;
+}
+
+std::string pipeline_error(const wire::WireNodes& nodes, const wire::PipelineSettings& settings = {}) {
+    wire::WirePipeline pipeline;
+    const wire::Status st = pipeline.update(nodes, settings);
+    EXPECT_FALSE(st.ok);
+    return st.message;
+}
+
+std::string segments_error(const std::string& text) {
+    std::vector<curved_space::Segment> segments;
+    const curved_space::Status st = curved_space::parse_segments_json(text, "segs.json", segments);
+    EXPECT_FALSE(st.ok);
+    EXPECT_TRUE(segments.empty());
+    return st.message;
+}
+
+std::string gltf_memory_error(const std::string& bytes) {
+    std::vector<engine::assets::MeshData> meshes;
+    const engine::assets::Status st =
+        engine::assets::read_gltf_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "piece.gltf", meshes);
+    EXPECT_FALSE(st.ok());
+    EXPECT_TRUE(meshes.empty());
+    return st.message;
+}
+
+engine::assets::MeshData quad(const std::string& name) {
+    engine::assets::MeshData m;
+    m.name = name;
+    m.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    m.normals = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    m.uvs = {0, 0, 1, 0, 1, 1, 0, 1};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    return m;
+}
+
+/// A one-quad glTF (JSON, buffer as a data: URI) whose index buffer holds `last_index` as its last index.
+std::string quad_gltf(int last_index, const std::string& buffer_uri = "") {
+    // 4 float3 positions (48 bytes) + 6 uint16 indices (12 bytes), base64 of the little-endian bytes.
+    const float positions[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const uint16_t indices[6] = {0, 1, 2, 0, 2, static_cast<uint16_t>(last_index)};
+    std::string raw(reinterpret_cast<const char*>(positions), sizeof positions);
+    raw.append(reinterpret_cast<const char*>(indices), sizeof indices);
+    static const char* kB64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string b64;
+    for (std::size_t i = 0; i < raw.size(); i += 3) {
+        const uint32_t n = (uint32_t(uint8_t(raw[i])) << 16) |
+                           (i + 1 < raw.size() ? uint32_t(uint8_t(raw[i + 1])) << 8 : 0u) |
+                           (i + 2 < raw.size() ? uint32_t(uint8_t(raw[i + 2])) : 0u);
+        b64 += kB64[(n >> 18) & 63];
+        b64 += kB64[(n >> 12) & 63];
+        b64 += i + 1 < raw.size() ? kB64[(n >> 6) & 63] : '=';
+        b64 += i + 2 < raw.size() ? kB64[n & 63] : '=';
+    }
+    const std::string uri = buffer_uri.empty() ? "data:application/octet-stream;base64," + b64 : buffer_uri;
+    return R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":60,"uri":")" + uri +
+           R"("}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12}],)"
+           R"("accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},)"
+           R"({"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}],)"
+           R"("meshes":[{"name":"quad","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+           R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0})";
+}
+
+fs::path temp_dir() {
+    const fs::path p = fs::temp_directory_path() /
+                       ("reliability_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::create_directories(p);
+    return p;
+}
+
+}  // namespace
+
+// ---- wire JSON (wire::io::parse_wire_json / load_wire_json) ----
+
+TEST(WireJsonErrors, CoordinateOfTheWrongTypeNamesWireAndNode) {
+    EXPECT_EQ(wire_json_error(R"({"wires": [{"nodes": [[0,0,0],[1,0,0]]},
+        {"nodes": [[0,0,0],[1,0,0],[2,0,0],[3,0,0],[4,"up",0]]}]})"),
+              "cable.json: wire 1, node 4: coordinate y must be a number, got string");
+}
+
+TEST(WireJsonErrors, FrameIsNamedWhenThereAreFrames) {
+    EXPECT_EQ(wire_json_error(R"({"frames": [{"wires": [{"nodes": [[0,0,0],[1,0,0]]}]},
+        {"wires": [{"nodes": [[0,0,0],{"p": [1,0,0], "stretch": -2}]}]}]})"),
+              "cable.json: frame 1, wire 0, node 1: stretch must be positive, got -2");
+}
+
+// A file holding one wire names no wire index (there is only one).
+TEST(WireJsonErrors, NegativeRadius) {
+    EXPECT_EQ(wire_json_error(R"({"radius": -0.5, "nodes": [[0,0,0],[1,0,0]]})"),
+              "cable.json: radius must be positive, got -0.5");
+    EXPECT_EQ(wire_json_error(R"({"wires": [{"nodes": [[0,0,0],[1,0,0]]}, {"radius": -1e-9, "nodes": [[0,0,0],[1,0,0]]}]})"),
+              "cable.json: wire 1: radius must be positive, got -1e-09");
+}
+
+TEST(WireJsonErrors, UnknownKeyIsATypo) {
+    EXPECT_EQ(wire_json_error(R"({"radius": 0.1, "node": [[0,0,0],[1,0,0]]})"),
+              "cable.json: unknown key 'node' in wire");
+}
+
+TEST(WireJsonErrors, MissingNodes) {
+    EXPECT_EQ(wire_json_error(R"({"radius": 0.1})"), "cable.json: missing \"nodes\"");
+}
+
+// nlohmann rejects the number while parsing, before any wire or node is known.
+TEST(WireJsonErrors, OverflowingNumber) {
+    EXPECT_EQ(wire_json_error(R"({"nodes": [[0,0,0],[1e999,0,0]]})"),
+              "cable.json: malformed JSON: [json.exception.out_of_range.406] number overflow parsing '1e999'");
+}
+
+TEST(WireJsonErrors, PhysicsAreaNamesItsValue) {
+    EXPECT_EQ(wire_json_error(R"({"nodes": [{"p": [0,0,0], "physics": {"theta": 0, "Iz": 1, "L": 1, "dL": 0, "A": 0}},
+        [1,0,0]]})"),
+              "cable.json: node 0: physics A must be positive, got 0");
+}
+
+TEST(WireJsonErrors, MalformedJsonNamesTheFileAndPosition) {
+    EXPECT_EQ(wire_json_error(R"({"nodes": [[0,0,0],[1,0)"),
+              "cable.json: malformed JSON: [json.exception.parse_error.101] parse error at line 1, column 24: "
+              "syntax error while parsing array - unexpected end of input; expected ']'");
+}
+
+TEST(WireJsonErrors, DuplicateIdNamesBothTheNodeAndTheId) {
+    EXPECT_EQ(wire_json_error(R"({"nodes": [{"p": [0,0,0], "id": 4}, {"p": [1,0,0], "id": 4}]})"),
+              "cable.json: node 1: id 4 is used twice");
+}
+
+TEST(WireJsonErrors, MissingFileNamesThePath) {
+    wire::io::SceneSpec scene;
+    const wire::Status st = wire::io::load_wire_json("/nonexistent/cable.json", scene);
+    EXPECT_EQ(st.message, "/nonexistent/cable.json: cannot open: No such file or directory");
+}
+
+// ---- curve stage through WirePipeline (wire::build_curve) ----
+
+TEST(CurveErrors, NanCoordinateNamesNodeAndAxis) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, std::numeric_limits<double>::quiet_NaN(), 0}};
+    wire::WirePipeline pipeline;
+    const wire::Status st = pipeline.update(nodes, {});
+    EXPECT_EQ(st.message, "node 3: position.y is NaN");
+    EXPECT_EQ(st.node, 3);
+}
+
+TEST(CurveErrors, InfiniteCoordinate) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {0, 0, -std::numeric_limits<double>::infinity()}};
+    EXPECT_EQ(pipeline_error(nodes), "node 1: position.z is -Inf");
+}
+
+TEST(CurveErrors, CoordinateBeyondTheSupportedRange) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {1, 0, -2.5e110}};
+    EXPECT_EQ(pipeline_error(nodes), "node 1: position.z is -2.5e+110 (beyond the supported range of +-1e12 m)");
+}
+
+TEST(CurveErrors, TooFewDistinctNodes) {
+    wire::WireNodes nodes;
+    nodes.positions = {{1, 2, 3}, {1, 2, 3}};
+    EXPECT_EQ(pipeline_error(nodes),
+              "a wire needs at least 2 distinct nodes, got 2 node(s) and 1 after merging coincident ones");
+}
+
+TEST(CurveErrors, ClosedLoopOfTwoNodes) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {1, 0, 0}};
+    wire::PipelineSettings s;
+    s.spline.closed = true;
+    EXPECT_EQ(pipeline_error(nodes, s), "a closed loop needs at least 3 distinct nodes, got 2 after merging coincident ones");
+}
+
+TEST(CurveErrors, NegativeNodeRadius) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+    nodes.radius_m = {0.01f, -0.02f, 0.01f};
+    EXPECT_EQ(pipeline_error(nodes), "node 1: radius_m is -0.0199999996 (must be finite and >= 0; 0 uses the wire's radius)");
+}
+
+TEST(CurveErrors, ArrayOfTheWrongLength) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+    nodes.stretch = {1.0f, 1.0f};
+    EXPECT_EQ(pipeline_error(nodes), "stretch has 2 entries for 3 nodes (must be empty or one per node)");
+}
+
+TEST(CurveErrors, PipelineKeepsThePreviousStateOnError) {
+    wire::WireNodes good;
+    good.positions = {{0, 0, 0}, {1, 0, 0}, {2, 1, 0}};
+    wire::WirePipeline pipeline;
+    ASSERT_TRUE(pipeline.update(good, {}).ok);
+    const std::size_t vertices = pipeline.mesh().vertices.size();
+    wire::WireNodes bad = good;
+    bad.positions[2].x = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(pipeline.update(bad, {}).message, "node 2: position.x is +Inf");
+    EXPECT_EQ(pipeline.mesh().vertices.size(), vertices);
+}
+
+// ---- glTF (engine::assets::read_gltf / read_gltf_memory) ----
+
+TEST(GltfErrors, MissingFile) {
+    std::vector<engine::assets::MeshData> meshes;
+    EXPECT_EQ(engine::assets::read_gltf("/nonexistent/piece.glb", meshes).message,
+              "/nonexistent/piece.glb: cannot open: No such file or directory");
+}
+
+TEST(GltfErrors, NotGltfAtAll) {
+    EXPECT_EQ(gltf_memory_error("hello"),
+              "piece.gltf: not a readable glTF file: [json.exception.parse_error.101] parse error at line 1, column 1: "
+              "syntax error while parsing value - invalid literal; last read: 'h'");
+}
+
+TEST(GltfErrors, IndexOutOfRangeNamesMeshPrimitiveAndIndex) {
+    EXPECT_EQ(gltf_memory_error(quad_gltf(9)),
+              "piece.gltf: mesh 0 'quad' primitive 0: index 5 = 9 is out of range (4 vertices)");
+}
+
+TEST(GltfErrors, ExternalBufferFromMemoryIsAnError) {
+    const std::string message = gltf_memory_error(quad_gltf(3, "quad.bin"));
+    EXPECT_EQ(message.rfind("piece.gltf: not a readable glTF file: ", 0), 0u) << message;
+    EXPECT_NE(message.find("quad.bin"), std::string::npos) << message;
+}
+
+TEST(GltfErrors, FileAndMemoryGiveTheSameMessage) {
+    const fs::path dir = temp_dir();
+    const std::string path = (dir / "piece.gltf").string();
+    std::ofstream(path) << quad_gltf(9);
+    std::vector<engine::assets::MeshData> meshes;
+    EXPECT_EQ(engine::assets::read_gltf(path, meshes).message,
+              path + ": mesh 0 'quad' primitive 0: index 5 = 9 is out of range (4 vertices)");
+    fs::remove_all(dir);
+}
+
+TEST(GltfMemory, ReadsWhatWriteGlbWrote) {
+    const fs::path dir = temp_dir();
+    const std::string path = (dir / "quad.glb").string();
+    std::vector<engine::assets::MeshData> written{quad("a")};
+    written[0].origin = glm::dvec3(0.0, 0.0, 2.0);
+    ASSERT_TRUE(engine::assets::write_glb(path, written).ok());
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<engine::assets::MeshData> from_memory, from_file;
+    const engine::assets::Status st =
+        engine::assets::read_gltf_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "quad.glb", from_memory);
+    ASSERT_TRUE(st.ok()) << st.message;
+    ASSERT_TRUE(engine::assets::read_gltf(path, from_file).ok());
+    ASSERT_EQ(from_memory.size(), 1u);
+    EXPECT_EQ(from_memory[0].name, "a");
+    EXPECT_EQ(from_memory[0].positions, from_file[0].positions);
+    EXPECT_EQ(from_memory[0].normals, from_file[0].normals);
+    EXPECT_EQ(from_memory[0].uvs, from_file[0].uvs);
+    EXPECT_EQ(from_memory[0].indices, from_file[0].indices);
+    EXPECT_FLOAT_EQ(from_memory[0].positions[2], 2.0f);  // the origin, as a node translation
+    fs::remove_all(dir);
+}
+
+TEST(GltfMemory, JsonWithEmbeddedBuffer) {
+    const std::string text = quad_gltf(3);
+    std::vector<engine::assets::MeshData> meshes;
+    const engine::assets::Status st =
+        engine::assets::read_gltf_memory(std::as_bytes(std::span(text.data(), text.size())), "quad.gltf", meshes);
+    ASSERT_TRUE(st.ok()) << st.message;
+    ASSERT_EQ(meshes.size(), 1u);
+    EXPECT_EQ(meshes[0].triangle_count(), 2u);
+    EXPECT_EQ(meshes[0].normals.size(), meshes[0].positions.size());  // computed from the faces
+}
+
+// ---- control mesh and subdivision (engine::assets::make_control_mesh / subdivide) ----
+
+TEST(SubdivideErrors, NonFinitePositionNamesMeshAndVertex) {
+    engine::assets::MeshData m = quad("hook");
+    m.positions[7] = std::numeric_limits<float>::quiet_NaN();
+    engine::assets::ControlMesh control;
+    EXPECT_EQ(engine::assets::make_control_mesh(m, control).message, "mesh 'hook': vertex 2 has a non-finite position");
+}
+
+TEST(SubdivideErrors, DegenerateFace) {
+    engine::assets::MeshData m = quad("hook");
+    m.indices = {0, 1, 1};
+    engine::assets::ControlMesh control;
+    EXPECT_EQ(engine::assets::make_control_mesh(m, control).message, "mesh 'hook': degenerate face 0 (vertex 1 repeated)");
+}
+
+TEST(SubdivideErrors, IndexOutOfRange) {
+    engine::assets::MeshData m = quad("hook");
+    m.indices[4] = 40;
+    engine::assets::ControlMesh control;
+    EXPECT_EQ(engine::assets::make_control_mesh(m, control).message, "mesh 'hook': index 40 out of range");
+}
+
+TEST(SubdivideErrors, LevelOutOfRange) {
+    engine::assets::MeshData out;
+    EXPECT_EQ(engine::assets::subdivide(quad("hook"), 7, out).message,
+              "mesh 'hook': subdivision level 7 out of range [0, 6]");
+}
+
+// ---- SEGS.json (curved_space::parse_segments_json) ----
+
+TEST(SegmentsErrors, NegativeLength) {
+    EXPECT_EQ(segments_error(R"({"segments": [{"length": 1, "angle": 0}, {"length": -1, "angle": 0.5}]})"),
+              "segs.json: segment 1: length must be positive, got -1");
+}
+
+TEST(SegmentsErrors, CurvatureOverflow) {
+    EXPECT_EQ(segments_error(R"({"segments": [{"length": 1e-300, "angle": 1e10}]})"),
+              "segs.json: segment 0: curvature angle/length overflows (angle 10000000000, length 1e-300)");
+}
+
+TEST(SegmentsErrors, TotalLengthBeyondTheRange) {
+    EXPECT_EQ(segments_error(R"({"segments": [{"length": 6e11, "angle": 0}, {"length": 6e11, "angle": 0}]})"),
+              "segs.json: segment 1: the chain's total length exceeds 1e12 m (1200000000000)");
+}
+
+TEST(SegmentsErrors, MissingKey) {
+    EXPECT_EQ(segments_error(R"({"segments": [{"length": 2}]})"), "segs.json: segment 0: missing key \"angle\"");
+}
+
+TEST(SegmentsErrors, UnknownKey) {
+    EXPECT_EQ(segments_error(R"({"segments": [{"length": 2, "angle": 0, "twist": 1}]})"),
+              "segs.json: segment 0: unknown key \"twist\" (expected length, angle, direction)");
+}
+
+TEST(SegmentsErrors, WrongType) {
+    EXPECT_EQ(segments_error(R"({"segments": [{"length": "2", "angle": 0}]})"),
+              "segs.json: segment 0: length must be a number, got string");
+}
+
+TEST(SegmentsErrors, EmptyList) {
+    EXPECT_EQ(segments_error(R"({"segments": []})"),
+              "segs.json: \"segments\" is empty (at least one segment is needed)");
+}
+
+TEST(SegmentsErrors, MissingFile) {
+    std::vector<curved_space::Segment> segments;
+    EXPECT_EQ(curved_space::read_segments_json("/nonexistent/segs.json", segments).message,
+              "/nonexistent/segs.json: cannot open the file");
+}
