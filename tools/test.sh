@@ -1,14 +1,22 @@
 #!/usr/bin/env bash
 # Builds and runs every test (README command (b); .ci/run runs exactly this).
 # Installs missing packages first (fast when all are present), so it works on a fresh machine.
-# Usage: tools/test.sh [--help]
+# Usage: tools/test.sh [--no-asan] [--no-fuzz] [--help]
+#   Stages: 1. Release build + ctest (build/); 2. ASan+UBSan build + ctest (build-asan/);
+#   3. every fuzz target for 5 seconds (tools/fuzz, build-fuzz/). --no-asan / --no-fuzz skip 2 / 3.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-case "${1:-}" in
-  -h|--help) sed -n '2,4p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
-  "") ;;
-  *) echo "test.sh: unknown option '$1'" >&2; exit 2 ;;
-esac
+run_asan=1
+run_fuzz=1
+while [ $# -gt 0 ]; do
+  case "$1" in
+    -h|--help) sed -n '2,6p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --no-asan) run_asan=0 ;;
+    --no-fuzz) run_fuzz=0 ;;
+    *) echo "test.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
 cd "$here"
 bash tools/setup.sh --no-build
 
@@ -22,3 +30,28 @@ if [ ! -f build/CMakeCache.txt ]; then generator=(-G Ninja); fi
 cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DWIRE_WERROR="$werror"
 cmake --build build --parallel "$jobs"
 ctest --test-dir build --output-on-failure --parallel "$jobs"
+
+# 2. The same tests under AddressSanitizer + UndefinedBehaviorSanitizer (any report fails the test).
+# Leak suppressions cover the Mesa/LLVM/EGL driver libraries only (tools/sanitizers/lsan.supp), never our code.
+if [ "$run_asan" -eq 1 ]; then
+  echo "test.sh: ASan+UBSan stage (build-asan/)"
+  generator=()
+  if [ ! -f build-asan/CMakeCache.txt ]; then generator=(-G Ninja); fi
+  # Warnings are enforced by stage 1; GCC's sanitizer instrumentation adds false -Wmaybe-uninitialized and
+  # -Wstringop-* reports, so this stage does not use -Werror.
+  cmake -S . -B build-asan "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DWIRE_SANITIZE=ON \
+    -DWIRE_BUILD_BENCHMARKS=OFF -DWIRE_WERROR=OFF
+  cmake --build build-asan --parallel "$jobs"
+  export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:print_stacktrace=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=0"
+  export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+  export LSAN_OPTIONS="suppressions=$here/tools/sanitizers/lsan.supp:print_suppressions=0"
+  ctest --test-dir build-asan --output-on-failure --parallel "$jobs"
+fi
+
+# 3. Each fuzz target briefly on a copy of its seed corpus (tools/fuzz; long runs are manual).
+if [ "$run_fuzz" -eq 1 ]; then
+  echo "test.sh: fuzz stage (build-fuzz/)"
+  for target in $(tools/fuzz list); do
+    tools/fuzz run "$target" 5
+  done
+fi
