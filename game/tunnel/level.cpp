@@ -127,7 +127,8 @@ struct Level::State {
     int height_px = 720;
     double time_s = 0.0;
     double fly_distance_m = 0.0;
-    double rope_time_s = 0.0;  // simulated rope time since frame 0 (drives the gusts)
+    double rope_time_s = 0.0;
+    double flight_z_m = 0.0;  // simulated rope time since frame 0 (drives the gusts)
     wire::render::FrameStats wire_stats{};
     std::vector<float> bucket;
 };
@@ -141,6 +142,10 @@ glm::dvec3 Level::rope_end(int piece, std::size_t anchor, double inset_m) const 
     p.y += inset_m > 0.0 ? 0.03 : 0.0;
     p.z += kPieceLength * piece;
     return chain_.transform_point(p);
+}
+
+double Level::flight_z_m() const {
+    return state_->flight_z_m;
 }
 
 int Level::piece_count() const {
@@ -393,6 +398,7 @@ void Level::animate(double dt_s) {
     s.fly_distance_m += options_.flight_speed_mps * dt_s;
     const double span = std::max(1.0, total - 18.0);
     const double z = 3.0 + std::fmod(s.fly_distance_m, span);
+    s.flight_z_m = z;
     camera_.aspect = static_cast<float>(s.width_px) / static_cast<float>(s.height_px);
     camera_.fov_y_rad = glm::radians(70.0f);
     camera_.near_m = 0.05f;
@@ -565,6 +571,7 @@ void Level::draw_wires() {
     stats_.wire_vertices = s.wire_stats.vertices;
     stats_.wire_triangles = s.wire_stats.triangles;
     stats_.wire_bytes_uploaded = s.wire_stats.bytes_uploaded;
+    stats_.wire_waited_for_gpu = s.wire_stats.waited_for_gpu;
 }
 
 void Level::frame(double dt_s) {

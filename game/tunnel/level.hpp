@@ -77,6 +77,8 @@ struct LevelFrameStats {
     std::size_t wire_vertices = 0;  ///< cpu_mesh: uploaded; gpu_rings: expanded by the vertex shader
     std::size_t wire_triangles = 0;
     std::size_t wire_bytes_uploaded = 0;
+    bool wire_waited_for_gpu =
+        false;  ///< the wire renderer waited on a fence (llvmpipe: the frame's raster work)
     std::size_t segment_bytes_uploaded = 0;  ///< curved-space segment records (SSBO)
     std::size_t piece_triangles = 0;         ///< tunnel triangles drawn
     std::size_t piece_vertices = 0;          ///< tunnel vertices drawn (bent by the vertex shader)
@@ -126,6 +128,8 @@ public:
     [[nodiscard]] const wire::WireNodes& cable_nodes(std::size_t cable) const;
     /// Bent world position of an anchor of piece `piece` (anchor index as in anchors.json).
     [[nodiscard]] glm::dvec3 anchor_world(int piece, std::size_t anchor) const;
+    /// Unbent z (along the chain) of the fly camera in the last frame.
+    [[nodiscard]] double flight_z_m() const;
     [[nodiscard]] int piece_count() const;
     [[nodiscard]] double piece_length_m() const;
     /// The tunnel wall radius (m) of the pieces.

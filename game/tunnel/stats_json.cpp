@@ -29,6 +29,7 @@ nlohmann::json frame_record(const LevelFrameStats& s, std::span<const engine::ec
             {"bytes_uploaded", s.wire_bytes_uploaded + s.segment_bytes_uploaded},
             {"wire_bytes_uploaded", s.wire_bytes_uploaded},
             {"segment_bytes_uploaded", s.segment_bytes_uploaded},
+            {"wire_waited_for_gpu", s.wire_waited_for_gpu},
             {"rope_nodes", s.rope_nodes},
             {"nodes_inserted", s.nodes_inserted},
             {"nodes_removed", s.nodes_removed},

@@ -150,8 +150,8 @@ TEST(TunnelSystem, WallsAndCablesWhereExpected) {
     EXPECT_EQ(background_pixels, (kHeight / 4) * (kWidth / 4));
 
     // Wall probes: upper half of the wall (clear of walkway and hooks), between the ribs, 3..7 m ahead of the
-    // camera along the unbent axis. The camera flies at unbent z = 3 + 2.5 t.
-    const double camera_z = 3.0 + 2.5 * (20 * kDt);
+    // camera along the unbent axis.
+    const double camera_z = level->flight_z_m();
     int probes = 0;
     int wall_coloured = 0;
     for (double ahead = 3.0; ahead <= 7.0; ahead += 1.0) {
