@@ -158,12 +158,18 @@ void check_accuracy_figures(const fs::path& dir) {
         EXPECT_LE(100.0 * number(*dr, "max_twist_deg"), number(*rot, "max_twist_deg")) << "at " << tol << " px";
         EXPECT_LT(number(*rot, "max_twist_deg"), number(*proj, "max_twist_deg")) << "at " << tol << " px";
     }
-    // Linear is left out: its remedy exceeds 1 mm in this churn (a known module issue, see docs/speed_vs_error.md).
-    for (const char* method : {"uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
-        const auto* r = find(csv.rows, {{"scene", "churn"}, {"method", method}, {"tolerance_px", "0.5"}});
-        ASSERT_TRUE(r);
-        EXPECT_LT(number(*r, "max_pop_remedy_m"), 1e-3) << method;
-        EXPECT_LT(number(*r, "max_pop_remedy_m"), number(*r, "max_pop_m")) << method;
+    // churn: nodes inserted on the curve and removed again over 60 frames; catenary: one node inserted on the curve,
+    // then an original node removed. (A removal that moves the curve more than max_blend_frames * max_step_m =
+    // 240 * 0.5 mm = 12 cm is stepped at offset/240 a frame: documented in multires.hpp, not exercised here.)
+    for (const char* scene : {"churn", "catenary"}) {
+        for (const char* method : {"linear", "uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
+            const auto* r = find(csv.rows, {{"scene", scene}, {"method", method}, {"tolerance_px", "0.5"}});
+            ASSERT_TRUE(r);
+            EXPECT_LT(number(*r, "max_pop_remedy_m"), 1e-3) << scene << " " << method;
+            if (std::string(method) != "linear") {  // a node inserted on a polyline changes nothing: no pop to remedy
+                EXPECT_LT(number(*r, "max_pop_remedy_m"), number(*r, "max_pop_m")) << scene << " " << method;
+            }
+        }
     }
     for (const char* method : {"auto", "curvature_tension", "linear"}) {
         const auto* r = find(csv.rows, {{"scene", "stretched_bend"}, {"method", method}, {"tolerance_px", "0.1"}});
