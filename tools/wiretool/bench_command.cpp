@@ -45,6 +45,9 @@ Action add_bench_command(CLI::App& app) {
                     "random_walk, churn)")
         ->delimiter(',');
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
+    cmd->add_flag("--gl", o->gl,
+                  "Draw every 10th frame of `standard` with the real WireRenderer (headless EGL) and check its "
+                  "FrameStats::bytes_uploaded against the computed bytes");
     cmd->add_flag("--no-systems", o->skip_systems, "Skip bench.csv/md (the ECS scenes)");
     return [o] { return run_bench(*o); };
 }

@@ -20,6 +20,7 @@ struct Options {
     std::vector<std::string> scenes; ///< empty: all; else only these (bench.csv and accuracy.csv scene names)
     bool skip_accuracy = false;      ///< only bench.csv/bench.md
     bool skip_systems = false;       ///< only accuracy/stability outputs
+    bool gl = false;                 ///< also draw `standard` with the real WireRenderer (headless EGL)
 };
 
 /// Process CPU time (all threads), milliseconds: robust against other load on a shared machine.

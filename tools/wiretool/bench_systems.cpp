@@ -5,6 +5,10 @@
 #include "commands.hpp"
 
 #include <engine/ecs/registry.hpp>
+#include <engine/gfx/lit_renderer.hpp>
+#include <engine/platform/capture.hpp>
+#include <engine/platform/context.hpp>
+#include <wire/render/wire_renderer.hpp>
 #include <wire/lod.hpp>
 #include <wire/reference.hpp>
 #include <wire/rings.hpp>
@@ -19,6 +23,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -101,6 +107,8 @@ struct RunSpec {
     int wires = 1000;
     bool sample_errors = true;
     int error_samples = 3;  // frames at which the screen error is measured (spread over the run)
+    /// Called after the systems of every measured frame (untimed), e.g. to draw the DrawList with GL.
+    std::function<void(const wire::systems::WireContext&, int frame)> after_frame;
 };
 
 SceneRun run_scene(const RunSpec& spec) {
@@ -165,6 +173,7 @@ SceneRun run_scene(const RunSpec& spec) {
             segments += static_cast<double>(
                 registry.get<wire::systems::WireCurve>(Entity{static_cast<uint32_t>(item.wire_id)}).curve.segment_count());
         out.visible_segments.push_back(segments);
+        if (spec.after_frame) spec.after_frame(ctx, f);
 
         if (!spec.sample_errors || std::find(sample_frames.begin(), sample_frames.end(), f) == sample_frames.end())
             continue;
@@ -270,6 +279,53 @@ std::vector<std::string> row(const std::string& scene, const std::string& mode, 
             num(vertices, 9), num(bytes, 10), num(cpu_ms_frame), num(ns_per_vertex), num(error_px)};
 }
 
+
+// --gl: the real WireRenderer on a headless EGL context (Mesa llvmpipe), drawing every 10th frame of a run to check
+// that the computed upload size equals the renderer's FrameStats::bytes_uploaded. The framebuffer is small: the
+// bytes do not depend on it, and llvmpipe's fill rate would dominate otherwise.
+struct GlCheck {
+    std::unique_ptr<engine::platform::Context> context;
+    wire::render::WireRenderer renderer;
+    std::size_t frames = 0, mismatches = 0;
+    double renderer_bytes = 0.0, computed_bytes = 0.0;
+    std::vector<double> draw_wall_ms;
+    std::string error;
+
+    bool init() {
+        auto created = engine::platform::create_context(
+            {.backend = engine::platform::Backend::headless, .width = 480, .height = 270, .quiet = true});
+        if (!created) {
+            error = created.error().message;
+            return false;
+        }
+        context = std::move(created).value();
+        auto r = wire::render::WireRenderer::create();
+        if (!r) {
+            error = r.error().message;
+            return false;
+        }
+        renderer = std::move(r).value();
+        for (int i = 1; i < 4; ++i) renderer.add_material({.tint = {0.3f * i, 0.5f, 1.0f - 0.2f * i}});
+        return true;
+    }
+    void draw(const wire::systems::WireContext& ctx, int frame, const std::filesystem::path& png) {
+        if (frame % 10 != 0) return;
+        context->begin_frame();
+        engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
+        const double t0 = wall_ms();
+        const wire::render::FrameStats st = renderer.draw(ctx.draw_list, ctx.camera);
+        (void)engine::platform::read_pixels(*context);  // waits for the frame: llvmpipe's threads stop before timing
+        draw_wall_ms.push_back(wall_ms() - t0);
+        context->end_frame();
+        const std::size_t computed = upload_bytes(ctx.draw_list);
+        ++frames;
+        mismatches += st.bytes_uploaded != computed;
+        renderer_bytes += static_cast<double>(st.bytes_uploaded);
+        computed_bytes += static_cast<double>(computed);
+        if (!png.empty()) (void)engine::platform::capture_png(*context, png);
+    }
+};
+
 }  // namespace
 
 int run_systems_bench(const Options& o) {
@@ -286,6 +342,10 @@ int run_systems_bench(const Options& o) {
     double adaptive_vertices_at_samples = 0.0, uniform_vertices_at_samples = 0.0;
     std::array<double, kSystems> standard_systems{};
     std::string thread_lines;
+    GlCheck gl;
+    std::string gl_note;
+    if (o.gl && !gl.init()) gl_note = "- --gl: no headless GL context (" + gl.error + "); bytes are computed only.\n";
+    const bool use_gl = o.gl && gl_note.empty();
 
     for (SceneKind kind : {SceneKind::standard, SceneKind::offscreen, SceneKind::swaying}) {
         const std::string name = scene_name(kind);
@@ -296,8 +356,13 @@ int run_systems_bench(const Options& o) {
             const bool cpu = path == wire::UploadPath::cpu_mesh;
             std::fprintf(stderr, "bench: %s %s, %d wires, %d frames, %d thread(s)\n", name.c_str(),
                          cpu ? "cpu-mesh" : "gpu-rings", wires, scene_frames, o.threads);
-            SceneRun r = run_scene({.kind = kind, .path = path, .threads = o.threads, .frames = scene_frames,
-                                    .wires = wires, .sample_errors = true, .error_samples = error_samples});
+            RunSpec spec{.kind = kind, .path = path, .threads = o.threads, .frames = scene_frames, .wires = wires,
+                         .sample_errors = true, .error_samples = error_samples, .after_frame = {}};
+            if (use_gl && kind == SceneKind::standard) {
+                const std::filesystem::path png = o.out_dir / (cpu ? "bench_gl_cpu_mesh.png" : "bench_gl_gpu_rings.png");
+                spec.after_frame = [&gl, png](const wire::systems::WireContext& c, int f) { gl.draw(c, f, png); };
+            }
+            SceneRun r = run_scene(spec);
             csv.add(row(name, cpu ? "cpu-mesh" : "gpu-rings", wires, median(r.visible), median(r.rings),
                         median(r.vertices), median(r.bytes), median(r.frame_cpu_ms), r.max_error_px));
             (cpu ? cpu_run : gpu_run) = std::move(r);
@@ -353,7 +418,8 @@ int run_systems_bench(const Options& o) {
                 }
                 std::fprintf(stderr, "bench: %s cpu-mesh, %d thread(s) (thread scaling)\n", name.c_str(), t);
                 const SceneRun r = run_scene({.kind = kind, .path = wire::UploadPath::cpu_mesh, .threads = t,
-                                              .frames = scene_frames, .wires = wires, .sample_errors = false});
+                                              .frames = scene_frames, .wires = wires, .sample_errors = false,
+                                              .error_samples = 0, .after_frame = {}});
                 wall[t - 1] = median(r.frame_wall_ms);
             }
             std::snprintf(buf, sizeof buf, "| %s | %.3f | %.3f | %.2fx |\n", name.c_str(), wall[0], wall[1],
@@ -410,6 +476,16 @@ int run_systems_bench(const Options& o) {
             md += buf;
         }
     }
+    if (use_gl) {
+        std::snprintf(buf, sizeof buf,
+                      "- --gl: WireRenderer drew %zu frames of `standard` (both paths) headless; FrameStats::"
+                      "bytes_uploaded matched the computed bytes on %zu of them (mean %.0f vs %.0f bytes); median "
+                      "draw + finish %.1f ms wall at 480x270 (bench_gl_*.png: the last frame drawn)\n",
+                      gl.frames, gl.frames - gl.mismatches, gl.frames ? gl.renderer_bytes / gl.frames : 0.0,
+                      gl.frames ? gl.computed_bytes / gl.frames : 0.0, median(gl.draw_wall_ms));
+        gl_note += buf;
+    }
+    md += gl_note;
     if (!thread_lines.empty()) {
         md += "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems)\n\n"
               "| scene | 1 thread | 2 threads | speed-up |\n| --- | --- | --- | --- |\n" + thread_lines;
