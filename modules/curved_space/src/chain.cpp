@@ -63,9 +63,10 @@ Status validate(std::span<const Segment> segments) {
             return Status::error(where + "angle must be finite, got " + format_number(s.angle_rad), index);
         if (!std::isfinite(s.direction_rad))
             return Status::error(where + "direction must be finite, got " + format_number(s.direction_rad), index);
-        if (!std::isfinite(s.angle_rad / s.length_m))
-            return Status::error(where + "curvature angle/length overflows (angle " + format_number(s.angle_rad) +
-                                     ", length " + format_number(s.length_m) + ")", index);
+        // Bounded (a bend radius of at least 1e-12 m) so curvature times any coordinate in range stays finite.
+        if (!(std::abs(s.angle_rad / s.length_m) <= 1e12))
+            return Status::error(where + "curvature angle/length must be at most 1e12 per metre, got angle " +
+                                     format_number(s.angle_rad) + " over length " + format_number(s.length_m), index);
         total_m += s.length_m;
         // Bounded so the accumulated matrices stay finite (the wire module's coordinate range too).
         if (!(total_m <= 1e12))

@@ -22,7 +22,7 @@ struct Aabb {
 
 class Chain;
 
-/// Checks every segment: length finite and > 0, angle and direction finite, curvature angle/length finite, the
+/// Checks every segment: length finite and > 0, angle and direction finite, |angle/length| at most 1e12 per metre, the
 /// total length at most 1e12 m. The first problem found is
 /// reported as e.g. "segment 3: length must be positive, got -1" or "segment 0: angle must be finite, got nan".
 [[nodiscard]] Status validate(std::span<const Segment> segments);
