@@ -326,9 +326,10 @@ TEST(SegmentsErrors, NegativeLength) {
               "segs.json: segment 1: length must be positive, got -1");
 }
 
-TEST(SegmentsErrors, CurvatureOverflow) {
+TEST(SegmentsErrors, CurvatureBeyondTheRange) {
     EXPECT_EQ(segments_error(R"({"segments": [{"length": 1e-300, "angle": 1e10}]})"),
-              "segs.json: segment 0: curvature angle/length overflows (angle 10000000000, length 1e-300)");
+              "segs.json: segment 0: curvature angle/length must be at most 1e12 per metre, got angle 10000000000 over "
+              "length 1e-300");
 }
 
 TEST(SegmentsErrors, TotalLengthBeyondTheRange) {
