@@ -52,6 +52,7 @@ struct Options {
     int min_wires = 20;
     int max_wires = 60;
     int max_nodes = 40;
+    long region_kib = 64;  ///< initial stream-buffer region: small, so the buffer grows (and retires buffers)
     double tolerance_px = 0.5;  ///< LOD screen error (the systems' default)
 };
 
@@ -62,12 +63,14 @@ void usage(std::FILE* out) {
     std::fprintf(out,
                  "usage: churn_soak [--frames N] [--seed S] [--csv FILE] [--every K] [--path-every M]\n"
                  "                  [--width W] [--height H] [--wires MIN MAX] [--max-nodes N] [--tolerance-px T]\n"
+                 "                  [--region-kib R]\n"
                  "Spawns, moves, edits and destroys wires at random for N frames (default 2000) with seed S\n"
                  "(default 1), rendering headless (default 320x180), and checks: finite DrawList, no draw of a\n"
                  "destroyed or bad wire, each bad wire reported once, RSS and GL objects bounded. The upload\n"
                  "path switches every M frames (default 250); RSS and GL names are sampled every K frames\n"
                  "(default 10) into FILE: frame,rss_kb,gl_buffers,live_wires,vertices,bytes_uploaded.\n"
                  "Wires: MIN..MAX live (default 20 60) of 8..N nodes (default 40), LOD tolerance T px (default 0.5).\n"
+                 "The renderer's stream-buffer regions start at R KiB (default 64), so they grow during the run.\n"
                  "Exit status: 0 all checks held, 1 a check failed, 2 usage.\n");
 }
 
@@ -116,6 +119,8 @@ Options parse(int argc, char** argv) {
             o.min_wires = static_cast<int>(parse_long("--wires", value(), 0));
             o.max_wires = static_cast<int>(parse_long("--wires", value(), 1));
             if (o.max_wires < o.min_wires) usage_error("%s: MAX < MIN", "--wires");
+        } else if (a == "--region-kib") {
+            o.region_kib = parse_long("--region-kib", value(), 1);
         } else if (a == "--tolerance-px") {
             char* end = nullptr;
             o.tolerance_px = std::strtod(value(), &end);
@@ -511,7 +516,8 @@ int Soak::run() {
     {
         // Anisotropic filtering is most of llvmpipe's cost when a wire passes close to the camera; the soak is
         // not about texture quality.
-        auto made = wire::render::WireRenderer::create({.max_anisotropy = 1.0f});
+        auto made = wire::render::WireRenderer::create(
+            {.region_bytes = static_cast<std::size_t>(opt_.region_kib) * 1024, .max_anisotropy = 1.0f});
         if (!made.ok()) {
             std::fprintf(stderr, "churn_soak: WireRenderer::create: %s\n", made.error().message.c_str());
             return 1;
