@@ -231,7 +231,7 @@ private:
     std::size_t nan_spawned_ = 0;
     std::size_t errors_reported_ = 0;
     std::vector<ws::ErrorReport> reports_;  ///< through on_error, this frame
-    int target_wires_ = 100;
+    int target_wires_ = 0;  ///< the population walks toward this; redrawn every 200 frames
 
     // What was exercised, for the summary.
     std::size_t spawned_ = 0, destroyed_ = 0, moved_ = 0, edited_ = 0, inserted_ = 0, removed_ = 0, restyled_ = 0;
@@ -557,6 +557,7 @@ int Soak::run() {
 
     std::vector<Sample> curve;
     const auto start = std::chrono::steady_clock::now();
+    target_wires_ = integer(opt_.min_wires, opt_.max_wires);
     for (int i = 0; i < opt_.min_wires; ++i) spawn_good();
     for (frame_ = 0; frame_ < opt_.frames; ++frame_) {
         context_.path = (frame_ / opt_.path_every) % 2 == 0 ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_rings;
