@@ -23,6 +23,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <numbers>
@@ -487,7 +488,14 @@ int run_systems_bench(const Options& o) {
     }
     md += gl_note;
     if (!thread_lines.empty()) {
-        md += "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems)\n\n"
+        std::string load = "unknown";
+        if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {  // other work on the machine skews wall times
+            char text[128] = {};
+            if (std::fgets(text, sizeof text, f)) load = std::string(text, std::strcspn(text, "\n"));
+            std::fclose(f);
+        }
+        md += "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems; /proc/loadavg at the "
+              "end: " + load + ")\n\n"
               "| scene | 1 thread | 2 threads | speed-up |\n| --- | --- | --- | --- |\n" + thread_lines;
     }
     if (!write_text(o.out_dir / "bench.md", md)) {
