@@ -230,15 +230,29 @@ Uniform search_uniform(const SceneRun& run) {
         adaptive_radial = std::max(adaptive_radial, s.adaptive_radial_px);
         radial_scale = std::max(radial_scale, s.max_radial_scale_px);
     }
-    // Smallest k with error <= the adaptive run's (binary search: the error falls with k as ~1/k^2).
-    uint32_t lo = 1, hi = 256;
+    // Smallest k with error <= the adaptive run's. The error falls with k (as ~1/k^2), so: double k until it
+    // passes, then bisect the last doubling. A failing k stops at its first wire over the limit (cheap); only
+    // passing ones are measured in full, so the search measures few of them.
+    const double limit = run.max_error_px;
+    uint32_t hi = 1;
+    double hi_error = uniform_error_px(run.samples, hi, limit);
+    while (hi_error > limit && hi < 256) {
+        hi = std::min(256u, 2 * hi);
+        hi_error = uniform_error_px(run.samples, hi, limit);
+    }
+    uint32_t lo = hi / 2 + 1;  // hi / 2 failed (or hi == 1)
     while (lo < hi) {
         const uint32_t mid = (lo + hi) / 2;
-        if (uniform_error_px(run.samples, mid, run.max_error_px) <= run.max_error_px) hi = mid;
-        else lo = mid + 1;
+        const double e = uniform_error_px(run.samples, mid, limit);
+        if (e <= limit) {
+            hi = mid;
+            hi_error = e;
+        } else {
+            lo = mid + 1;
+        }
     }
-    u.rings_per_segment = lo;
-    u.max_error_px = uniform_error_px(run.samples, lo, 1e300);
+    u.rings_per_segment = hi;
+    u.max_error_px = hi_error;
     // Smallest side count whose radial error on the nearest wire is no worse than the adaptive sides'.
     for (u.sides = 3; u.sides < 64; ++u.sides)
         if (radial_scale * (1.0 - std::cos(std::numbers::pi / u.sides)) <= adaptive_radial * (1.0 + 1e-12)) break;
