@@ -201,7 +201,49 @@ uint32_t hysteresis_count(uint32_t old_count, uint32_t raw_count, double band) {
     return std::min(old_count, raw_count + 1 + raw_count / 8);
 }
 
-bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod) {
+BoundingSphere curve_bounding_sphere(const Curve& curve) {
+    if (curve.segments.empty()) return {};
+    glm::dvec3 lo(std::numeric_limits<double>::infinity());
+    glm::dvec3 hi(-std::numeric_limits<double>::infinity());
+    for (const CubicBezier& c : curve.segments)
+        for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+    double radius = 0.0;
+    for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    // Round the radius up by a relative hair so rounding in the centre cannot leave a corner outside.
+    return {centre, (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
+}
+
+namespace {
+
+void mark_culled(WireLod& lod, bool& changed) {
+    changed = lod.visible || !lod.counts.empty();
+    lod.visible = false;
+    lod.counts.clear();
+    lod.required.clear();
+    lod.sides = 0;
+    lod.required_sides = 0;
+    lod.z_min_m = 0.0;
+    lod.visible_segments = 0;
+    lod.clamped_segments = 0;
+    lod.changed_counts = 0;
+}
+
+}  // namespace
+
+bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
+                const BoundingSphere* bounds) {
+    if (bounds != nullptr && bounds->radius_m >= 0.0) {
+        const ViewTransform tf(view);
+        if (PlaneTest(view, bounds->radius_m).outside(tf(bounds->centre_m)) != 0) {
+            bool changed = false;
+            mark_culled(lod, changed);
+            return changed;
+        }
+    }
     const double eps = tolerance_or_default(settings.tolerance_px);
     const uint32_t max_rings = settings.max_rings_per_segment ? settings.max_rings_per_segment : default_max_rings;
     const uint32_t max_sides = std::max<uint32_t>(settings.max_sides ? settings.max_sides : default_max_sides, 3);
@@ -230,13 +272,8 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
         wire_outside &= outside[i];
     }
     if (n == 0 || wire_outside != 0) {
-        const bool changed = lod.visible || !lod.counts.empty();
-        lod.visible = false;
-        lod.counts.clear();
-        lod.required.clear();
-        lod.sides = 0;
-        lod.required_sides = 0;
-        lod.z_min_m = 0.0;
+        bool changed = false;
+        mark_culled(lod, changed);
         return changed;
     }
 

@@ -461,6 +461,42 @@ TEST(LodCulling, ViewSpaceTestAgreesWithWorldPlanes) {
     EXPECT_GT(culled, 400);
 }
 
+TEST(LodCulling, BoundingSphereCullGivesTheSameLodAsTheHullTest) {
+    // The O(1) sphere test may only skip work: for every wire and camera, update_lod with the sphere must leave
+    // exactly the state it leaves without it, and the sphere must contain every inflated control point.
+    Rng rng(23);
+    int culled_by_sphere = 0, visible = 0;
+    for (int i = 0; i < 600; ++i) {
+        WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
+        const glm::dvec3 shift = random_unit(rng) * uniform(rng, 0.0, 30.0);
+        for (glm::dvec3& p : nodes.positions) p += shift;
+        Curve curve;
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = static_cast<float>(uniform(rng, 0.001, 0.3))}, curve).ok);
+        const BoundingSphere sphere = curve_bounding_sphere(curve);
+        for (const CubicBezier& c : curve.segments)
+            for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3})
+                ASSERT_LE(glm::length(p - sphere.centre_m) + curve.radius_m[0], sphere.radius_m * (1 + 1e-12));
+        const LodView view = LodView::perspective(random_unit(rng) * uniform(rng, 0.0, 10.0), random_unit(rng) * 5.0,
+                                                  glm::dvec3(0, 1, 0), kFov, kWidth, kHeight, 0.1, 60.0);
+        WireLod with, without;
+        update_lod(curve, view, {}, without);
+        update_lod(curve, view, {}, with, &sphere);
+        ASSERT_EQ(with.visible, without.visible) << "case " << i;
+        EXPECT_EQ(with.counts, without.counts) << "case " << i;
+        EXPECT_EQ(with.sides, without.sides) << "case " << i;
+        EXPECT_EQ(with.visible_segments, without.visible_segments) << "case " << i;
+        // Was the sphere alone enough to cull? (planes from the world-space frustum, same convention as above)
+        bool sphere_out = false;
+        for (const glm::dvec4& plane : view.planes)
+            sphere_out = sphere_out || glm::dot(glm::dvec3(plane), sphere.centre_m) + plane.w < -sphere.radius_m;
+        culled_by_sphere += sphere_out ? 1 : 0;
+        visible += with.visible ? 1 : 0;
+    }
+    // Both outcomes occur, so the comparison means something.
+    EXPECT_GT(culled_by_sphere, 60);
+    EXPECT_GT(visible, 60);
+}
+
 TEST(LodCulling, OffscreenSegmentsAreCoarse) {
     // A long straight-ish cable passing beside and behind the camera: segments off screen get 1 ring.
     WireNodes nodes;

@@ -92,12 +92,27 @@ struct WireLod {
     double z_min_m = 0.0;            ///< nearest depth of the visible segments (clamped to the near plane)
 };
 
-/// Updates `lod` for `curve` seen by `view`. Culled wires (no visible segment) get visible = false, empty counts
+/// A sphere enclosing a wire's tube: every control point of the curve, inflated by its largest radius. Computed
+/// once when the curve changes (O(control points)); tested against the frustum in O(1) every frame.
+struct BoundingSphere {
+    glm::dvec3 centre_m{};
+    double radius_m = -1.0;  ///< < 0: unknown (update_lod then skips the quick test)
+};
+
+/// The bounding sphere of `curve` (centre of the control points' box, radius its half diagonal plus the largest
+/// tube radius). An empty curve gives radius -1.
+[[nodiscard]] BoundingSphere curve_bounding_sphere(const Curve& curve);
+
+/// Updates `lod` for `curve` seen by `view`. With `bounds` (from curve_bounding_sphere), a wire whose sphere is
+/// outside one frustum plane is culled in O(1) before any per-segment work: the result is the same as the hull
+/// test's (the sphere contains every inflated control point), only cheaper, so an off-screen wire costs one
+/// sphere test per camera change. Culled wires (no visible segment) get visible = false, empty counts
 /// and sides 0: the caller builds no rings. Otherwise counts holds segment_count() entries >= 1, each at least
 /// what the tolerance requires (hysteresis may keep more, never fewer), and sides in [3, max_sides].
 /// If the segment count differs from the previous update, hysteresis restarts from the raw counts.
 /// Returns whether counts or sides changed (the ring stage can skip the wire otherwise).
-bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod);
+bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
+                const BoundingSphere* bounds = nullptr);
 
 /// True if the control points of every segment, inflated by radius_m, are not all outside one frustum plane.
 [[nodiscard]] bool hull_visible(std::span<const CubicBezier> segments, double radius_m, const LodView& view);

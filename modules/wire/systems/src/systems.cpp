@@ -144,6 +144,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         ++c.builds;
         if (job.status.ok) {
             ++c.generation;
+            c.bounds = curve_bounding_sphere(c.curve);
             job.changed = true;
             c.previous_nodes = nodes;
         }
@@ -214,7 +215,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
         settings.max_sides = job.style->max_sides ? job.style->max_sides : kDefaultMaxSides;
         if (base.max_sides != 0) settings.max_sides = std::min(settings.max_sides, base.max_sides);
         WireLodState& s = *job.lod;
-        if (update_lod(job.curve->curve, ctx.view, settings, s.lod)) ++s.generation;
+        if (update_lod(job.curve->curve, ctx.view, settings, s.lod, &job.curve->bounds)) ++s.generation;
         ++s.updates;
         s.seen_curve = job.curve->generation;
         s.seen_view = view_generation;

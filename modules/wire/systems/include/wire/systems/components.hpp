@@ -37,6 +37,7 @@ struct WireCurve {
     Curve curve;                       ///< what is drawn; empty until the nodes were valid once
     SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
     uint64_t generation = 0;           ///< +1 each time `curve` changes
+    BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test)
     uint64_t builds = 0;               ///< times the curve stage ran for this wire (test/statistics counter)
     bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
     bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
