@@ -1,7 +1,7 @@
-// `wiretool bench`, part 2: speed against error. Reference scenes whose exact answer is generated in code (catenary,
-// helix, stretched run + tight bend, hairpin, smooth random curve, churn), every spline method, three frame methods
-// and five LOD tolerances; per row time, size, world/screen/twist error and pops. Writes accuracy.csv, accuracy.md,
-// stability.md and speed_vs_error.png (gnuplot, when installed).
+// `wiretool bench`, part 2: speed against error. Reference scenes whose exact answer is generated in code
+// (catenary, helix, stretched run + tight bend, hairpin, smooth random curve, churn), every spline method,
+// three frame methods and five LOD tolerances; per row time, size, world/screen/twist error and pops. Writes
+// accuracy.csv, accuracy.md, stability.md and speed_vs_error.png (gnuplot, when installed).
 #include "bench_common.hpp"
 #include "commands.hpp"
 
@@ -34,20 +34,22 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kTolerancesPx[] = {0.1, 0.25, 0.5, 1.0, 2.0};
 constexpr float kRadiusM = 0.01f;
 /// Samples per segment of the pop metric (--quick: 96). Its polyline error is ~h^2 k / 8: at 32 a strongly
-/// overshooting 2 m segment (chordal on the stretched run) reads a 1.1 mm pop that 256 samples show to be 0.02 mm.
+/// overshooting 2 m segment (chordal on the stretched run) reads a 1.1 mm pop that 256 samples show to be
+/// 0.02 mm.
 constexpr int kPopSamplesPerSegment = 256;
 constexpr int kQuickPopSamplesPerSegment = 96;
 
-// ---- scenes -------------------------------------------------------------------------------------------------
+// ---- scenes
+// -------------------------------------------------------------------------------------------------
 
 /// A scene: one wire's nodes, taken from an exact curve at known parameters, and how to measure against it.
 struct Scene {
     std::string name;
     std::string description;
-    wire::WireNodes nodes;            ///< with ids (the pop events and churn need them)
-    float stretch = 1.0f;             ///< for the physics arrays of the curvature-tension method
-    // Truth: an exact catenary, or a dense polyline of the exact curve with the curve parameter of every sample
-    // and of every node (so a query only searches near its own segment).
+    wire::WireNodes nodes;  ///< with ids (the pop events and churn need them)
+    float stretch = 1.0f;   ///< for the physics arrays of the curvature-tension method
+    // Truth: an exact catenary, or a dense polyline of the exact curve with the curve parameter of every
+    // sample and of every node (so a query only searches near its own segment).
     bool catenary_truth = false;
     wire::Catenary catenary;
     std::vector<glm::dvec3> dense;
@@ -97,11 +99,13 @@ void sample_truth(Scene& s, const std::function<glm::dvec3(double)>& curve, cons
 Scene catenary_scene(const std::string& name) {
     Scene s;
     s.name = name;
-    s.description = "20 m catenary (0,0,0)-(16,2,0), 16 nodes at s = L(1-cos(pi i/15))/2 (dense near the ends)";
+    s.description =
+        "20 m catenary (0,0,0)-(16,2,0), 16 nodes at s = L(1-cos(pi i/15))/2 (dense near the ends)";
     s.catenary_truth = true;
     (void)s.catenary.solve(glm::dvec3(0.0), glm::dvec3(16.0, 2.0, 0.0), 20.0);
     std::vector<double> arc;
-    for (int i = 0; i < 16; ++i) arc.push_back(s.catenary.length_m() * 0.5 * (1.0 - std::cos(kPi * i / 15.0)));
+    for (int i = 0; i < 16; ++i)
+        arc.push_back(s.catenary.length_m() * 0.5 * (1.0 - std::cos(kPi * i / 15.0)));
     s.nodes.positions = s.catenary.points_at_arc_lengths(arc);
     set_ids(s.nodes);
     return s;
@@ -114,18 +118,20 @@ Scene helix_scene() {
     const double a = 1.0, b = 0.3;
     std::vector<double> params;
     for (int i = 0; i <= 36; ++i) params.push_back(2.0 * kPi * i / 12.0);
-    sample_truth(s, [&](double th) { return glm::dvec3(a * std::cos(th), a * std::sin(th), b * th); }, params, 0.0,
-                 params.back(), 40000);
+    sample_truth(
+        s, [&](double th) { return glm::dvec3(a * std::cos(th), a * std::sin(th), b * th); }, params, 0.0,
+        params.back(), 40000);
     return s;
 }
 
-/// Stretched 6% along +x (nodes every 2 m to x = 10), a 0.1 m element turning 90 degrees down, then long elements:
-/// the straight run must stay on its line.
+/// Stretched 6% along +x (nodes every 2 m to x = 10), a 0.1 m element turning 90 degrees down, then long
+/// elements: the straight run must stay on its line.
 Scene stretched_bend_scene() {
     Scene s;
     s.name = "stretched_bend";
-    s.description = "6% stretched straight run (nodes every 2 m), 0.1 m element turning 90 deg, long run down; "
-                    "world error = distance off the straight line over the run";
+    s.description =
+        "6% stretched straight run (nodes every 2 m), 0.1 m element turning 90 deg, long run down; "
+        "world error = distance off the straight line over the run";
     for (int i = 0; i <= 5; ++i) s.nodes.positions.emplace_back(2.0 * i, 0.0, 0.0);
     s.nodes.positions.emplace_back(10.0, -0.1, 0.0);
     s.nodes.positions.emplace_back(10.0, -2.1, 0.0);
@@ -137,12 +143,13 @@ Scene stretched_bend_scene() {
     return s;
 }
 
-/// Two 5 m legs 0.5 m apart joined by a half circle of radius 0.25 m; nodes every metre on the legs and at every
-/// 45 degrees on the turn.
+/// Two 5 m legs 0.5 m apart joined by a half circle of radius 0.25 m; nodes every metre on the legs and at
+/// every 45 degrees on the turn.
 Scene hairpin_scene() {
     Scene s;
     s.name = "hairpin";
-    s.description = "hairpin: two 5 m legs joined by a half circle of radius 0.25 m, nodes every 1 m and every 45 deg";
+    s.description =
+        "hairpin: two 5 m legs joined by a half circle of radius 0.25 m, nodes every 1 m and every 45 deg";
     const double r = 0.25, leg = 5.0, arc = kPi * r;
     auto u_shape = [=](double p) {  // p = arc length from the start of the first leg
         if (p <= leg) return glm::dvec3(leg - p, r, 0.0);
@@ -160,11 +167,13 @@ Scene hairpin_scene() {
     return s;
 }
 
-/// A smooth random curve (random Fourier series, fixed seed) through 40 nodes at random spacing (ratio up to ~4).
+/// A smooth random curve (random Fourier series, fixed seed) through 40 nodes at random spacing (ratio up to
+/// ~4).
 Scene random_walk_scene() {
     Scene s;
     s.name = "random_walk";
-    s.description = "smooth random 3D curve (6-term random Fourier series, ~12 m) through 40 nodes at random spacing";
+    s.description =
+        "smooth random 3D curve (6-term random Fourier series, ~12 m) through 40 nodes at random spacing";
     unsigned seed = 12345u;
     auto rnd = [&seed] {
         seed = seed * 1664525u + 1013904223u;
@@ -193,7 +202,8 @@ Scene random_walk_scene() {
     return s;
 }
 
-// ---- measurements -----------------------------------------------------------------------------------------------
+// ---- measurements
+// -----------------------------------------------------------------------------------------------
 
 double point_segment_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
     const glm::dvec3 ab = b - a;
@@ -217,12 +227,14 @@ double truth_distance(const Scene& s, const glm::dvec3& p, const wire::Curve& cu
     std::size_t i1 = std::min(static_cast<std::size_t>(hi - s.dense_param.begin()), s.dense.size() - 1);
     if (i0 > 0) --i0;
     double best = 1e300;
-    for (std::size_t i = i0; i < i1; ++i) best = std::min(best, point_segment_distance(p, s.dense[i], s.dense[i + 1]));
+    for (std::size_t i = i0; i < i1; ++i)
+        best = std::min(best, point_segment_distance(p, s.dense[i], s.dense[i + 1]));
     return best;
 }
 
-/// Largest distance of the drawn centre polyline (ring centres, 4 points per ring interval) to the exact curve;
-/// for the stretched run: largest distance off the line y = z = 0 over its first straight_segments segments.
+/// Largest distance of the drawn centre polyline (ring centres, 4 points per ring interval) to the exact
+/// curve; for the stretched run: largest distance off the line y = z = 0 over its first straight_segments
+/// segments.
 double world_error_m(const Scene& s, const wire::Curve& curve, const std::vector<wire::RingParam>& params) {
     double worst = 0.0;
     for (std::size_t i = 0; i < params.size(); ++i) {
@@ -233,7 +245,8 @@ double world_error_m(const Scene& s, const wire::Curve& curve, const std::vector
         for (int q = 0; q < (last ? 1 : 4); ++q) {
             const glm::dvec3 p = a + (b - a) * (q / 4.0);
             if (s.straight_segments > 0) {
-                if (params[i].segment < s.straight_segments && (last || params[i + 1].segment < s.straight_segments))
+                if (params[i].segment < s.straight_segments &&
+                    (last || params[i + 1].segment < s.straight_segments))
                     worst = std::max(worst, std::hypot(p.y, p.z));
             } else {
                 worst = std::max(worst, truth_distance(s, p, curve, params[i].segment));
@@ -243,7 +256,8 @@ double world_error_m(const Scene& s, const wire::Curve& curve, const std::vector
     return worst;
 }
 
-/// Ring parameters with `sub` steps per ring interval (ring i of `params` is entry i*sub), for a reference RMF.
+/// Ring parameters with `sub` steps per ring interval (ring i of `params` is entry i*sub), for a reference
+/// RMF.
 std::vector<wire::RingParam> refine(const std::vector<wire::RingParam>& params, int sub) {
     std::vector<wire::RingParam> out;
     for (std::size_t i = 0; i + 1 < params.size(); ++i) {
@@ -255,9 +269,9 @@ std::vector<wire::RingParam> refine(const std::vector<wire::RingParam>& params, 
     return out;
 }
 
-/// Largest angle (degrees) between each ring's normal and the rotation-minimizing frame of the same curve at the
-/// same parameter, both seeded alike at ring 0. The reference is double reflection with 64 steps per ring interval
-/// (fourth order: converged to ~1e-9 degrees), so this isolates the frame method from the spline.
+/// Largest angle (degrees) between each ring's normal and the rotation-minimizing frame of the same curve at
+/// the same parameter, both seeded alike at ring 0. The reference is double reflection with 64 steps per ring
+/// interval (fourth order: converged to ~1e-9 degrees), so this isolates the frame method from the spline.
 double twist_error_deg(const wire::Curve& curve, const std::vector<wire::RingParam>& params,
                        const wire::RingSet& rings) {
     constexpr int kSub = 64;
@@ -268,19 +282,21 @@ double twist_error_deg(const wire::Curve& curve, const std::vector<wire::RingPar
     for (std::size_t i = 0; i < rings.frames.size(); ++i) {
         const wire::Frame& g = ref.frames[i * kSub];
         const wire::Frame& f = rings.frames[i];
-        worst = std::max(worst, std::abs(std::atan2(glm::dot(glm::cross(g.r, f.r), g.t), glm::dot(g.r, f.r))));
+        worst =
+            std::max(worst, std::abs(std::atan2(glm::dot(glm::cross(g.r, f.r), g.t), glm::dot(g.r, f.r))));
     }
     return worst * 180.0 / kPi;
 }
 
-// ---- methods ----------------------------------------------------------------------------------------------------
+// ---- methods
+// ----------------------------------------------------------------------------------------------------
 
 struct Method {
     std::string name;
     wire::SplineSettings spline;
     wire::FrameMethod frames = wire::FrameMethod::double_reflection;
-    bool physics = false;   ///< curvature tension from per-node physics arrays
-    std::string spline_key; ///< methods with the same curve share their pop measurement
+    bool physics = false;    ///< curvature tension from per-node physics arrays
+    std::string spline_key;  ///< methods with the same curve share their pop measurement
 };
 
 std::vector<Method> methods() {
@@ -292,12 +308,21 @@ std::vector<Method> methods() {
         {"chordal", {.kind = SplineKind::catmull_rom, .alpha = 1.0}, {}, false, "chordal"},
         {"c2", {.kind = SplineKind::c2}, {}, false, "c2"},
         {"auto", {.kind = SplineKind::automatic}, {}, false, "auto"},
-        {"curvature_tension", {.kind = SplineKind::catmull_rom, .alpha = 0.5, .curvature_tension = true}, {}, true,
+        {"curvature_tension",
+         {.kind = SplineKind::catmull_rom, .alpha = 0.5, .curvature_tension = true},
+         {},
+         true,
          "curvature_tension"},
-        {"centripetal+rotation", {.kind = SplineKind::catmull_rom, .alpha = 0.5}, wire::FrameMethod::rotation, false,
+        {"centripetal+rotation",
+         {.kind = SplineKind::catmull_rom, .alpha = 0.5},
+         wire::FrameMethod::rotation,
+         false,
          "centripetal"},
-        {"centripetal+projection", {.kind = SplineKind::catmull_rom, .alpha = 0.5}, wire::FrameMethod::projection,
-         false, "centripetal"},
+        {"centripetal+projection",
+         {.kind = SplineKind::catmull_rom, .alpha = 0.5},
+         wire::FrameMethod::projection,
+         false,
+         "centripetal"},
     };
 }
 
@@ -314,13 +339,15 @@ void add_physics(wire::WireNodes& n, float stretch) {
         const glm::dvec3 in = i > 0 ? n.positions[i] - n.positions[i - 1] : glm::dvec3(0.0);
         const glm::dvec3 out = i + 1 < count ? n.positions[i + 1] - n.positions[i] : glm::dvec3(0.0);
         const double li = glm::length(in), lo = glm::length(out);
-        if (li > 0.0 && lo > 0.0) n.theta_rad[i] = std::acos(std::clamp(glm::dot(in, out) / (li * lo), -1.0, 1.0));
+        if (li > 0.0 && lo > 0.0)
+            n.theta_rad[i] = std::acos(std::clamp(glm::dot(in, out) / (li * lo), -1.0, 1.0));
         n.length_m[i] = li + lo;
         n.delta_length_m[i] = (li + lo) * (static_cast<double>(stretch) - 1.0);
     }
 }
 
-/// Inserts a node before `at` with id `id`, copying the neighbour's optional per-node entries (physics included).
+/// Inserts a node before `at` with id `id`, copying the neighbour's optional per-node entries (physics
+/// included).
 void insert_node(wire::WireNodes& n, std::size_t at, const glm::dvec3& p, uint32_t id) {
     auto dup = [at](auto& v) {
         if (v.empty()) return;
@@ -341,7 +368,8 @@ void remove_node(wire::WireNodes& n, std::size_t at) {
         erase(n.length_m), erase(n.delta_length_m), erase(n.area_m2);
 }
 
-// ---- the pipeline of one wire, timed --------------------------------------------------------------------------
+// ---- the pipeline of one wire, timed
+// --------------------------------------------------------------------------
 
 struct WireOutput {
     wire::Curve curve;
@@ -356,7 +384,8 @@ void tessellate(const wire::LodView& view, double tolerance_px, wire::FrameMetho
                 WireOutput& w) {
     w.lod = {};
     (void)wire::update_lod(w.curve, view, {.tolerance_px = tolerance_px, .hysteresis_band = -1.0}, w.lod);
-    if (w.lod.counts.empty()) w.lod.counts.assign(w.curve.segment_count(), 1u);  // culled: never in these scenes
+    if (w.lod.counts.empty())
+        w.lod.counts.assign(w.curve.segment_count(), 1u);  // culled: never in these scenes
     wire::place_rings(w.curve, w.lod.counts, w.params);
     wire::RingSettings rs;
     rs.frames.method = frames;
@@ -364,8 +393,8 @@ void tessellate(const wire::LodView& view, double tolerance_px, wire::FrameMetho
     if (mesh) wire::build_tube(w.rings, {.sides = std::max(3u, w.lod.sides)}, w.mesh);
 }
 
-/// Median over 3 trials of the CPU time of one call of `fn`, microseconds (each trial repeats `fn` until it has
-/// used at least `min_ms`).
+/// Median over 3 trials of the CPU time of one call of `fn`, microseconds (each trial repeats `fn` until it
+/// has used at least `min_ms`).
 double time_us(const std::function<void()>& fn, double min_ms) {
     std::vector<double> trials;
     for (int t = 0; t < 3; ++t) {
@@ -382,17 +411,18 @@ double time_us(const std::function<void()>& fn, double min_ms) {
     return median(trials);
 }
 
-// ---- pops -------------------------------------------------------------------------------------------------------
+// ---- pops
+// -------------------------------------------------------------------------------------------------------
 
 struct Pops {
     double no_remedy_m = 0.0;
     double remedy_m = 0.0;
 };
 
-/// Runs `states` (each shown for at least one frame, then held until the geomorph ends) and returns the largest
-/// jump between consecutive rendered curves, with and without the remedy.
-Pops measure_pops(const std::vector<wire::WireNodes>& states, const wire::SplineSettings& spline, int hold_frames,
-                  int samples) {
+/// Runs `states` (each shown for at least one frame, then held until the geomorph ends) and returns the
+/// largest jump between consecutive rendered curves, with and without the remedy.
+Pops measure_pops(const std::vector<wire::WireNodes>& states, const wire::SplineSettings& spline,
+                  int hold_frames, int samples) {
     Pops out;
     for (bool remedy : {false, true}) {
         wire::MultiresCurve m({.spline = spline, .geomorph = remedy});
@@ -413,8 +443,8 @@ Pops measure_pops(const std::vector<wire::WireNodes>& states, const wire::Spline
     return out;
 }
 
-/// One event on a static scene: a node inserted exactly on the curve in the middle of the middle segment, then an
-/// original interior node removed.
+/// One event on a static scene: a node inserted exactly on the curve in the middle of the middle segment,
+/// then an original interior node removed.
 Pops event_pops(const wire::WireNodes& nodes, const wire::SplineSettings& spline, int samples) {
     wire::Curve c;
     if (!wire::build_curve(nodes, spline, c) || c.segment_count() < 3) return {};
@@ -427,10 +457,10 @@ Pops event_pops(const wire::WireNodes& nodes, const wire::SplineSettings& spline
     return measure_pops({nodes, inserted, removed}, spline, 400, samples);
 }
 
-/// Churn: the catenary's nodes while the simulation refines and coarsens: every 5 frames an event, two of every
-/// three insert a node exactly on the rendered target curve (middle of a random segment), the third removes a random
-/// one of the inserted nodes (coarsening undoes refinement; the original nodes stay, as the posts and the physics'
-/// coarsest level would). The states of every frame, in order.
+/// Churn: the catenary's nodes while the simulation refines and coarsens: every 5 frames an event, two of
+/// every three insert a node exactly on the rendered target curve (middle of a random segment), the third
+/// removes a random one of the inserted nodes (coarsening undoes refinement; the original nodes stay, as the
+/// posts and the physics' coarsest level would). The states of every frame, in order.
 std::vector<wire::WireNodes> churn_states(const wire::WireNodes& start, const wire::SplineSettings& spline,
                                           int frames) {
     std::vector<wire::WireNodes> states;
@@ -466,7 +496,8 @@ Pops churn_pops(const std::vector<wire::WireNodes>& states, const wire::SplineSe
     return measure_pops(states, spline, 1, samples);
 }
 
-// ---- rows -------------------------------------------------------------------------------------------------------
+// ---- rows
+// -------------------------------------------------------------------------------------------------------
 
 struct Row {
     std::string scene, method;
@@ -477,9 +508,22 @@ struct Row {
 };
 
 std::vector<std::string> to_cells(const Row& r) {
-    return {r.scene, r.method, num(r.tolerance_px), num(r.rings), num(r.sides), num(r.vertices), num(r.bytes_cpu),
-            num(r.bytes_gpu), num(r.ns_per_vertex), num(r.us_cpu), num(r.us_gpu), num(r.world_m), num(r.screen_px),
-            num(r.twist_deg), num(r.pop_m), num(r.pop_remedy_m)};
+    return {r.scene,
+            r.method,
+            num(r.tolerance_px),
+            num(r.rings),
+            num(r.sides),
+            num(r.vertices),
+            num(r.bytes_cpu),
+            num(r.bytes_gpu),
+            num(r.ns_per_vertex),
+            num(r.us_cpu),
+            num(r.us_gpu),
+            num(r.world_m),
+            num(r.screen_px),
+            num(r.twist_deg),
+            num(r.pop_m),
+            num(r.pop_remedy_m)};
 }
 
 Row measure_row(const Scene& s, const Method& m, const wire::WireNodes& nodes, double tol, double min_ms) {
@@ -503,21 +547,27 @@ Row measure_row(const Scene& s, const Method& m, const wire::WireNodes& nodes, d
     r.twist_deg = twist_error_deg(w.curve, w.params, w.rings);
 
     WireOutput t;
-    r.us_cpu = time_us([&] {
-        (void)wire::build_curve(nodes, m.spline, t.curve);
-        tessellate(s.view, tol, m.frames, true, t);
-    }, min_ms);
-    r.us_gpu = time_us([&] {
-        (void)wire::build_curve(nodes, m.spline, t.curve);
-        tessellate(s.view, tol, m.frames, false, t);
-    }, min_ms);
+    r.us_cpu = time_us(
+        [&] {
+            (void)wire::build_curve(nodes, m.spline, t.curve);
+            tessellate(s.view, tol, m.frames, true, t);
+        },
+        min_ms);
+    r.us_gpu = time_us(
+        [&] {
+            (void)wire::build_curve(nodes, m.spline, t.curve);
+            tessellate(s.view, tol, m.frames, false, t);
+        },
+        min_ms);
     r.ns_per_vertex = r.vertices > 0 ? 1e3 * r.us_cpu / static_cast<double>(r.vertices) : 0.0;
     return r;
 }
 
-/// Churn rows: every frame's state through the pop-free curve stage, then lod/rings/mesh; time per frame, errors
-/// as the worst over the frames (world error against the catenary, which the inserted nodes lie near, not on).
-Row measure_churn_row(const Scene& s, const Method& m, const std::vector<wire::WireNodes>& states, double tol) {
+/// Churn rows: every frame's state through the pop-free curve stage, then lod/rings/mesh; time per frame,
+/// errors as the worst over the frames (world error against the catenary, which the inserted nodes lie near,
+/// not on).
+Row measure_churn_row(const Scene& s, const Method& m, const std::vector<wire::WireNodes>& states,
+                      double tol) {
     Row r;
     r.scene = s.name;
     r.method = m.name;
@@ -539,20 +589,24 @@ Row measure_churn_row(const Scene& s, const Method& m, const std::vector<wire::W
         r.bytes_gpu = std::max(r.bytes_gpu, gpu_rings_bytes(1, w.rings.rings.size()));
         if (f % 10 == 0 || f + 1 == states.size()) {
             r.world_m = std::max(r.world_m, world_error_m(s, w.curve, w.params));
-            r.screen_px = std::max(r.screen_px, wire::measure_screen_error(w.curve, w.params, s.view, 128).max_px);
+            r.screen_px =
+                std::max(r.screen_px, wire::measure_screen_error(w.curve, w.params, s.view, 128).max_px);
             r.twist_deg = std::max(r.twist_deg, twist_error_deg(w.curve, w.params, w.rings));
         }
     }
     r.us_cpu = median(us);
-    r.us_gpu = r.us_cpu;  // the frame cost is dominated by the pop-free curve stage; the tube is not split out here
+    r.us_gpu =
+        r.us_cpu;  // the frame cost is dominated by the pop-free curve stage; the tube is not split out here
     r.ns_per_vertex = r.vertices > 0 ? 1e3 * r.us_cpu / static_cast<double>(r.vertices) : 0.0;
     (void)frames;
     return r;
 }
 
-// ---- outputs ----------------------------------------------------------------------------------------------------
+// ---- outputs
+// ----------------------------------------------------------------------------------------------------
 
-const Row* find_row(const std::vector<Row>& rows, const std::string& scene, const std::string& method, double tol) {
+const Row* find_row(const std::vector<Row>& rows, const std::string& scene, const std::string& method,
+                    double tol) {
     for (const Row& r : rows)
         if (r.scene == scene && r.method == method && std::abs(r.tolerance_px - tol) < 1e-12) return &r;
     return nullptr;
@@ -568,20 +622,29 @@ std::string plot(const Options& o, const std::vector<Row>& rows) {
         bool twist;
         std::vector<std::string> methods;
     };
-    const std::vector<std::string> splines = {"linear", "uniform", "centripetal", "chordal", "c2", "auto",
-                                              "curvature_tension"};
+    const std::vector<std::string> splines = {"linear", "uniform", "centripetal",      "chordal",
+                                              "c2",     "auto",    "curvature_tension"};
     const std::vector<Panel> panels = {
-        {"catenary", "catenary 20 m, 16 nodes", "max world error against the exact catenary (m)", false, splines},
-        {"random_walk", "smooth random curve, 40 nodes", "max world error against the exact curve (m)", false, splines},
-        {"helix", "helix, 3 turns: frame methods", "max twist error against the RMF (degrees)", true,
+        {"catenary", "catenary 20 m, 16 nodes", "max world error against the exact catenary (m)", false,
+         splines},
+        {"random_walk", "smooth random curve, 40 nodes", "max world error against the exact curve (m)", false,
+         splines},
+        {"helix",
+         "helix, 3 turns: frame methods",
+         "max twist error against the RMF (degrees)",
+         true,
          {"centripetal", "centripetal+rotation", "centripetal+projection"}},
     };
     std::string data, script;
     script += "set terminal png size 1800,620 font \",11\" noenhanced\n";
-    script += "set output '" + png.string() + "'\nset multiplot layout 1,3 title \"wiretool bench: time per wire "
-              "against error, one marker per LOD tolerance (0.1, 0.25, 0.5, 1, 2 px; larger tolerance = fewer rings"
-              " = less time)\"\n";
-    script += "set logscale xy\nset grid\nset key top right font \",9\"\nset ylabel \"CPU time per wire, curve+lod+rings+mesh (us)\"\n";
+    script +=
+        "set output '" + png.string() +
+        "'\nset multiplot layout 1,3 title \"wiretool bench: time per wire "
+        "against error, one marker per LOD tolerance (0.1, 0.25, 0.5, 1, 2 px; larger tolerance = fewer rings"
+        " = less time)\"\n";
+    script +=
+        "set logscale xy\nset grid\nset key top right font \",9\"\nset ylabel \"CPU time per wire, "
+        "curve+lod+rings+mesh (us)\"\n";
     int block = 0;
     bool any = false;
     for (const Panel& p : panels) {
@@ -597,7 +660,8 @@ std::string plot(const Options& o, const std::vector<Row>& rows) {
             if (lines.empty()) continue;
             data += "# " + p.scene + " " + m + "\n" + lines + "\n\n";
             plots += std::string(plots.empty() ? "plot " : ", ") + "'" + dat.string() + "' index " +
-                     std::to_string(block++) + " using 1:2 with linespoints pointsize 1.3 title \"" + m + "\"";
+                     std::to_string(block++) + " using 1:2 with linespoints pointsize 1.3 title \"" + m +
+                     "\"";
             if (m == "centripetal")
                 plots += ", '' index " + std::to_string(block - 1) +
                          " using 1:2:(sprintf(\"%g px\",$3)) with labels offset 0,-1 font \",8\" notitle";
@@ -613,9 +677,11 @@ std::string plot(const Options& o, const std::vector<Row>& rows) {
     if (!any) return "Plot skipped: none of its scenes (catenary, random_walk, helix) was run.";
     if (!write_text(dat, data) || !write_text(gp, script)) return "Plot skipped: cannot write its data.";
     if (std::system("gnuplot --version > /dev/null 2>&1") != 0)
-        return "Plot skipped: gnuplot is not installed (tools/setup.sh installs gnuplot-nox); data and script are in "
+        return "Plot skipped: gnuplot is not installed (tools/setup.sh installs gnuplot-nox); data and "
+               "script are in "
                "speed_vs_error.dat/.gp.";
-    const std::string cmd = "gnuplot '" + gp.string() + "' > '" + (o.out_dir / "gnuplot.log").string() + "' 2>&1";
+    const std::string cmd =
+        "gnuplot '" + gp.string() + "' > '" + (o.out_dir / "gnuplot.log").string() + "' 2>&1";
     if (std::system(cmd.c_str()) != 0 || !std::filesystem::exists(png))
         return "Plot failed: see gnuplot.log (script speed_vs_error.gp).";
     return "Plot: speed_vs_error.png (data speed_vs_error.dat, script speed_vs_error.gp).";
@@ -634,8 +700,9 @@ int run_accuracy_bench(const Options& o) {
     if (want("churn")) {
         scenes.push_back(catenary_scene("churn"));
         scenes.back().churn = true;
-        scenes.back().description = "the 20 m catenary refined and coarsened: every 5 frames a node is inserted exactly "
-                                    "on the curve (2 events of 3) or an inserted node removed (1 of 3)";
+        scenes.back().description =
+            "the 20 m catenary refined and coarsened: every 5 frames a node is inserted exactly "
+            "on the curve (2 events of 3) or an inserted node removed (1 of 3)";
     }
     for (Scene& s : scenes) frame_camera(s);
     const double min_ms = o.quick ? 0.3 : 3.0;
@@ -665,9 +732,22 @@ int run_accuracy_bench(const Options& o) {
     }
 
     Table csv;
-    csv.header = {"scene", "method", "tolerance_px", "rings", "sides", "vertices", "bytes_cpu_mesh",
-                  "bytes_gpu_rings", "ns_per_vertex", "us_per_wire_cpu_mesh", "us_per_wire_gpu_rings",
-                  "max_world_error_m", "max_screen_error_px", "max_twist_deg", "max_pop_m", "max_pop_remedy_m"};
+    csv.header = {"scene",
+                  "method",
+                  "tolerance_px",
+                  "rings",
+                  "sides",
+                  "vertices",
+                  "bytes_cpu_mesh",
+                  "bytes_gpu_rings",
+                  "ns_per_vertex",
+                  "us_per_wire_cpu_mesh",
+                  "us_per_wire_gpu_rings",
+                  "max_world_error_m",
+                  "max_screen_error_px",
+                  "max_twist_deg",
+                  "max_pop_m",
+                  "max_pop_remedy_m"};
     for (const Row& r : rows) csv.add(to_cells(r));
     if (!csv.write_csv(o.out_dir / "accuracy.csv")) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "accuracy.csv").c_str());
@@ -676,18 +756,28 @@ int run_accuracy_bench(const Options& o) {
 
     const std::string plot_note = plot(o, rows);
     std::string md = "# wiretool bench: speed against error\n\n";
-    md += "One wire per scene, seen whole by a 1920x1080, 60-degree camera; every spline method (frames by double "
-          "reflection) plus centripetal with the rotation and projection frame baselines; LOD tolerances 0.1, 0.25, "
-          "0.5, 1 and 2 px. Columns: rings, radial sides and tube vertices the LOD chose; bytes one frame uploads "
-          "(cpu-mesh: vertices + indices + draw record + command; gpu-rings: 48-byte ring records + draw record + "
-          "command); CPU time of curve + lod + rings + mesh (cpu-mesh) or curve + lod + rings (gpu-rings) per wire, "
-          "median of 3 trials, and per vertex; `max_world_error_m`: largest distance from the drawn centre polyline "
-          "to the exact curve (spline error plus tessellation error); `max_screen_error_px`: largest pixel distance "
-          "from the rendered curve to the drawn polyline; `max_twist_deg`: largest angle between a ring's normal "
-          "and the rotation-minimizing frame of the same curve at the same point (double reflection at 64 steps "
-          "per ring interval); `max_pop_m`/`max_pop_remedy_m`: largest displacement between consecutive frames "
-          "without/with the pop-free geomorph, for one node inserted exactly on the curve then one removed "
-          "(churn: every event of the run). Pops do not depend on the tolerance.\n\n";
+    md +=
+        "One wire per scene, seen whole by a 1920x1080, 60-degree camera; every spline method (frames by "
+        "double "
+        "reflection) plus centripetal with the rotation and projection frame baselines; LOD tolerances 0.1, "
+        "0.25, "
+        "0.5, 1 and 2 px. Columns: rings, radial sides and tube vertices the LOD chose; bytes one frame "
+        "uploads "
+        "(cpu-mesh: vertices + indices + draw record + command; gpu-rings: 48-byte ring records + draw "
+        "record + "
+        "command); CPU time of curve + lod + rings + mesh (cpu-mesh) or curve + lod + rings (gpu-rings) per "
+        "wire, "
+        "median of 3 trials, and per vertex; `max_world_error_m`: largest distance from the drawn centre "
+        "polyline "
+        "to the exact curve (spline error plus tessellation error); `max_screen_error_px`: largest pixel "
+        "distance "
+        "from the rendered curve to the drawn polyline; `max_twist_deg`: largest angle between a ring's "
+        "normal "
+        "and the rotation-minimizing frame of the same curve at the same point (double reflection at 64 "
+        "steps "
+        "per ring interval); `max_pop_m`/`max_pop_remedy_m`: largest displacement between consecutive frames "
+        "without/with the pop-free geomorph, for one node inserted exactly on the curve then one removed "
+        "(churn: every event of the run). Pops do not depend on the tolerance.\n\n";
     md += "Scenes:\n\n";
     for (const Scene& s : scenes) md += "- `" + s.name + "`: " + s.description + "\n";
     md += "\n" + plot_note + "\n\n";
@@ -710,10 +800,12 @@ int run_accuracy_bench(const Options& o) {
         const Row* rot = find_row(rows, "helix", "centripetal+rotation", 0.5);
         const Row* proj = find_row(rows, "helix", "centripetal+projection", 0.5);
         std::snprintf(buf, sizeof buf,
-                      "- twist error on the helix at equal rings (%zu rings): double reflection %.3g deg, rotation %.3g "
+                      "- twist error on the helix at equal rings (%zu rings): double reflection %.3g deg, "
+                      "rotation %.3g "
                       "deg (%.0fx), projection %.3g deg (%.0fx)\n",
                       dr->rings, dr->twist_deg, rot ? rot->twist_deg : NAN,
-                      rot && dr->twist_deg > 0 ? rot->twist_deg / dr->twist_deg : NAN, proj ? proj->twist_deg : NAN,
+                      rot && dr->twist_deg > 0 ? rot->twist_deg / dr->twist_deg : NAN,
+                      proj ? proj->twist_deg : NAN,
                       proj && dr->twist_deg > 0 ? proj->twist_deg / dr->twist_deg : NAN);
         md += buf;
     }

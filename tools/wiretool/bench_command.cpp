@@ -35,19 +35,22 @@ int run_bench(const bench::Options& o) {
 Action add_bench_command(CLI::App& app) {
     auto o = std::make_shared<bench::Options>();
     CLI::App* cmd = app.add_subcommand(
-        "bench", "Runs the standard and reference scenes; writes DIR/bench.csv, bench.md, accuracy.csv, accuracy.md, "
+        "bench",
+        "Runs the standard and reference scenes; writes DIR/bench.csv, bench.md, accuracy.csv, accuracy.md, "
         "stability.md and speed_vs_error.png (see docs/speed_vs_error.md).");
     cmd->add_option("--out", o->out_dir, "Output directory (created if missing)")->required();
     cmd->add_flag("--quick", o->quick, "Fewer frames (finishes in under a minute); the CSV keeps its layout");
     cmd->add_option("--threads", o->threads, "Worker threads for the bench rows (tbb::global_control)")
         ->check(CLI::Range(1, 64));
-    cmd->add_option("--scenes", o->scenes, "Only these scenes (standard, offscreen, swaying; catenary, helix, stretched_bend, hairpin, "
-                    "random_walk, churn)")
-        ->delimiter(',');
+    cmd->add_option("--scenes", o->scenes, "Only these scenes, comma-separated")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"standard", "offscreen", "swaying", "catenary", "helix", "stretched_bend",
+                               "hairpin", "random_walk", "churn"}));
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
-    cmd->add_flag("--gl", o->gl,
-                  "Draw every 10th frame of `standard` with the real WireRenderer (headless EGL) and check its "
-                  "FrameStats::bytes_uploaded against the computed bytes");
+    cmd->add_flag(
+        "--gl", o->gl,
+        "Draw every 10th frame of `standard` with the real WireRenderer (headless EGL) and check its "
+        "FrameStats::bytes_uploaded against the computed bytes");
     cmd->add_flag("--no-systems", o->skip_systems, "Skip bench.csv/md (the ECS scenes)");
     return [o] { return run_bench(*o); };
 }

@@ -16,7 +16,8 @@ double cpu_ms() {
 }
 
 double wall_ms() {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch())
+        .count();
 }
 
 double median(std::vector<double> v) {
@@ -29,7 +30,7 @@ double median(std::vector<double> v) {
 }
 
 namespace {
-constexpr std::size_t kDrawRecordBytes = 32;     // detail::GpuDraw
+constexpr std::size_t kDrawRecordBytes = 32;       // detail::GpuDraw
 constexpr std::size_t kElementsCommandBytes = 20;  // DrawElementsIndirectCommand
 constexpr std::size_t kArraysCommandBytes = 16;    // DrawArraysIndirectCommand
 }  // namespace
@@ -99,7 +100,9 @@ std::string num(double v, int digits) {
     return buf;
 }
 
-std::string num(std::size_t v) { return std::to_string(v); }
+std::string num(std::size_t v) {
+    return std::to_string(v);
+}
 
 bool write_text(const std::filesystem::path& file, const std::string& text) {
     std::ofstream out(file);

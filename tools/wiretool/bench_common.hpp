@@ -16,11 +16,12 @@ namespace wiretool::bench {
 struct Options {
     bool quick = false;
     std::filesystem::path out_dir;
-    int threads = 1;                 ///< tbb::global_control for the bench rows (the 1-vs-2 thread run is separate)
-    std::vector<std::string> scenes; ///< empty: all; else only these (bench.csv and accuracy.csv scene names)
-    bool skip_accuracy = false;      ///< only bench.csv/bench.md
-    bool skip_systems = false;       ///< only accuracy/stability outputs
-    bool gl = false;                 ///< also draw `standard` with the real WireRenderer (headless EGL)
+    int threads = 1;  ///< tbb::global_control for the bench rows (the 1-vs-2 thread run is separate)
+    std::vector<std::string>
+        scenes;                  ///< empty: all; else only these (bench.csv and accuracy.csv scene names)
+    bool skip_accuracy = false;  ///< only bench.csv/bench.md
+    bool skip_systems = false;   ///< only accuracy/stability outputs
+    bool gl = false;             ///< also draw `standard` with the real WireRenderer (headless EGL)
 };
 
 /// Process CPU time (all threads), milliseconds: robust against other load on a shared machine.
@@ -30,9 +31,10 @@ double wall_ms();
 /// Median of `v` (0 for an empty vector). Takes a copy.
 double median(std::vector<double> v);
 
-/// Bytes WireRenderer::draw() memcpy's into its mapped buffer for `list` (wire_renderer.cpp): per drawn item a
-/// 32-byte draw record and a 20-byte (cpu-mesh, DrawElementsIndirect) or 16-byte (gpu-rings, DrawArraysIndirect)
-/// command, plus vertices (32 B) and indices (4 B) or ring records (48 B). Items without geometry are skipped.
+/// Bytes WireRenderer::draw() memcpy's into its mapped buffer for `list` (wire_renderer.cpp): per drawn item
+/// a 32-byte draw record and a 20-byte (cpu-mesh, DrawElementsIndirect) or 16-byte (gpu-rings,
+/// DrawArraysIndirect) command, plus vertices (32 B) and indices (4 B) or ring records (48 B). Items without
+/// geometry are skipped.
 std::size_t upload_bytes(const wire::DrawList& list);
 /// The same for a cpu-mesh upload of `items` meshes with these totals.
 std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices);
@@ -60,8 +62,8 @@ std::string num(std::size_t v);
 
 // The bench parts. Each writes its files into o.out_dir, prints progress to stderr and returns an exit status
 // (exit_ok, or exit_failure when a file could not be written).
-int run_systems_bench(const Options& o);    ///< bench.csv, bench.md
-int run_accuracy_bench(const Options& o);   ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
+int run_systems_bench(const Options& o);   ///< bench.csv, bench.md
+int run_accuracy_bench(const Options& o);  ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
 /// The DESIGN §5 hard cases as a Markdown section (case, result, max error).
 std::string stability_report();
 

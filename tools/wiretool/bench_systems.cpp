@@ -1,6 +1,7 @@
-// `wiretool bench`, part 1: the wire systems (curve -> lod -> rings -> mesh -> draw_list) on a field of hanging
-// wires seen by a moving camera: CPU time per frame and per system, counts, upload bytes, measured screen error,
-// and a uniform tessellation with the same maximum screen error as the baseline. Writes bench.csv and bench.md.
+// `wiretool bench`, part 1: the wire systems (curve -> lod -> rings -> mesh -> draw_list) on a field of
+// hanging wires seen by a moving camera: CPU time per frame and per system, counts, upload bytes, measured
+// screen error, and a uniform tessellation with the same maximum screen error as the baseline. Writes
+// bench.csv and bench.md.
 #include "bench_common.hpp"
 #include "commands.hpp"
 
@@ -8,9 +9,9 @@
 #include <engine/gfx/lit_renderer.hpp>
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
-#include <wire/render/wire_renderer.hpp>
 #include <wire/lod.hpp>
 #include <wire/reference.hpp>
+#include <wire/render/wire_renderer.hpp>
 #include <wire/rings.hpp>
 #include <wire/systems/api.hpp>
 #include <wire/systems/systems.hpp>
@@ -45,15 +46,18 @@ enum class SceneKind { standard, offscreen, swaying };
 
 const char* scene_name(SceneKind k) {
     switch (k) {
-        case SceneKind::standard: return "standard";
-        case SceneKind::offscreen: return "offscreen";
-        case SceneKind::swaying: return "swaying";
+        case SceneKind::standard:
+            return "standard";
+        case SceneKind::offscreen:
+            return "offscreen";
+        case SceneKind::swaying:
+            return "swaying";
     }
     return "?";
 }
 
-// Wire i of the field (20 rows high, count/20 deep): a catenary 10 m across, 3-8% longer than its chord, through
-// 64 nodes at equal arc lengths.
+// Wire i of the field (20 rows high, count/20 deep): a catenary 10 m across, 3-8% longer than its chord,
+// through 64 nodes at equal arc lengths.
 wire::WireNodes hanging_wire(int i) {
     const int row = i % 20, col = i / 20;
     const glm::dvec3 p1(-5.0, 0.6 * row, -1.5 * col);
@@ -68,8 +72,8 @@ wire::WireNodes hanging_wire(int i) {
     return n;
 }
 
-// standard/swaying: flies slowly into the field, swaying, so every frame moves the camera. offscreen: the same
-// motion sideways, 12 m in front of the field and looking away from it: every wire is behind the camera.
+// standard/swaying: flies slowly into the field, swaying, so every frame moves the camera. offscreen: the
+// same motion sideways, 12 m in front of the field and looking away from it: every wire is behind the camera.
 void place_camera(engine::scene::Camera& cam, SceneKind kind, int frame) {
     const float t = static_cast<float>(frame);
     if (kind == SceneKind::offscreen) {
@@ -113,7 +117,8 @@ struct RunSpec {
 };
 
 SceneRun run_scene(const RunSpec& spec) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(spec.threads));
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(spec.threads));
     engine::ecs::Registry registry;
     wire::systems::WireContext ctx;
     ctx.path = spec.path;
@@ -124,8 +129,8 @@ SceneRun run_scene(const RunSpec& spec) {
     ctx.lod.tolerance_px = kTolerancePx;
     std::vector<Entity> wires;
     for (int i = 0; i < spec.wires; ++i) {
-        wires.push_back(wire::systems::spawn_wire(registry, hanging_wire(i),
-                                                  {.radius_m = kRadiusM, .material = static_cast<uint32_t>(i % 4)}));
+        wires.push_back(wire::systems::spawn_wire(
+            registry, hanging_wire(i), {.radius_m = kRadiusM, .material = static_cast<uint32_t>(i % 4)}));
     }
     std::vector<int> sample_frames;
     for (int k = 0; k < spec.error_samples; ++k)
@@ -172,11 +177,13 @@ SceneRun run_scene(const RunSpec& spec) {
         double segments = 0.0;
         for (const wire::DrawItem& item : ctx.draw_list.items)
             segments += static_cast<double>(
-                registry.get<wire::systems::WireCurve>(Entity{static_cast<uint32_t>(item.wire_id)}).curve.segment_count());
+                registry.get<wire::systems::WireCurve>(Entity{static_cast<uint32_t>(item.wire_id)})
+                    .curve.segment_count());
         out.visible_segments.push_back(segments);
         if (spec.after_frame) spec.after_frame(ctx, f);
 
-        if (!spec.sample_errors || std::find(sample_frames.begin(), sample_frames.end(), f) == sample_frames.end())
+        if (!spec.sample_errors ||
+            std::find(sample_frames.begin(), sample_frames.end(), f) == sample_frames.end())
             continue;
         Sample s;
         s.view = ctx.view;
@@ -255,7 +262,8 @@ Uniform search_uniform(const SceneRun& run) {
     u.max_error_px = hi_error;
     // Smallest side count whose radial error on the nearest wire is no worse than the adaptive sides'.
     for (u.sides = 3; u.sides < 64; ++u.sides)
-        if (radial_scale * (1.0 - std::cos(std::numbers::pi / u.sides)) <= adaptive_radial * (1.0 + 1e-12)) break;
+        if (radial_scale * (1.0 - std::cos(std::numbers::pi / u.sides)) <= adaptive_radial * (1.0 + 1e-12))
+            break;
 
     // CPU cost of building that tessellation (rings + mesh) for the visible wires of each sample.
     std::vector<double> ms;
@@ -288,16 +296,26 @@ std::array<double, kSystems> system_medians(const SceneRun& r) {
 }
 
 std::vector<std::string> row(const std::string& scene, const std::string& mode, int wires, double visible,
-                             double rings, double vertices, double bytes, double cpu_ms_frame, double error_px) {
+                             double rings, double vertices, double bytes, double cpu_ms_frame,
+                             double error_px) {
     const double ns_per_vertex = vertices > 0 ? cpu_ms_frame * 1e6 / vertices : 0.0;
-    return {scene, "centripetal", mode, num(kTolerancePx), std::to_string(wires), num(visible, 6), num(rings, 8),
-            num(vertices, 9), num(bytes, 10), num(cpu_ms_frame), num(ns_per_vertex), num(error_px)};
+    return {scene,
+            "centripetal",
+            mode,
+            num(kTolerancePx),
+            std::to_string(wires),
+            num(visible, 6),
+            num(rings, 8),
+            num(vertices, 9),
+            num(bytes, 10),
+            num(cpu_ms_frame),
+            num(ns_per_vertex),
+            num(error_px)};
 }
 
-
-// --gl: the real WireRenderer on a headless EGL context (Mesa llvmpipe), drawing every 10th frame of a run to check
-// that the computed upload size equals the renderer's FrameStats::bytes_uploaded. The framebuffer is small: the
-// bytes do not depend on it, and llvmpipe's fill rate would dominate otherwise.
+// --gl: the real WireRenderer on a headless EGL context (Mesa llvmpipe), drawing every 10th frame of a run to
+// check that the computed upload size equals the renderer's FrameStats::bytes_uploaded. The framebuffer is
+// small: the bytes do not depend on it, and llvmpipe's fill rate would dominate otherwise.
 struct GlCheck {
     std::unique_ptr<engine::platform::Context> context;
     wire::render::WireRenderer renderer;
@@ -329,7 +347,8 @@ struct GlCheck {
         engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
         const double t0 = wall_ms();
         const wire::render::FrameStats st = renderer.draw(ctx.draw_list, ctx.camera);
-        (void)engine::platform::read_pixels(*context);  // waits for the frame: llvmpipe's threads stop before timing
+        (void)engine::platform::read_pixels(
+            *context);  // waits for the frame: llvmpipe's threads stop before timing
         draw_wall_ms.push_back(wall_ms() - t0);
         context->end_frame();
         const std::size_t computed = upload_bytes(ctx.draw_list);
@@ -348,7 +367,8 @@ int run_systems_bench(const Options& o) {
     const int wires = 1000;
     const int error_samples = o.quick ? 2 : 3;
     Table csv;
-    csv.header = {"scene", "method", "mode", "tolerance_px", "wires", "visible_wires", "rings", "vertices",
+    csv.header = {"scene",          "method",           "mode",          "tolerance_px",
+                  "wires",          "visible_wires",    "rings",         "vertices",
                   "bytes_uploaded", "cpu_ms_per_frame", "ns_per_vertex", "max_screen_error_px"};
     std::string notes;
     char buf[2048];
@@ -359,7 +379,8 @@ int run_systems_bench(const Options& o) {
     std::string thread_lines;
     GlCheck gl;
     std::string gl_note;
-    if (o.gl && !gl.init()) gl_note = "- --gl: no headless GL context (" + gl.error + "); bytes are computed only.\n";
+    if (o.gl && !gl.init())
+        gl_note = "- --gl: no headless GL context (" + gl.error + "); bytes are computed only.\n";
     const bool use_gl = o.gl && gl_note.empty();
 
     for (SceneKind kind : {SceneKind::standard, SceneKind::offscreen, SceneKind::swaying}) {
@@ -371,11 +392,20 @@ int run_systems_bench(const Options& o) {
             const bool cpu = path == wire::UploadPath::cpu_mesh;
             std::fprintf(stderr, "bench: %s %s, %d wires, %d frames, %d thread(s)\n", name.c_str(),
                          cpu ? "cpu-mesh" : "gpu-rings", wires, scene_frames, o.threads);
-            RunSpec spec{.kind = kind, .path = path, .threads = o.threads, .frames = scene_frames, .wires = wires,
-                         .sample_errors = true, .error_samples = error_samples, .after_frame = {}};
+            RunSpec spec{.kind = kind,
+                         .path = path,
+                         .threads = o.threads,
+                         .frames = scene_frames,
+                         .wires = wires,
+                         .sample_errors = true,
+                         .error_samples = error_samples,
+                         .after_frame = {}};
             if (use_gl && kind == SceneKind::standard) {
-                const std::filesystem::path png = o.out_dir / (cpu ? "bench_gl_cpu_mesh.png" : "bench_gl_gpu_rings.png");
-                spec.after_frame = [&gl, png](const wire::systems::WireContext& c, int f) { gl.draw(c, f, png); };
+                const std::filesystem::path png =
+                    o.out_dir / (cpu ? "bench_gl_cpu_mesh.png" : "bench_gl_gpu_rings.png");
+                spec.after_frame = [&gl, png](const wire::systems::WireContext& c, int f) {
+                    gl.draw(c, f, png);
+                };
             }
             SceneRun r = run_scene(spec);
             csv.add(row(name, cpu ? "cpu-mesh" : "gpu-rings", wires, median(r.visible), median(r.rings),
@@ -387,23 +417,24 @@ int run_systems_bench(const Options& o) {
         std::vector<double> u_rings, u_vertices, u_bytes, a_vertices;
         for (std::size_t f = 0; f < cpu_run.visible.size(); ++f) {
             const double n = cpu_run.visible[f];
-            const double r = u.rings_per_segment * cpu_run.visible_segments[f] + n;  // open wires: one extra ring
-            const double v = r * (u.sides + 1) + n * 2.0 * (u.sides + 1);             // sides + caps
-            const double idx = r * 6.0 * u.sides;                                     // (r - n) bands + n cap pairs
+            const double r =
+                u.rings_per_segment * cpu_run.visible_segments[f] + n;     // open wires: one extra ring
+            const double v = r * (u.sides + 1) + n * 2.0 * (u.sides + 1);  // sides + caps
+            const double idx = r * 6.0 * u.sides;                          // (r - n) bands + n cap pairs
             u_rings.push_back(r);
             u_vertices.push_back(v);
-            u_bytes.push_back(static_cast<double>(cpu_mesh_bytes(static_cast<std::size_t>(n),
-                                                                 static_cast<std::size_t>(v),
-                                                                 static_cast<std::size_t>(idx))));
+            u_bytes.push_back(static_cast<double>(cpu_mesh_bytes(
+                static_cast<std::size_t>(n), static_cast<std::size_t>(v), static_cast<std::size_t>(idx))));
         }
         const double curve_ms = system_medians(cpu_run)[0];
         csv.add(row(name, "uniform", wires, median(cpu_run.visible), median(u_rings), median(u_vertices),
                     median(u_bytes), curve_ms + u.rebuild_cpu_ms, u.max_error_px));
-        std::snprintf(buf, sizeof buf,
-                      "- `%s` uniform baseline: %u rings per segment, %u sides (max centre-line error %.3f px "
-                      "against the adaptive run's %.3f px over %zu sampled frames).\n",
-                      name.c_str(), u.rings_per_segment, u.sides, u.max_error_px, cpu_run.max_error_px,
-                      cpu_run.samples.size());
+        std::snprintf(
+            buf, sizeof buf,
+            "- `%s` uniform baseline: %u rings per segment, %u sides (max centre-line error %.3f px "
+            "against the adaptive run's %.3f px over %zu sampled frames).\n",
+            name.c_str(), u.rings_per_segment, u.sides, u.max_error_px, cpu_run.max_error_px,
+            cpu_run.samples.size());
         notes += buf;
 
         if (kind == SceneKind::standard) {
@@ -411,13 +442,14 @@ int run_systems_bench(const Options& o) {
             standard_systems = system_medians(cpu_run);
             bytes_cpu = median(cpu_run.bytes);
             bytes_gpu = median(gpu_run.bytes);
-            for (const Sample& s : cpu_run.samples) adaptive_vertices_at_samples += static_cast<double>(s.adaptive_vertices);
+            for (const Sample& s : cpu_run.samples)
+                adaptive_vertices_at_samples += static_cast<double>(s.adaptive_vertices);
             // The uniform count at the same sampled frames (same visible wires).
             for (const Sample& s : cpu_run.samples) {
                 for (const wire::Curve& c : s.curves) {
                     const std::size_t r = u.rings_per_segment * c.segment_count() + 1;
-                    uniform_vertices_at_samples += static_cast<double>(
-                        wire::tube_counts(r, false, {.sides = u.sides}).vertices);
+                    uniform_vertices_at_samples +=
+                        static_cast<double>(wire::tube_counts(r, false, {.sides = u.sides}).vertices);
                 }
             }
         }
@@ -432,9 +464,14 @@ int run_systems_bench(const Options& o) {
                     continue;
                 }
                 std::fprintf(stderr, "bench: %s cpu-mesh, %d thread(s) (thread scaling)\n", name.c_str(), t);
-                const SceneRun r = run_scene({.kind = kind, .path = wire::UploadPath::cpu_mesh, .threads = t,
-                                              .frames = scene_frames, .wires = wires, .sample_errors = false,
-                                              .error_samples = 0, .after_frame = {}});
+                const SceneRun r = run_scene({.kind = kind,
+                                              .path = wire::UploadPath::cpu_mesh,
+                                              .threads = t,
+                                              .frames = scene_frames,
+                                              .wires = wires,
+                                              .sample_errors = false,
+                                              .error_samples = 0,
+                                              .after_frame = {}});
                 wall[t - 1] = median(r.frame_wall_ms);
             }
             std::snprintf(buf, sizeof buf, "| %s | %.3f | %.3f | %.2fx |\n", name.c_str(), wall[0], wall[1],
@@ -449,18 +486,19 @@ int run_systems_bench(const Options& o) {
     }
 
     std::string md = "# wiretool bench: wire systems\n\n";
-    std::snprintf(buf, sizeof buf,
-                  "%d hanging wires of %d nodes (catenaries 10 m across), 1920x1080, 60 degree field of view, "
-                  "tolerance %.2f px, %d frames of a moving camera (medians exclude frame 0, which builds everything)%s; "
-                  "%d thread(s). `standard`: static nodes; `swaying`: every node moves every frame; `offscreen`: "
-                  "the same wires, all behind the camera. CPU time is process CPU time of the five systems "
-                  "(curve, lod, rings, mesh, draw_list) per frame. `bytes_uploaded` is computed exactly as "
-                  "WireRenderer::draw() would memcpy it from the frame's DrawList (no GL is run). `uniform`: a fixed "
-                  "ring count per segment and one side count, the smallest whose measured maximum screen error is "
-                  "no worse than the adaptive run's; its CPU time is the curve stage plus building its rings and "
-                  "mesh for every visible wire (what it costs whenever the wires move).\n\n",
-                  wires, kNodes, kTolerancePx, frames, o.quick ? " (--quick; `swaying` runs 8 frames)" : "",
-                  o.threads);
+    std::snprintf(
+        buf, sizeof buf,
+        "%d hanging wires of %d nodes (catenaries 10 m across), 1920x1080, 60 degree field of view, "
+        "tolerance %.2f px, %d frames of a moving camera (medians exclude frame 0, which builds "
+        "everything)%s; "
+        "%d thread(s). `standard`: static nodes; `swaying`: every node moves every frame; `offscreen`: "
+        "the same wires, all behind the camera. CPU time is process CPU time of the five systems "
+        "(curve, lod, rings, mesh, draw_list) per frame. `bytes_uploaded` is computed exactly as "
+        "WireRenderer::draw() would memcpy it from the frame's DrawList (no GL is run). `uniform`: a fixed "
+        "ring count per segment and one side count, the smallest whose measured maximum screen error is "
+        "no worse than the adaptive run's; its CPU time is the curve stage plus building its rings and "
+        "mesh for every visible wire (what it costs whenever the wires move).\n\n",
+        wires, kNodes, kTolerancePx, frames, o.quick ? " (--quick; `swaying` runs 8 frames)" : "", o.threads);
     md += buf;
     md += csv.markdown();
     md += "\n" + notes;
@@ -468,36 +506,41 @@ int run_systems_bench(const Options& o) {
         md += "\n## Figures\n\n";
         md += "Per-system CPU ms per frame, `standard`, cpu-mesh (median):";
         for (int i = 0; i < kSystems; ++i) {
-            std::snprintf(buf, sizeof buf, " %s %.3f;", kSystemNames[i], standard_systems[static_cast<std::size_t>(i)]);
+            std::snprintf(buf, sizeof buf, " %s %.3f;", kSystemNames[i],
+                          standard_systems[static_cast<std::size_t>(i)]);
             md += buf;
         }
         md += "\n\n";
         if (adaptive_vertices_at_samples > 0.0) {
-            std::snprintf(buf, sizeof buf,
-                          "- adaptive vs uniform at equal max screen error (`standard`, same sampled frames): "
-                          "%.0f vs %.0f vertices, %.1fx fewer (aim >= 5x)\n",
-                          adaptive_vertices_at_samples, uniform_vertices_at_samples,
-                          uniform_vertices_at_samples / adaptive_vertices_at_samples);
+            std::snprintf(
+                buf, sizeof buf,
+                "- adaptive vs uniform at equal max screen error (`standard`, same sampled frames): "
+                "%.0f vs %.0f vertices, %.1fx fewer (aim >= 5x)\n",
+                adaptive_vertices_at_samples, uniform_vertices_at_samples,
+                uniform_vertices_at_samples / adaptive_vertices_at_samples);
             md += buf;
         }
         if (bytes_gpu > 0.0) {
-            std::snprintf(buf, sizeof buf, "- gpu-rings vs cpu-mesh bytes per frame: %.0f vs %.0f, %.1fx fewer (aim >= 6x)\n",
+            std::snprintf(buf, sizeof buf,
+                          "- gpu-rings vs cpu-mesh bytes per frame: %.0f vs %.0f, %.1fx fewer (aim >= 6x)\n",
                           bytes_gpu, bytes_cpu, bytes_cpu / bytes_gpu);
             md += buf;
         }
         if (offscreen_cpu_ms >= 0.0) {
-            std::snprintf(buf, sizeof buf, "- offscreen vs standard CPU per frame: %.4f vs %.4f ms = %.2f%% (aim < 2%%)\n",
+            std::snprintf(buf, sizeof buf,
+                          "- offscreen vs standard CPU per frame: %.4f vs %.4f ms = %.2f%% (aim < 2%%)\n",
                           offscreen_cpu_ms, standard_cpu_ms, 100.0 * offscreen_cpu_ms / standard_cpu_ms);
             md += buf;
         }
     }
     if (use_gl) {
-        std::snprintf(buf, sizeof buf,
-                      "- --gl: WireRenderer drew %zu frames of `standard` (both paths) headless; FrameStats::"
-                      "bytes_uploaded matched the computed bytes on %zu of them (mean %.0f vs %.0f bytes); median "
-                      "draw + finish %.1f ms wall at 480x270 (bench_gl_*.png: the last frame drawn)\n",
-                      gl.frames, gl.frames - gl.mismatches, gl.frames ? gl.renderer_bytes / gl.frames : 0.0,
-                      gl.frames ? gl.computed_bytes / gl.frames : 0.0, median(gl.draw_wall_ms));
+        std::snprintf(
+            buf, sizeof buf,
+            "- --gl: WireRenderer drew %zu frames of `standard` (both paths) headless; FrameStats::"
+            "bytes_uploaded matched the computed bytes on %zu of them (mean %.0f vs %.0f bytes); median "
+            "draw + finish %.1f ms wall at 480x270 (bench_gl_*.png: the last frame drawn)\n",
+            gl.frames, gl.frames - gl.mismatches, gl.frames ? gl.renderer_bytes / gl.frames : 0.0,
+            gl.frames ? gl.computed_bytes / gl.frames : 0.0, median(gl.draw_wall_ms));
         gl_note += buf;
     }
     md += gl_note;
@@ -508,9 +551,14 @@ int run_systems_bench(const Options& o) {
             if (std::fgets(text, sizeof text, f)) load = std::string(text, std::strcspn(text, "\n"));
             std::fclose(f);
         }
-        md += "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems; /proc/loadavg at the "
-              "end: " + load + ")\n\n"
-              "| scene | 1 thread | 2 threads | speed-up |\n| --- | --- | --- | --- |\n" + thread_lines;
+        md +=
+            "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems; /proc/loadavg at "
+            "the "
+            "end: " +
+            load +
+            ")\n\n"
+            "| scene | 1 thread | 2 threads | speed-up |\n| --- | --- | --- | --- |\n" +
+            thread_lines;
     }
     if (!write_text(o.out_dir / "bench.md", md)) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench.md").c_str());

@@ -2,6 +2,8 @@
 // accuracy figures the bench exists to show. Timings are never checked (the machine is shared and loaded).
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -9,8 +11,6 @@
 #include <map>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -35,7 +35,8 @@ Csv read_csv(const fs::path& file) {
         std::stringstream ss(line);
         std::map<std::string, std::string> row;
         std::size_t i = 0;
-        for (std::string c; std::getline(ss, c, ','); ++i) row[i < csv.columns.size() ? csv.columns[i] : "?"] = c;
+        for (std::string c; std::getline(ss, c, ','); ++i)
+            row[i < csv.columns.size() ? csv.columns[i] : "?"] = c;
         EXPECT_EQ(i, csv.columns.size()) << file << ": " << line;
         csv.rows.push_back(row);
     }
@@ -50,11 +51,13 @@ double number(const std::map<std::string, std::string>& row, const std::string& 
     }
     char* end = nullptr;
     const double v = std::strtod(it->second.c_str(), &end);
-    EXPECT_TRUE(end != it->second.c_str() && *end == '\0') << key << " = '" << it->second << "' is not a number";
+    EXPECT_TRUE(end != it->second.c_str() && *end == '\0')
+        << key << " = '" << it->second << "' is not a number";
     return v;
 }
 
-const std::map<std::string, std::string>* find(const Rows& rows, const std::map<std::string, std::string>& keys) {
+const std::map<std::string, std::string>* find(const Rows& rows,
+                                               const std::map<std::string, std::string>& keys) {
     for (const auto& r : rows) {
         bool ok = true;
         for (const auto& [k, v] : keys) ok = ok && r.count(k) && r.at(k) == v;
@@ -66,15 +69,17 @@ const std::map<std::string, std::string>* find(const Rows& rows, const std::map<
 // The bench's outputs in a fresh directory (one run serves every check below: ctest runs each TEST in its own
 // process, so the checks are one TEST rather than a suite sharing a fixture).
 const fs::path& out_dir() {
-    static const fs::path dir = fs::temp_directory_path() / ("wiretool_bench_test_" + std::to_string(::getpid()));
+    static const fs::path dir =
+        fs::temp_directory_path() / ("wiretool_bench_test_" + std::to_string(::getpid()));
     return dir;
 }
 
 void check_bench_csv(const fs::path& dir) {
     const Csv csv = read_csv(dir / "bench.csv");
-    EXPECT_EQ(csv.header,
-              "scene,method,mode,tolerance_px,wires,visible_wires,rings,vertices,bytes_uploaded,cpu_ms_per_frame,"
-              "ns_per_vertex,max_screen_error_px");
+    EXPECT_EQ(
+        csv.header,
+        "scene,method,mode,tolerance_px,wires,visible_wires,rings,vertices,bytes_uploaded,cpu_ms_per_frame,"
+        "ns_per_vertex,max_screen_error_px");
     EXPECT_TRUE(fs::exists(dir / "bench.md"));
     ASSERT_EQ(csv.rows.size(), 6u) << "2 scenes x {cpu-mesh, gpu-rings, uniform}";
     for (const auto& r : csv.rows) {
@@ -113,27 +118,37 @@ void check_bench_csv(const fs::path& dir) {
 
 void check_accuracy_csv(const fs::path& dir) {
     const Csv csv = read_csv(dir / "accuracy.csv");
-    EXPECT_EQ(csv.header,
-              "scene,method,tolerance_px,rings,sides,vertices,bytes_cpu_mesh,bytes_gpu_rings,ns_per_vertex,"
-              "us_per_wire_cpu_mesh,us_per_wire_gpu_rings,max_world_error_m,max_screen_error_px,max_twist_deg,"
-              "max_pop_m,max_pop_remedy_m");
+    EXPECT_EQ(
+        csv.header,
+        "scene,method,tolerance_px,rings,sides,vertices,bytes_cpu_mesh,bytes_gpu_rings,ns_per_vertex,"
+        "us_per_wire_cpu_mesh,us_per_wire_gpu_rings,max_world_error_m,max_screen_error_px,max_twist_deg,"
+        "max_pop_m,max_pop_remedy_m");
     EXPECT_TRUE(fs::exists(dir / "accuracy.md"));
     EXPECT_TRUE(fs::exists(dir / "stability.md"));
     const std::vector<std::string> scenes = {"catenary", "helix", "stretched_bend", "churn"};
-    const std::vector<std::string> methods = {"linear", "uniform", "centripetal", "chordal", "c2", "auto",
-                                              "curvature_tension", "centripetal+rotation", "centripetal+projection"};
+    const std::vector<std::string> methods = {"linear",
+                                              "uniform",
+                                              "centripetal",
+                                              "chordal",
+                                              "c2",
+                                              "auto",
+                                              "curvature_tension",
+                                              "centripetal+rotation",
+                                              "centripetal+projection"};
     const std::vector<std::string> tolerances = {"0.1", "0.25", "0.5", "1", "2"};
     ASSERT_EQ(csv.rows.size(), scenes.size() * methods.size() * tolerances.size());
     for (const auto& scene : scenes)
         for (const auto& method : methods)
             for (const auto& tol : tolerances)
-                EXPECT_NE(find(csv.rows, {{"scene", scene}, {"method", method}, {"tolerance_px", tol}}), nullptr)
+                EXPECT_NE(find(csv.rows, {{"scene", scene}, {"method", method}, {"tolerance_px", tol}}),
+                          nullptr)
                     << scene << " " << method << " " << tol;
     for (const auto& r : csv.rows) {
         for (const std::string& c : csv.columns) {
             if (c == "scene" || c == "method") continue;
             const double v = number(r, c);
-            EXPECT_TRUE(std::isfinite(v) && v >= 0.0) << c << " in " << r.at("scene") << "/" << r.at("method");
+            EXPECT_TRUE(std::isfinite(v) && v >= 0.0)
+                << c << " in " << r.at("scene") << "/" << r.at("method");
         }
         EXPECT_GT(number(r, "rings"), 0.0);
         EXPECT_LT(number(r, "bytes_gpu_rings"), number(r, "bytes_cpu_mesh"));
@@ -143,36 +158,43 @@ void check_accuracy_csv(const fs::path& dir) {
     }
 }
 
-// The figures, as accuracy bounds: double reflection's twist error is at least 100x below the rotation
-// method's at equal rings (helix), the pop-free remedy keeps every frame's pop under 1 mm on the 20 m cable while
-// nodes come and go, and the automatic spline keeps a stretched run on its straight line.
+// The figures, as accuracy bounds: double reflection's twist error is at least 100x below the
+// rotation method's at equal rings (helix), the pop-free remedy keeps every frame's pop under 1 mm on the 20
+// m cable while nodes come and go, and the automatic spline keeps a stretched run on its straight line.
 void check_accuracy_figures(const fs::path& dir) {
     const Csv csv = read_csv(dir / "accuracy.csv");
     for (const char* tol : {"0.1", "0.25", "0.5", "1", "2"}) {
-        const auto* dr = find(csv.rows, {{"scene", "helix"}, {"method", "centripetal"}, {"tolerance_px", tol}});
-        const auto* rot = find(csv.rows, {{"scene", "helix"}, {"method", "centripetal+rotation"}, {"tolerance_px", tol}});
+        const auto* dr =
+            find(csv.rows, {{"scene", "helix"}, {"method", "centripetal"}, {"tolerance_px", tol}});
+        const auto* rot =
+            find(csv.rows, {{"scene", "helix"}, {"method", "centripetal+rotation"}, {"tolerance_px", tol}});
         const auto* proj =
             find(csv.rows, {{"scene", "helix"}, {"method", "centripetal+projection"}, {"tolerance_px", tol}});
         ASSERT_TRUE(dr && rot && proj);
         EXPECT_EQ(number(*dr, "rings"), number(*rot, "rings")) << "equal rings";
-        EXPECT_LE(100.0 * number(*dr, "max_twist_deg"), number(*rot, "max_twist_deg")) << "at " << tol << " px";
+        EXPECT_LE(100.0 * number(*dr, "max_twist_deg"), number(*rot, "max_twist_deg"))
+            << "at " << tol << " px";
         EXPECT_LT(number(*rot, "max_twist_deg"), number(*proj, "max_twist_deg")) << "at " << tol << " px";
     }
-    // churn: nodes inserted on the curve and removed again over 60 frames; catenary: one node inserted on the curve,
-    // then an original node removed. (A removal that moves the curve more than max_blend_frames * max_step_m =
-    // 240 * 0.5 mm = 12 cm is stepped at offset/240 a frame: documented in multires.hpp, not exercised here.)
+    // churn: nodes inserted on the curve and removed again over 60 frames; catenary: one node inserted on the
+    // curve, then an original node removed. (A removal that moves the curve more than max_blend_frames *
+    // max_step_m = 240 * 0.5 mm = 12 cm is stepped at offset/240 a frame: documented in multires.hpp, not
+    // exercised here.)
     for (const char* scene : {"churn", "catenary"}) {
-        for (const char* method : {"linear", "uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
+        for (const char* method :
+             {"linear", "uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
             const auto* r = find(csv.rows, {{"scene", scene}, {"method", method}, {"tolerance_px", "0.5"}});
             ASSERT_TRUE(r);
             EXPECT_LT(number(*r, "max_pop_remedy_m"), 1e-3) << scene << " " << method;
-            if (std::string(method) != "linear") {  // a node inserted on a polyline changes nothing: no pop to remedy
+            if (std::string(method) !=
+                "linear") {  // a node inserted on a polyline changes nothing: no pop to remedy
                 EXPECT_LT(number(*r, "max_pop_remedy_m"), number(*r, "max_pop_m")) << scene << " " << method;
             }
         }
     }
     for (const char* method : {"auto", "curvature_tension", "linear"}) {
-        const auto* r = find(csv.rows, {{"scene", "stretched_bend"}, {"method", method}, {"tolerance_px", "0.1"}});
+        const auto* r =
+            find(csv.rows, {{"scene", "stretched_bend"}, {"method", method}, {"tolerance_px", "0.1"}});
         ASSERT_TRUE(r);
         EXPECT_LT(number(*r, "max_world_error_m"), 1e-4) << method << ": the stretched run leaves its line";
     }
@@ -188,8 +210,8 @@ void check_stability_and_plot(const fs::path& dir) {
     std::stringstream ss;
     ss << in.rdbuf();
     const std::string md = ss.str();
-    for (const char* c : {"| coincident nodes (exact) | ok", "| NaN in a node | error: node 2", "| 0 nodes | error:",
-                          "| 100,000-node wire", "| closed loop of 3 nodes | ok",
+    for (const char* c : {"| coincident nodes (exact) | ok", "| NaN in a node | error: node 2",
+                          "| 0 nodes | error:", "| 100,000-node wire", "| closed loop of 3 nodes | ok",
                           "| 1,000 chained bend segments closing a full circle | ok"})
         EXPECT_NE(md.find(c), std::string::npos) << c;
     EXPECT_EQ(md.find("NON-FINITE"), std::string::npos);
@@ -205,9 +227,10 @@ void check_stability_and_plot(const fs::path& dir) {
 TEST(WiretoolBench, QuickRunHonoursTheContract) {
     const fs::path& dir = out_dir();
     fs::remove_all(dir);
-    const std::string cmd = std::string(WIRETOOL_PATH) +
-                            " bench --quick --scenes standard,offscreen,catenary,helix,stretched_bend,churn --out " +
-                            dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
+    const std::string cmd =
+        std::string(WIRETOOL_PATH) +
+        " bench --quick --scenes standard,offscreen,catenary,helix,stretched_bend,churn --out " +
+        dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
     const int raw = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "see " << dir.string() << ".log";
     {
