@@ -266,6 +266,10 @@ Status convert_mesh(const tinygltf::Model& model, int mesh_index, const glm::dma
                                        " vertices)");
         for (float f : m.positions)
             if (!std::isfinite(f)) return Status::failure(who + ": POSITION holds a NaN or infinite value");
+        for (float f : m.normals)
+            if (!std::isfinite(f)) return Status::failure(who + ": NORMAL holds a NaN or infinite value");
+        for (float f : m.uvs)
+            if (!std::isfinite(f)) return Status::failure(who + ": TEXCOORD_0 holds a NaN or infinite value");
         if (m.normals.empty()) {  // area-weighted face normals
             std::vector<glm::dvec3> acc(n, glm::dvec3(0.0));
             auto P = [&](uint32_t i) { return glm::dvec3(m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]); };
@@ -293,6 +297,11 @@ Status convert_mesh(const tinygltf::Model& model, int mesh_index, const glm::dma
                 }
             }
         }
+        // Huge (finite) positions or node scales overflow the float results or the computed normals.
+        for (std::size_t i = 0; i < m.positions.size(); ++i)
+            if (!std::isfinite(m.positions[i]) || !std::isfinite(m.normals[i]))
+                return Status::failure(who + ": a position or normal is not finite after the node transforms "
+                                             "(values too large)");
         out.push_back(std::move(m));
     }
     return {};
