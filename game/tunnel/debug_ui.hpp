@@ -28,4 +28,7 @@ public:
     [[nodiscard]] virtual const char* kind() const = 0;
 };
 
+/// The panel without Dear ImGui: one stats line on stdout per 60 frames. `kind` says why it is used.
+[[nodiscard]] std::unique_ptr<DebugUi> make_text_ui(const char* kind);
+
 }  // namespace tunnel

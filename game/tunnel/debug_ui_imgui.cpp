@@ -102,29 +102,11 @@ public:
     const char* kind() const override { return "Dear ImGui"; }
 };
 
-class TextUi final : public DebugUi {
-public:
-    void draw(Level& level, double frame_ms, UiRequests&) override {
-        if (++frames_ % 60 != 0) return;
-        const LevelFrameStats& s = level.stats();
-        std::printf(
-            "frame %llu: %.1f ms, %zu/%zu wires, %zu wire vertices, %zu tunnel triangles, %zu rope nodes\n",
-            static_cast<unsigned long long>(s.frame), frame_ms, s.wires_drawn, s.wires, s.wire_vertices,
-            s.piece_triangles, s.rope_nodes);
-    }
-    bool wants_mouse() const override { return false; }
-    bool wants_keyboard() const override { return false; }
-    const char* kind() const override { return "stdout (no GLFW window for ImGui)"; }
-
-private:
-    unsigned long long frames_ = 0;
-};
-
 }  // namespace
 
 std::unique_ptr<DebugUi> DebugUi::create(engine::platform::Context& context) {
     GLFWwindow* window = context.headless() ? nullptr : glfwGetCurrentContext();
-    if (window == nullptr) return std::make_unique<TextUi>();
+    if (window == nullptr) return make_text_ui("stdout (no GLFW window for ImGui)");
     return std::make_unique<ImGuiUi>(window);
 }
 

@@ -1,4 +1,5 @@
-// Fallback debug panel without Dear ImGui: one stats line on stdout per second of frames.
+// Debug panel without Dear ImGui: one stats line on stdout per 60 frames (the fallback when ImGui is not built
+// or there is no GLFW window).
 #include "tunnel/debug_ui.hpp"
 
 #include <cstdio>
@@ -19,16 +20,20 @@ public:
     }
     bool wants_mouse() const override { return false; }
     bool wants_keyboard() const override { return false; }
-    const char* kind() const override { return "stdout"; }
+    const char* kind() const override { return kind_; }
+    explicit TextUi(const char* kind) : kind_(kind) {}
 
 private:
+    const char* kind_;
     unsigned long long frames_ = 0;
 };
 
 }  // namespace
 
-std::unique_ptr<DebugUi> DebugUi::create(engine::platform::Context&) {
-    return std::make_unique<TextUi>();
-}
+std::unique_ptr<DebugUi> make_text_ui(const char* kind) { return std::make_unique<TextUi>(kind); }
+
+#ifndef TUNNEL_HAVE_IMGUI
+std::unique_ptr<DebugUi> DebugUi::create(engine::platform::Context&) { return make_text_ui("stdout"); }
+#endif
 
 }  // namespace tunnel
