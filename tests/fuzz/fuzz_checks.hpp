@@ -4,12 +4,29 @@
 
 #include <wire/pipeline.hpp>
 
+#include <fuzzer/FuzzedDataProvider.h>
+
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <span>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 namespace wire_fuzz {
+
+/// A double from the fuzzer's bytes: one of the target's `special` values (NaN, Inf, denormals, huge, tiny...)
+/// when the first byte indexes one, a value in [-10, 10] for the rest of the lower half, otherwise 8 raw bytes.
+inline double special_or_raw(FuzzedDataProvider& in, std::span<const double> special) {
+    const uint8_t pick = in.ConsumeIntegral<uint8_t>();
+    if (pick < special.size()) return special[pick];
+    if (pick < 128) return in.ConsumeFloatingPointInRange<double>(-10.0, 10.0);
+    double raw = 0.0;
+    const auto bytes = in.ConsumeBytes<uint8_t>(sizeof raw);
+    if (!bytes.empty()) std::memcpy(&raw, bytes.data(), bytes.size());
+    return raw;
+}
 
 [[noreturn]] inline void fail(const std::string& what) {
     std::fprintf(stderr, "fuzz property violated: %s\n", what.c_str());

@@ -26,13 +26,7 @@ double special_or_raw(FuzzedDataProvider& in) {
     static constexpr double kSpecial[] = {0.0,   -0.0,  1.0,   -1.0,  0.5,    2.0,    1e-9,   -1e-9, 1e-6,
                                           1e6,   -1e6,  1e-300, 5e-324, 1e300, -1e300, 1.7976931348623157e308,
                                           kInf,  -kInf, std::numeric_limits<double>::quiet_NaN(), 100.0, 3.0};
-    const uint8_t pick = in.ConsumeIntegral<uint8_t>();
-    if (pick < sizeof kSpecial / sizeof kSpecial[0]) return kSpecial[pick];
-    if (pick < 128) return in.ConsumeFloatingPointInRange<double>(-10.0, 10.0);
-    double raw = 0.0;
-    const auto bytes = in.ConsumeBytes<uint8_t>(sizeof raw);
-    if (!bytes.empty()) std::memcpy(&raw, bytes.data(), bytes.size());
-    return raw;
+    return wire_fuzz::special_or_raw(in, kSpecial);
 }
 
 wire::PipelineSettings read_settings(FuzzedDataProvider& in) {
