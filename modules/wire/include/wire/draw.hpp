@@ -17,7 +17,8 @@ namespace wire {
 /// How wire geometry reaches the GPU.
 enum class UploadPath : uint8_t {
     cpu_mesh,   ///< vertices + indices built on the CPU (TubeVertex, 32 bytes a vertex)
-    gpu_rings,  ///< ring records only (Ring, 48 bytes a ring); the vertex shader expands sides from gl_VertexID
+    gpu_rings,  ///< ring records only (packed to 28 bytes a ring by the renderer, retained on the GPU while a
+                ///< wire's rings are unchanged); the vertex shader expands sides from gl_VertexID
 };
 
 /// One visible wire this frame. Positions inside are relative to origin_m (double, world), so the renderer can
@@ -25,7 +26,10 @@ enum class UploadPath : uint8_t {
 struct DrawItem {
     glm::dvec3 origin_m{};
     uint32_t material = 0;   ///< index into the renderer's material table (texture, colour)
-    uint64_t wire_id = 0;    ///< the wire's entity, for statistics and tests
+    uint64_t wire_id = 0;    ///< the wire's entity (unique while it lives; the retained ring storage's key)
+    /// gpu_rings: changes whenever `rings` change (WireRings::generation). The renderer keeps a wire's ring
+    /// records on the GPU while (wire_id, rings_generation) stays the same; 0 means unknown: upload every frame.
+    uint64_t rings_generation = 0;
 
     // cpu_mesh path
     std::span<const TubeVertex> vertices;

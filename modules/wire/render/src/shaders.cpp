@@ -1,6 +1,7 @@
-// GLSL sources. The ring expansion reproduces wire::write_tube (tube.cpp) vertex for vertex: same layout,
-// same triangle order and winding, same normal tilt by the radius slope, so both paths rasterize the same
-// triangles.
+// GLSL sources. The ring expansion reproduces wire::write_tube (tube.cpp) vertex for vertex: same vertex
+// layout (rows of sides + 1, caps of centre + rim), same triangles and winding, same normal tilt by the radius
+// slope, so both paths rasterize the same triangles. Only the order differs: the caps come first in the index
+// pattern.
 #include "shaders.hpp"
 
 namespace wire::render::detail {
@@ -45,69 +46,91 @@ void main() {
 )";
 
 constexpr std::string_view kRingsMain = R"(
-struct Ring { vec3 centre_m; float radius_m; vec3 normal; float u; vec3 binormal; uint segment; };
-layout(std430, binding = 1) readonly buffer Rings { Ring rings[]; };
+// Packed ring records (wire::render::PackedRing, 7 words): centre xyz, radius, u (floats), frame quaternion in
+// smallest-three form (2-bit index of the largest component, three 20-bit components).
+layout(std430, binding = 1) readonly buffer Rings { uint ring_words[]; };
 const float kTwoPi = 6.28318530717958647692;
+const uint kCapVertexBase = 1073741824u;  // 1 << 30: vertex ids of the two caps (kCapVertexBase in upload_plan.hpp)
+
+struct Ring { vec3 centre_m; float radius_m; float u; vec3 normal; vec3 binormal; vec3 tangent; };
+
+uint ring_base(DrawData d, uint i) { return d.ring_first + i * 7u; }
+vec3 ring_centre(DrawData d, uint i) {
+  uint b = ring_base(d, i);
+  return vec3(uintBitsToFloat(ring_words[b]), uintBitsToFloat(ring_words[b + 1u]), uintBitsToFloat(ring_words[b + 2u]));
+}
+float ring_radius(DrawData d, uint i) { return uintBitsToFloat(ring_words[ring_base(d, i) + 3u]); }
+
+float fixed20(uint k) { return (float(k) / 1048575.0 * 2.0 - 1.0) * 0.70710678; }
+
+Ring load_ring(DrawData d, uint i) {
+  uint b = ring_base(d, i);
+  Ring r;
+  r.centre_m = ring_centre(d, i);
+  r.radius_m = uintBitsToFloat(ring_words[b + 3u]);
+  r.u = uintBitsToFloat(ring_words[b + 4u]);
+  uint w0 = ring_words[b + 5u], w1 = ring_words[b + 6u];
+  uint largest = w0 & 3u;
+  vec3 abc = vec3(fixed20((w0 >> 2u) & 1048575u), fixed20(((w0 >> 22u) | (w1 << 10u)) & 1048575u),
+                  fixed20((w1 >> 10u) & 1048575u));
+  float big = sqrt(max(0.0, 1.0 - dot(abc, abc)));
+  vec4 q = largest == 0u ? vec4(big, abc) : largest == 1u ? vec4(abc.x, big, abc.yz)
+         : largest == 2u ? vec4(abc.xy, big, abc.z) : vec4(abc, big);
+  float x = q.x, y = q.y, z = q.z, w = q.w;
+  r.normal = vec3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y));
+  r.binormal = vec3(2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x));
+  r.tangent = vec3(2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
+  return r;
+}
 
 // wire::write_tube's slope_at: central difference of radius over chord length, one-sided at open ends.
-float slope_at(DrawData d, uint i) {
+float slope_at(DrawData d, uint i, Ring ri) {
   uint n = d.ring_count;
   if ((d.flags & kTilt) == 0u || n < 2u) return 0.0;
   bool closed = (d.flags & kClosed) != 0u;
   uint lo = i > 0u ? i - 1u : (closed ? n - 1u : i);
   uint hi = i + 1u < n ? i + 1u : (closed ? 0u : i);
-  Ring rl = rings[d.ring_first + lo], rh = rings[d.ring_first + hi], ri = rings[d.ring_first + i];
-  float dr = rh.radius_m - rl.radius_m;
+  float dr = ring_radius(d, hi) - ring_radius(d, lo);
   if (dr == 0.0) return 0.0;
-  float ds = length(rh.centre_m - ri.centre_m) + length(ri.centre_m - rl.centre_m);
+  float ds = length(ring_centre(d, hi) - ri.centre_m) + length(ri.centre_m - ring_centre(d, lo));
   return ds > 0.0 ? dr / ds : 0.0;
 }
 
+// Indexed: gl_VertexID is row * (n + 1) + s for the tube (row = ring, or ring_count for a closed wire's
+// repeat of ring 0), kCapVertexBase + cap * (n + 1) + k for the caps (k = 0 centre, 1 + j rim vertex j).
 void main() {
   DrawData d = draws[draw_index()];
   uint n = d.sides;
   uint vid = uint(gl_VertexID);
-  bool closed = (d.flags & kClosed) != 0u;
-  uint bands = d.ring_count - 1u + (closed ? 1u : 0u);
-  uint side_vertices = bands * 6u * n;
   vec3 pos;
   vec3 nrm;
   vec2 uv;
-  if (vid < side_vertices) {
-    // Band b joins ring rows b and b + 1; quad j: (a_j, a_j+1, b_j), (a_j+1, b_j+1, b_j), CCW from outside.
-    uint band = vid / (6u * n);
-    uint rem = vid - band * 6u * n;
-    uint j = rem / 6u;
-    uint c = rem - j * 6u;
-    uint row = band + ((c == 2u || c == 4u || c == 5u) ? 1u : 0u);
-    uint s = j + ((c == 1u || c == 3u || c == 4u) ? 1u : 0u);
+  if (vid < kCapVertexBase) {
+    uint row = vid / (n + 1u);
+    uint s = vid - row * (n + 1u);
     uint i = row == d.ring_count ? 0u : row;  // a closed wire's last row repeats ring 0 ...
-    Ring r = rings[d.ring_first + i];
+    Ring r = load_ring(d, i);
     float u = row == d.ring_count ? d.u_close : r.u;  // ... with u = u_close
     float phi = kTwoPi * float(s == n ? 0u : s) / float(n);
     float cp = cos(phi), sp = sin(phi);
-    float slope = slope_at(d, i);
+    float slope = slope_at(d, i, r);
     float a = 1.0 / sqrt(1.0 + slope * slope);
-    vec3 tb = (slope * a) * cross(r.normal, r.binormal);
+    vec3 tb = (slope * a) * r.tangent;
     pos = r.centre_m + (cp * (r.radius_m * r.normal) + sp * (r.radius_m * r.binormal));
     nrm = -tb + (cp * (a * r.normal) + sp * (a * r.binormal));
     uv = vec2(u, float(s) / float(n));
   } else {
-    // Caps: start cap faces -t (centre, rim_k, rim_j), end cap +t (centre, rim_j, rim_k), k = j + 1 mod n.
-    uint k = vid - side_vertices;
-    uint cap = k / (3u * n);
-    uint rem = k - cap * 3u * n;
-    uint j = rem / 3u;
-    uint c = rem - j * 3u;
-    Ring r = rings[d.ring_first + (cap == 0u ? 0u : d.ring_count - 1u)];
-    nrm = (cap == 0u ? -1.0 : 1.0) * cross(r.normal, r.binormal);
+    // Caps: start cap faces -t, end cap +t; the index pattern orders the triangles (centre, rim, rim).
+    uint k = vid - kCapVertexBase;
+    uint cap = k / (n + 1u);
+    uint c = k - cap * (n + 1u);
+    Ring r = load_ring(d, cap == 0u ? 0u : d.ring_count - 1u);
+    nrm = (cap == 0u ? -1.0 : 1.0) * r.tangent;
     if (c == 0u) {
       pos = r.centre_m;
       uv = vec2(0.5);
     } else {
-      uint jn = (j + 1u) % n;
-      uint rim = cap == 0u ? (c == 1u ? jn : j) : (c == 1u ? j : jn);
-      float phi = kTwoPi * float(rim) / float(n);
+      float phi = kTwoPi * float(c - 1u) / float(n);
       float cp = cos(phi), sp = sin(phi);
       pos = r.centre_m + (cp * (r.radius_m * r.normal) + sp * (r.radius_m * r.binormal));
       uv = vec2(0.5) + 0.5 * vec2(cp, sp);

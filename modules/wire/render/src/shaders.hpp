@@ -10,7 +10,7 @@ namespace wire::render::detail {
 /// Per-draw record in the SSBO at binding 0 (std430, 32 bytes); must match DrawData in the GLSL.
 struct GpuDraw {
     float offset_m[3];    ///< wire origin minus camera position (computed in double)
-    uint32_t ring_first;  ///< gpu-rings: first ring of the wire in the ring SSBO (binding 1)
+    uint32_t ring_first;  ///< gpu-rings: first 32-bit word of the wire's PackedRings in the ring SSBO (binding 1)
     uint32_t ring_count;
     uint32_t sides;
     uint32_t flags;  ///< kClosed | kCaps | kTilt
@@ -20,7 +20,7 @@ static_assert(sizeof(GpuDraw) == 32);
 inline constexpr uint32_t kClosed = 1u, kCaps = 2u, kTilt = 4u;
 
 /// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex). Otherwise the ring expansion from
-/// gl_VertexID. `draw_parameters`: the draw index is gl_BaseInstanceARB (ARB_shader_draw_parameters), else
+/// gl_VertexID of an indexed draw over the static pattern (upload_plan.hpp). `draw_parameters`: the draw index is gl_BaseInstanceARB (ARB_shader_draw_parameters), else
 /// the instanced attribute at location 3 (divisor 1; its buffer holds 0, 1, 2, ... so it reads baseInstance).
 std::string vertex_source(bool cpu_mesh, bool draw_parameters);
 /// `shading`: optional GLSL defining vec3 shade(vec3 albedo, vec3 n, vec3 to_eye); empty: the default

@@ -1,10 +1,15 @@
-// WireRenderer: one stream-buffer region per frame holding per-draw records, indirect commands and geometry
-// (tube vertices + indices, or ring records), drawn with one glMultiDraw*Indirect per material.
+// WireRenderer: one stream-buffer region per frame holding per-draw records, indirect commands and streamed
+// geometry (tube vertices + indices, or packed rings when not retained); retained ring records in a
+// RetainedBuffer; a static index pattern per side count for the ring expansion; one glMultiDrawElementsIndirect
+// per material.
 #include "wire/render/wire_renderer.hpp"
 
 #include "shaders.hpp"
-#include "wire/render/stream_buffer.hpp"
+#include "wire/render/upload_plan.hpp"
 #include "wire/render/weave.hpp"
+
+#include "engine/gfx/retained_buffer.hpp"
+#include "engine/gfx/stream_buffer.hpp"
 
 #include <epoxy/gl.h>
 
@@ -20,6 +25,8 @@ namespace wire::render {
 namespace {
 
 namespace gfx = engine::gfx;
+using gfx::StreamBuffer;
+using gfx::StreamRegion;
 
 struct DrawElementsIndirectCommand {
     uint32_t count;
@@ -28,36 +35,35 @@ struct DrawElementsIndirectCommand {
     int32_t base_vertex;
     uint32_t base_instance;
 };
-struct DrawArraysIndirectCommand {
-    uint32_t count;
-    uint32_t instance_count;
-    uint32_t first;
-    uint32_t base_instance;
-};
-static_assert(sizeof(DrawElementsIndirectCommand) == 20 && sizeof(DrawArraysIndirectCommand) == 16);
+static_assert(sizeof(DrawElementsIndirectCommand) == kCommandBytes);
+static_assert(sizeof(detail::GpuDraw) == kDrawRecordBytes);
 
 constexpr std::size_t kSectionAlign =
     256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every driver we know
 constexpr GLuint kDrawIndexLocation = 3;
+constexpr uint32_t kPatternMinSides = 16;  // patterns are built for 3..max(this, largest side count seen)
 
 std::size_t align_up(std::size_t v) {
     return (v + kSectionAlign - 1) / kSectionAlign * kSectionAlign;
 }
 
-/// Vertices the ring expansion produces for a gpu-rings item (0 if it draws nothing).
-uint32_t expanded_vertices(const DrawItem& item) {
-    const auto rings = static_cast<uint32_t>(item.rings.size());
-    if (rings == 0) return 0;
-    const uint32_t n = item.sides;
-    const uint32_t bands = rings - 1 + (item.closed ? 1 : 0);
-    uint32_t count = bands * 6 * n;
-    if (!item.closed && item.caps) count += 2 * 3 * n;
-    return count;
-}
-
-bool has_geometry(const DrawItem& item, UploadPath path) {
-    if (path == UploadPath::cpu_mesh) return !item.vertices.empty() && !item.indices.empty();
-    return expanded_vertices(item) > 0;
+/// Indices of the ring-expansion pattern for `n` sides (upload_plan.hpp): start cap, end cap, kChunkBands
+/// bands, in write_tube's winding.
+void append_pattern(uint32_t n, std::vector<uint32_t>& out) {
+    for (uint32_t cap = 0; cap < 2; ++cap) {
+        const uint32_t centre = kCapVertexBase + cap * (n + 1);
+        for (uint32_t j = 0; j < n; ++j) {
+            const uint32_t rim_j = centre + 1 + j, rim_k = centre + 1 + (j + 1) % n;
+            // Start cap faces -t: (centre, rim_k, rim_j); end cap faces +t: (centre, rim_j, rim_k).
+            out.insert(out.end(), {centre, cap == 0 ? rim_k : rim_j, cap == 0 ? rim_j : rim_k});
+        }
+    }
+    for (uint32_t b = 0; b < kChunkBands; ++b) {
+        for (uint32_t j = 0; j < n; ++j) {
+            const uint32_t a = b * (n + 1) + j, c = (b + 1) * (n + 1) + j;
+            out.insert(out.end(), {a, a + 1, c, a + 1, c + 1, c});
+        }
+    }
 }
 
 }  // namespace
@@ -72,9 +78,76 @@ struct WireRenderer::State {
     std::size_t draw_index_capacity = 0;
     bool draw_parameters = false;
     StreamBuffer stream;
+    gfx::RetainedBuffer ring_storage;  ///< retained packed rings (gpu-rings, retain_rings)
+    RingResidency residency{180};
+    gfx::Buffer pattern;                 ///< static index patterns of the ring expansion, one per side count
+    std::vector<uint32_t> pattern_first; ///< first index of side count n's pattern (index n)
+    uint32_t pattern_max_sides = 0;
     std::vector<gfx::Texture> textures;
     std::vector<Material> materials;
-    std::vector<uint32_t> order;  ///< items with geometry, sorted by material (scratch, reused)
+    // Per-frame scratch, reused.
+    std::vector<uint32_t> order;          ///< items with geometry, sorted by material
+    std::vector<uint32_t> command_first;  ///< per order position: its first command (plus one past the end)
+    std::vector<uint32_t> ring_word;      ///< per order position: first word of its rings (retained)
+    std::vector<PackedRing> packed;
+
+    Expected<void> ensure_patterns(uint32_t max_sides) {
+        if (max_sides <= pattern_max_sides) return {};
+        const uint32_t top = std::max(max_sides, std::max(kPatternMinSides, 2 * pattern_max_sides));
+        std::vector<uint32_t> indices;
+        std::vector<uint32_t> first(top + 1, 0);
+        for (uint32_t n = 3; n <= top; ++n) {
+            first[n] = static_cast<uint32_t>(indices.size());
+            append_pattern(n, indices);
+        }
+        Expected<gfx::Buffer> made = gfx::make_buffer(std::span<const uint32_t>(indices), "wire ring pattern");
+        if (!made) return made.error();
+        pattern = std::move(made).value();  // draws in flight keep the old one alive (GL deletes it later)
+        pattern_first = std::move(first);
+        pattern_max_sides = top;
+        glVertexArrayElementBuffer(rings_vao.id(), pattern.id());
+        return {};
+    }
+
+    /// Retained path: makes every drawn item's rings resident (uploading new or changed ones) and records the
+    /// first word of each; evicts wires not drawn for a while. Items whose rings could not be stored are
+    /// dropped from `order` (the rest of the frame draws).
+    void retain(const DrawList& list, FrameStats& stats) {
+        ring_storage.begin_frame();
+        residency.begin_frame();
+        ring_word.clear();
+        std::size_t kept = 0;
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            const DrawItem& item = list.items[order[k]];
+            RingResidency::Touch t = residency.touch(item);
+            if (t.replaced && t.replaced->size_bytes > 0)
+                ring_storage.free({.offset_bytes = t.replaced->offset_bytes, .size_bytes = t.replaced->size_bytes});
+            if (t.upload) {
+                const std::size_t bytes = item.rings.size() * sizeof(PackedRing);
+                Expected<gfx::RetainedRange> range = ring_storage.allocate(bytes);
+                if (!range) {
+                    residency.forget(item.wire_id);
+                    continue;
+                }
+                packed.resize(item.rings.size());
+                pack_rings(item.rings, packed.data());
+                std::memcpy(range->data, packed.data(), bytes);  // write-only mapped memory: one memcpy
+                t.entry->offset_bytes = range->offset_bytes;
+                t.entry->size_bytes = bytes;
+                stats.ring_bytes_uploaded += bytes;
+                ++stats.wires_uploaded;
+                stats.buffer_grew = stats.buffer_grew || range->grew;
+            }
+            ring_word.push_back(static_cast<uint32_t>(t.entry->offset_bytes / 4));
+            order[kept++] = order[k];
+        }
+        order.resize(kept);
+        for (const Residency& gone : residency.evict()) {
+            if (gone.size_bytes > 0)
+                ring_storage.free({.offset_bytes = gone.offset_bytes, .size_bytes = gone.size_bytes});
+            ++stats.wires_evicted;
+        }
+    }
 
     Expected<void> ensure_draw_index_capacity(std::size_t n) {
         if (draw_parameters || n <= draw_index_capacity) return {};
@@ -173,6 +246,15 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
          .label = "wire stream"});
     if (!stream) return stream.error();
     s.stream = std::move(stream).value();
+    Expected<gfx::RetainedBuffer> storage = gfx::RetainedBuffer::create(
+        {.initial_bytes = desc.ring_storage_bytes != 0 ? desc.ring_storage_bytes : std::size_t{4} << 20,
+         .growth = desc.growth,
+         .alignment = 16,
+         .label = "wire ring storage"});
+    if (!storage) return storage.error();
+    s.ring_storage = std::move(storage).value();
+    s.residency = RingResidency(desc.retain_frames != 0 ? desc.retain_frames : 180);
+    if (Expected<void> st = s.ensure_patterns(kPatternMinSides); !st) return st.error();
     return r;
 }
 
@@ -207,51 +289,87 @@ const std::vector<unsigned>& WireRenderer::allocated_stream_buffers() const {
 std::size_t WireRenderer::region_bytes() const {
     return state_->stream.region_bytes();
 }
+std::size_t WireRenderer::resident_wires() const {
+    return state_->residency.resident_wires();
+}
+std::size_t WireRenderer::ring_storage_live_bytes() const {
+    return state_->ring_storage.live_bytes();
+}
+std::size_t WireRenderer::ring_storage_capacity() const {
+    return state_->ring_storage.capacity_bytes();
+}
+std::size_t WireRenderer::live_ring_buffers() const {
+    return state_->ring_storage.live_buffers();
+}
+const std::vector<unsigned>& WireRenderer::allocated_ring_buffers() const {
+    return state_->ring_storage.allocated_buffers();
+}
 
 FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
                               const FrameSettings& settings) {
     State& s = *state_;
     FrameStats stats;
     const bool cpu = list.path == UploadPath::cpu_mesh;
+    const bool retained = !cpu && s.desc.retain_rings;
 
-    // Items with geometry, grouped by material (stable: equal materials keep the list's order).
+    // (1) Items with geometry, grouped by material (stable: equal materials keep the list's order).
     s.order.clear();
+    uint32_t max_sides = 0;
     for (uint32_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         assert(item.material < s.materials.size() && "DrawItem::material out of range");
         assert((cpu || item.sides >= 3) && "DrawItem::sides must be >= 3");
-        if (has_geometry(item, list.path)) s.order.push_back(i);
+        if (!has_geometry(item, list.path)) continue;
+        s.order.push_back(i);
+        max_sides = std::max(max_sides, item.sides);
     }
-    if (s.order.empty()) return stats;  // nothing to draw: no GL call at all
     std::stable_sort(s.order.begin(), s.order.end(),
                      [&](uint32_t a, uint32_t b) { return list.items[a].material < list.items[b].material; });
+    if (retained) {
+        s.retain(list, stats);  // also on an empty list: culled and destroyed wires age out
+    }
+    if (s.order.empty()) {  // nothing to draw: no draw call
+        if (retained) s.ring_storage.end_frame();
+        return stats;
+    }
     const std::size_t n = s.order.size();
     if (Expected<void> st = s.ensure_draw_index_capacity(n); !st) return stats;
+    if (!cpu) {
+        if (Expected<void> st = s.ensure_patterns(max_sides); !st) return stats;
+    }
 
-    // Region layout: per-draw records | indirect commands | vertices or rings | indices.
+    // (2) Prepare: commands per item, then the region layout: per-draw records | indirect commands |
+    // streamed geometry (vertices, or packed rings) | indices.
+    s.command_first.resize(n + 1);
+    uint32_t commands = 0;
     std::size_t geometry_bytes = 0;
     std::size_t index_bytes = 0;
-    for (uint32_t i : s.order) {
-        const DrawItem& item = list.items[i];
+    for (std::size_t k = 0; k < n; ++k) {
+        const DrawItem& item = list.items[s.order[k]];
+        s.command_first[k] = commands;
         if (cpu) {
+            commands += 1;
             geometry_bytes += item.vertices.size_bytes();
             index_bytes += item.indices.size_bytes();
         } else {
-            geometry_bytes += item.rings.size_bytes();
+            commands += command_count(item);
+            if (!retained) geometry_bytes += item.rings.size() * sizeof(PackedRing);
         }
     }
+    s.command_first[n] = commands;
     const std::size_t draws_bytes = n * sizeof(detail::GpuDraw);
-    const std::size_t command_stride =
-        cpu ? sizeof(DrawElementsIndirectCommand) : sizeof(DrawArraysIndirectCommand);
     const std::size_t command_offset = align_up(draws_bytes);
-    const std::size_t geometry_offset = align_up(command_offset + n * command_stride);
+    const std::size_t geometry_offset = align_up(command_offset + commands * sizeof(DrawElementsIndirectCommand));
     const std::size_t index_offset = align_up(geometry_offset + geometry_bytes);
     const std::size_t total = index_offset + index_bytes;
 
     Expected<StreamRegion> begun = s.stream.begin(total);
-    if (!begun) return stats;  // allocation failed: skip the frame's wires, the rest of the frame goes on
+    if (!begun) {  // allocation failed: skip the frame's wires, the rest of the frame goes on
+        if (retained) s.ring_storage.end_frame();
+        return stats;
+    }
     const StreamRegion region = *begun;
-    stats.buffer_grew = region.grew;
+    stats.buffer_grew = stats.buffer_grew || region.grew;
     stats.waited_for_gpu = region.waited;
 
     // Fill the region with memcpy only (write-combined memory: never read it back).
@@ -260,8 +378,10 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
     std::size_t geometry_cursor = 0;  // bytes into the geometry section
     std::size_t index_cursor = 0;     // indices into the index section
     uint32_t vertex_cursor = 0;       // vertices into the vertex section
-    uint32_t ring_cursor = 0;
     const std::size_t first_index_base = (region.offset_bytes + index_offset) / sizeof(uint32_t);
+    auto put_command = [&](uint32_t c, const DrawElementsIndirectCommand& command) {
+        std::memcpy(base + command_offset + c * sizeof(command), &command, sizeof(command));
+    };
     for (std::size_t k = 0; k < n; ++k) {
         const DrawItem& item = list.items[s.order[k]];
         const glm::vec3 offset(item.origin_m - eye);  // difference in double, then float
@@ -273,10 +393,9 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
                         item.vertices.size_bytes());
             std::memcpy(base + index_offset + index_cursor * sizeof(uint32_t), item.indices.data(),
                         item.indices.size_bytes());
-            const DrawElementsIndirectCommand command{
-                index_count, 1, static_cast<uint32_t>(first_index_base + index_cursor),
-                static_cast<int32_t>(vertex_cursor), static_cast<uint32_t>(k)};
-            std::memcpy(base + command_offset + k * command_stride, &command, sizeof(command));
+            put_command(s.command_first[k],
+                        {index_count, 1, static_cast<uint32_t>(first_index_base + index_cursor),
+                         static_cast<int32_t>(vertex_cursor), static_cast<uint32_t>(k)});
             geometry_cursor += item.vertices.size_bytes();
             index_cursor += index_count;
             vertex_cursor += vertex_count;
@@ -284,33 +403,53 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
             stats.triangles += index_count / 3;
         } else {
             const auto ring_count = static_cast<uint32_t>(item.rings.size());
-            std::memcpy(base + geometry_offset + geometry_cursor, item.rings.data(), item.rings.size_bytes());
-            draw.ring_first = ring_cursor;
+            if (retained) {
+                draw.ring_first = s.ring_word[k];
+            } else {
+                s.packed.resize(ring_count);
+                pack_rings(item.rings, s.packed.data());
+                std::memcpy(base + geometry_offset + geometry_cursor, s.packed.data(),
+                            ring_count * sizeof(PackedRing));
+                draw.ring_first = static_cast<uint32_t>(geometry_cursor / 4);
+                geometry_cursor += ring_count * sizeof(PackedRing);
+                stats.ring_bytes_uploaded += ring_count * sizeof(PackedRing);
+                ++stats.wires_uploaded;
+            }
             draw.ring_count = ring_count;
             draw.sides = item.sides;
             // Normals tilt by the radius slope as write_tube's default does; a wire of constant radius has
-            // slope 0 everywhere, so the shader skips the three neighbour fetches per vertex for it.
+            // slope 0 everywhere, so the shader skips the neighbour fetches per vertex for it.
             const float r0 = item.rings.front().radius_m;
             const bool varying = std::any_of(item.rings.begin(), item.rings.end(),
                                              [r0](const Ring& r) { return r.radius_m != r0; });
+            const bool caps = !item.closed && item.caps;
             draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) |
                          (varying ? detail::kTilt : 0u);
             draw.u_close = item.u_close;
-            const uint32_t count = expanded_vertices(item);
-            const DrawArraysIndirectCommand command{count, 1, 0, static_cast<uint32_t>(k)};
-            std::memcpy(base + command_offset + k * command_stride, &command, sizeof(command));
-            geometry_cursor += item.rings.size_bytes();
-            ring_cursor += ring_count;
-            stats.vertices += count;
-            stats.triangles += count / 3;
+            // Commands over the side count's pattern: the first carries the caps, each covers <= kChunkBands.
+            const uint32_t sides = item.sides;
+            const uint32_t bands = band_count(item);
+            const uint32_t pattern = s.pattern_first[sides];
+            for (uint32_t c = 0, first_band = 0; c < s.command_first[k + 1] - s.command_first[k];
+                 ++c, first_band += kChunkBands) {
+                const uint32_t chunk = std::min(kChunkBands, bands - std::min(bands, first_band));
+                const bool with_caps = c == 0 && caps;
+                put_command(s.command_first[k] + c,
+                            {(chunk + (with_caps ? 1u : 0u)) * 6 * sides, 1,
+                             pattern + (with_caps ? 0u : 6 * sides),
+                             static_cast<int32_t>(first_band * (sides + 1)), static_cast<uint32_t>(k)});
+            }
+            stats.vertices += expanded_vertices(item);
+            stats.triangles += expanded_triangles(item);
         }
         std::memcpy(base + k * sizeof(detail::GpuDraw), &draw, sizeof(draw));
     }
-    stats.bytes_uploaded = draws_bytes + n * command_stride + geometry_bytes + index_bytes;
+    stats.bytes_uploaded = draws_bytes + commands * sizeof(DrawElementsIndirectCommand) + geometry_bytes +
+                           index_bytes + (retained ? stats.ring_bytes_uploaded : 0);
     stats.draw_items = n;
-    stats.indirect_commands = n;
+    stats.indirect_commands = commands;
 
-    // GL state for the wires.
+    // (3) Submit: GL state for the wires, the mode's program and vertex array, one multi-draw per material.
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
@@ -340,14 +479,18 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         glVertexArrayElementBuffer(s.cpu_vao.id(), buffer);
         s.cpu_vao.bind();
     } else {
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, buffer,
-                          static_cast<GLintptr>(region.offset_bytes + geometry_offset),
-                          static_cast<GLsizeiptr>(geometry_bytes));
-        s.rings_vao.bind();
+        if (retained) {
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, s.ring_storage.buffer(), 0,
+                              static_cast<GLsizeiptr>(s.ring_storage.capacity_bytes()));
+        } else {
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, buffer,
+                              static_cast<GLintptr>(region.offset_bytes + geometry_offset),
+                              static_cast<GLsizeiptr>(std::max<std::size_t>(geometry_bytes, 4)));
+        }
+        s.rings_vao.bind();  // its element buffer is the pattern
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, buffer);
 
-    // One multi-draw per run of equal materials.
     for (std::size_t first = 0; first < n;) {
         const uint32_t material_index = list.items[s.order[first]].material;
         std::size_t last = first + 1;
@@ -355,18 +498,15 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         const Material& material = s.materials[material_index];
         program.set("u_tint", material.tint);
         s.textures[material.texture].bind(0);
-        const auto* indirect =
-            reinterpret_cast<const void*>(region.offset_bytes + command_offset + first * command_stride);
-        const auto count = static_cast<GLsizei>(last - first);
-        if (cpu) {
-            glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, indirect, count, 0);
-        } else {
-            glMultiDrawArraysIndirect(GL_TRIANGLES, indirect, count, 0);
-        }
+        const auto* indirect = reinterpret_cast<const void*>(
+            region.offset_bytes + command_offset + s.command_first[first] * sizeof(DrawElementsIndirectCommand));
+        const auto count = static_cast<GLsizei>(s.command_first[last] - s.command_first[first]);
+        glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, indirect, count, 0);
         ++stats.multi_draw_calls;
         first = last;
     }
     s.stream.end();
+    if (retained) s.ring_storage.end_frame();
 
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);

@@ -313,6 +313,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         item.material = style->material;
         item.wire_id = engine::ecs::to_integral(e);
         item.rings = rs.rings;
+        item.rings_generation = rings->generation;
         item.sides = std::max<uint32_t>(lod->lod.sides, 3);
         item.closed = rs.closed;
         item.caps = caps_of(*style);

@@ -1,5 +1,16 @@
 // The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
-// one persistently mapped buffer and one multi-draw per material. The only wire code that touches GL.
+// persistently mapped buffers and one multi-draw per material. The only wire code that touches GL.
+//
+// Upload paths: cpu-mesh streams every visible wire's vertices and indices each frame; gpu-rings keeps each
+// wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
+// a frame sends the rings of changed wires plus one draw record and command per visible wire, and expands the
+// tube in the vertex shader over a static index pattern per side count (each vertex shaded once per ring).
+//
+// Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
+// by material, (2) a per-mode "prepare" step that writes each item's draw record and indirect commands (and
+// streams or retains its geometry), (3) one shared submission loop issuing glMultiDrawElementsIndirect per run
+// of equal materials with the mode's program, vertex array and element buffer. A new mode adds a program, a
+// prepare step and its element pattern.
 //
 //   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
 //   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
@@ -55,6 +66,13 @@ struct RendererDesc {
     std::string_view shading_glsl{};
     /// Use the instanced draw-index attribute even when ARB_shader_draw_parameters is available (tests).
     bool force_draw_index_attribute = false;
+    /// gpu-rings: keep ring records on the GPU between frames (false: stream every visible wire's rings each
+    /// frame, the path's behaviour before retention; kept for comparison in benchmarks and tests).
+    bool retain_rings = true;
+    /// Frames a wire's ring records stay resident while it is not drawn (culled or destroyed); 0 -> 180.
+    uint32_t retain_frames = 0;
+    /// Initial size of the retained ring buffer (grows as needed); 0 -> 4 MiB.
+    std::size_t ring_storage_bytes = 0;
 };
 
 /// Per-frame options.
@@ -68,9 +86,12 @@ struct FrameSettings {
 
 /// What one draw() did.
 struct FrameStats {
-    std::size_t bytes_uploaded = 0;  ///< bytes memcpy'd into the mapped buffer (geometry, per-draw, commands)
+    std::size_t bytes_uploaded = 0;  ///< bytes memcpy'd into mapped buffers (geometry, per-draw, commands)
+    std::size_t ring_bytes_uploaded = 0;  ///< gpu-rings: the packed ring records among them
+    std::size_t wires_uploaded = 0;       ///< gpu-rings: wires whose rings were written this frame
+    std::size_t wires_evicted = 0;        ///< gpu-rings retained: ranges freed (wires not drawn for a while)
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
-    std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices expanded by the shader
+    std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
     std::size_t triangles = 0;
     std::size_t indirect_commands = 0;
     std::size_t multi_draw_calls = 0;  ///< one per material in use
@@ -114,6 +135,13 @@ public:
     /// GL names of every stream buffer allocated so far (the first is the initial one).
     [[nodiscard]] const std::vector<unsigned>& allocated_stream_buffers() const;
     [[nodiscard]] std::size_t region_bytes() const;
+    /// Retained ring storage: wires resident, bytes in live ranges, buffer capacity, GL buffers alive, and every
+    /// GL buffer it allocated (tests check growth retires the old ones).
+    [[nodiscard]] std::size_t resident_wires() const;
+    [[nodiscard]] std::size_t ring_storage_live_bytes() const;
+    [[nodiscard]] std::size_t ring_storage_capacity() const;
+    [[nodiscard]] std::size_t live_ring_buffers() const;
+    [[nodiscard]] const std::vector<unsigned>& allocated_ring_buffers() const;
 
 private:
     struct State;

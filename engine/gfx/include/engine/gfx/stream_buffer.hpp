@@ -1,9 +1,9 @@
 // A persistently mapped GL buffer split into regions for the frames in flight, each guarded by a fence: the
 // CPU writes a frame's data with memcpy into the region the GPU finished with. Grows without stalling the
-// frame. (Generic GL: belongs in engine::gfx once that folder takes it; kept here so wire code touches GL in
-// one place.)
+// frame. Generic GL (the wire renderer streams its per-frame draw records through it).
 #pragma once
 
+#include "engine/gfx/resources.hpp"
 #include "engine/platform/expected.hpp"
 
 #include <cstddef>
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace wire::render {
+namespace engine::gfx {
 
 using engine::platform::Error;
 using engine::platform::Expected;
@@ -68,4 +68,4 @@ private:
     std::unique_ptr<State> state_;
 };
 
-}  // namespace wire::render
+}  // namespace engine::gfx

@@ -1,8 +1,6 @@
 // StreamBuffer: glBufferStorage(MAP_WRITE | MAP_PERSISTENT | MAP_COHERENT), mapped once; glFenceSync per
 // region.
-#include "wire/render/stream_buffer.hpp"
-
-#include "engine/gfx/resources.hpp"
+#include "engine/gfx/stream_buffer.hpp"
 
 #include <epoxy/gl.h>
 
@@ -11,7 +9,7 @@
 #include <cmath>
 #include <utility>
 
-namespace wire::render {
+namespace engine::gfx {
 
 namespace {
 constexpr GLbitfield kMapFlags = GL_MAP_WRITE_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
@@ -42,11 +40,11 @@ bool wait(GLsync fence) {
 
 struct StreamBuffer::State {
     struct Retired {
-        engine::gfx::Buffer buffer;
+        Buffer buffer;
         GLsync fence = nullptr;  ///< placed after the buffer's last use
     };
     StreamBufferDesc desc;
-    engine::gfx::Buffer buffer;
+    Buffer buffer;
     std::byte* mapped = nullptr;
     std::size_t region_bytes = 0;
     std::vector<GLsync> fences;  ///< one per region, null when the region has no pending GPU work
@@ -68,8 +66,8 @@ struct StreamBuffer::State {
 
     Expected<void> allocate(std::size_t new_region_bytes) {
         const std::size_t total = new_region_bytes * desc.regions;
-        Expected<engine::gfx::Buffer> made =
-            engine::gfx::make_buffer({.size_bytes = total, .storage_flags = kMapFlags, .label = desc.label});
+        Expected<Buffer> made =
+            make_buffer({.size_bytes = total, .storage_flags = kMapFlags, .label = desc.label});
         if (!made) return made.error();
         auto* ptr = static_cast<std::byte*>(
             glMapNamedBufferRange(made->id(), 0, static_cast<GLsizeiptr>(total), kMapFlags));
@@ -173,4 +171,4 @@ const std::vector<unsigned>& StreamBuffer::allocated_buffers() const {
     return state_ ? state_->allocated : none;
 }
 
-}  // namespace wire::render
+}  // namespace engine::gfx

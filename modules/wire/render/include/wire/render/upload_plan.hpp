@@ -1,0 +1,126 @@
+// What the wire renderer uploads, without GL: the compact ring record, the indexed expansion's draw counts, the
+// bytes a frame sends on each path, and which wires' ring records are resident on the GPU. The renderer and
+// `wiretool bench` share these, so the benchmark's byte counts are the renderer's by construction.
+#pragma once
+
+#include "wire/draw.hpp"
+#include "wire/rings.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+namespace wire::render {
+
+/// The ring record as the GPU reads it: 28 bytes (seven 32-bit words) instead of wire::Ring's 48. Centre,
+/// radius and u stay float (the same values as wire::Ring); the frame (normal r, binormal s, tangent t = r x s)
+/// is a unit quaternion in "smallest three" form: the index of the largest component (2 bits) and the other
+/// three in [-1/sqrt 2, 1/sqrt 2] as 20-bit fixed point (step 1.35e-6), the largest made positive and rebuilt
+/// as sqrt(1 - a^2 - b^2 - c^2). Measured in upload_plan_test: frame angle error <= ~2e-6 rad, so the rim
+/// moves < 0.01 px for tubes up to thousands of pixels in radius.
+struct PackedRing {
+    float centre_m[3];
+    float radius_m;
+    float u;
+    uint32_t frame[2];
+};
+static_assert(sizeof(PackedRing) == 28, "PackedRing is the 28-byte GPU ring record");
+inline constexpr uint32_t kPackedRingWords = sizeof(PackedRing) / 4;
+
+[[nodiscard]] PackedRing pack_ring(const Ring& ring);
+void pack_rings(std::span<const Ring> rings, PackedRing* out);
+
+/// The frame a PackedRing decodes to, computed as the vertex shader does (float).
+struct DecodedFrame {
+    glm::vec3 normal{}, binormal{}, tangent{};
+};
+[[nodiscard]] DecodedFrame unpack_frame(const PackedRing& ring);
+
+// ---- indexed expansion --------------------------------------------------------------------------------------
+// A wire of R rings and n sides has rows of n + 1 vertices (the seam is duplicated for u = 1), one row per ring
+// (a closed wire has one more row: ring 0 again with u = u_close), and, on open wires with caps, two caps of
+// n + 1 vertices (centre + rim) addressed by vertex ids from kCapVertexBase up. One static index pattern per
+// side count: [start cap 3n][end cap 3n][kChunkBands bands of 6n]; a wire with more bands draws several
+// commands over it with base vertex = chunk * kChunkBands * (n + 1). Every vertex is shaded once per draw
+// command, i.e. once per ring row (twice at a chunk boundary).
+inline constexpr uint32_t kChunkBands = 128;
+inline constexpr uint32_t kCapVertexBase = 1u << 30;
+
+/// Bands (quads rows) of a gpu-rings item: rings - 1, plus 1 on a closed wire; 0 without rings.
+[[nodiscard]] uint32_t band_count(const DrawItem& item);
+/// Whether the item draws anything on `path` (the renderer skips the others).
+[[nodiscard]] bool has_geometry(const DrawItem& item, UploadPath path);
+/// Indirect commands a gpu-rings item needs (1 per started chunk of kChunkBands bands; 1 for caps only).
+[[nodiscard]] uint32_t command_count(const DrawItem& item);
+/// Vertices (unique, as a mesh would hold them) and triangles of a gpu-rings item: equal to wire::tube_counts.
+[[nodiscard]] uint32_t expanded_vertices(const DrawItem& item);
+[[nodiscard]] uint32_t expanded_triangles(const DrawItem& item);
+
+// ---- bytes per frame ----------------------------------------------------------------------------------------
+inline constexpr std::size_t kDrawRecordBytes = 32;  ///< per drawn item (detail::GpuDraw)
+inline constexpr std::size_t kCommandBytes = 20;     ///< per indirect command (DrawElementsIndirectCommand)
+
+/// Bytes a frame of `list` sends when every item's geometry is streamed (cpu-mesh; gpu-rings not retained):
+/// draw records, commands, and vertices + indices or packed rings.
+[[nodiscard]] std::size_t streamed_upload_bytes(const DrawList& list);
+
+// ---- retained ring storage ----------------------------------------------------------------------------------
+
+/// One wire's ring records on the GPU.
+struct Residency {
+    uint64_t wire_id = 0;
+    uint64_t generation = 0;   ///< DrawItem::rings_generation the records were uploaded for
+    uint32_t rings = 0;
+    uint64_t last_frame = 0;   ///< frame it was last drawn in
+    std::size_t offset_bytes = 0;  ///< where the renderer put them (unused by the bench's model)
+    std::size_t size_bytes = 0;
+};
+
+/// Which wires' ring records are resident. A frame touches each drawn item: a new wire, a changed
+/// rings_generation (or 0) means upload (and the replaced residency's range is returned to be freed). Wires
+/// not drawn for more than `retain_frames` frames are evicted (culled wires keep their range a while: turning
+/// the camera back costs nothing; a destroyed wire's range is freed then and reused, never drawn, since only
+/// drawn items are bound to records).
+class RingResidency {
+public:
+    explicit RingResidency(uint32_t retain_frames = 180) : retain_frames_(retain_frames) {}
+
+    struct Touch {
+        Residency* entry = nullptr;
+        bool upload = false;                 ///< the item's rings must be written (entry's range to be set)
+        std::optional<Residency> replaced;   ///< the previous residency whose range is now unused
+    };
+    void begin_frame() { ++frame_; }
+    Touch touch(const DrawItem& item);
+    /// Removes and returns the entries not drawn in the last retain_frames frames.
+    std::vector<Residency> evict();
+    /// Drops a wire's entry without returning it (its range was never stored).
+    void forget(uint64_t wire_id) { entries_.erase(wire_id); }
+
+    [[nodiscard]] std::size_t resident_wires() const { return entries_.size(); }
+    [[nodiscard]] uint64_t frame() const { return frame_; }
+    [[nodiscard]] uint32_t retain_frames() const { return retain_frames_; }
+    [[nodiscard]] const Residency* find(uint64_t wire_id) const;
+
+private:
+    uint32_t retain_frames_;
+    uint64_t frame_ = 0;
+    std::unordered_map<uint64_t, Residency> entries_;
+};
+
+/// What a retained gpu-rings frame of `list` uploads given `residency` (updated as the renderer would):
+/// draw records and commands of every drawn item plus the packed rings of the items that must upload.
+struct RetainedFrame {
+    std::size_t bytes = 0;
+    std::size_t ring_bytes = 0;
+    std::size_t wires_uploaded = 0;
+    std::size_t wires_evicted = 0;
+};
+RetainedFrame plan_retained_frame(const DrawList& list, RingResidency& residency);
+
+}  // namespace wire::render
