@@ -4,6 +4,7 @@
 #include <epoxy/gl.h>
 
 #include <cassert>
+#include <chrono>
 #include <deque>
 
 namespace engine::gfx {
@@ -12,12 +13,14 @@ struct GpuTimer::State {
     struct Pending {
         GLuint query;
         uint64_t frame;
+        std::chrono::steady_clock::time_point issued;
     };
     std::vector<GLuint> free_queries;
     std::vector<GLuint> all;
     std::deque<Pending> pending;  ///< oldest first
     uint64_t frames = 0;
     uint64_t skipped = 0;
+    uint64_t rejected = 0;
     bool active = false;
     bool measuring = false;  ///< the active begin() got a query
     std::optional<Measurement> latest;
@@ -26,11 +29,21 @@ struct GpuTimer::State {
         if (!all.empty()) glDeleteQueries(static_cast<GLsizei>(all.size()), all.data());
     }
 
-    Measurement read(const Pending& p) {
+    /// The result, or nothing when it is impossible: a pass cannot take longer on the GPU than the wall time
+    /// from issuing it to reading it back (llvmpipe reports time since boot for a query begun while its
+    /// rasterizer has no scene, e.g. around a clear alone).
+    std::optional<Measurement> read(const Pending& p) {
         GLuint64 ns = 0;
         glGetQueryObjectui64v(p.query, GL_QUERY_RESULT, &ns);
         free_queries.push_back(p.query);
-        return {p.frame, static_cast<double>(ns) * 1e-6};
+        const double wall_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - p.issued).count();
+        const double ms = static_cast<double>(ns) * 1e-6;
+        if (ms > wall_ms + 1.0) {
+            ++rejected;
+            return std::nullopt;
+        }
+        return Measurement{p.frame, ms};
     }
 };
 
@@ -62,7 +75,7 @@ void GpuTimer::begin() {
     const GLuint q = s.free_queries.back();
     s.free_queries.pop_back();
     glBeginQuery(GL_TIME_ELAPSED, q);
-    s.pending.push_back({q, s.frames++});
+    s.pending.push_back({q, s.frames++, std::chrono::steady_clock::now()});
 }
 
 void GpuTimer::end() {
@@ -80,7 +93,7 @@ std::vector<GpuTimer::Measurement> GpuTimer::poll() {
         GLint available = 0;
         glGetQueryObjectiv(s.pending.front().query, GL_QUERY_RESULT_AVAILABLE, &available);
         if (available == 0) break;  // results arrive in order
-        out.push_back(s.read(s.pending.front()));
+        if (auto m = s.read(s.pending.front())) out.push_back(*m);
         s.pending.pop_front();
     }
     if (!out.empty()) s.latest = out.back();
@@ -92,7 +105,7 @@ std::vector<GpuTimer::Measurement> GpuTimer::finish() {
     assert(!s.active && "GpuTimer::finish inside begin/end");
     std::vector<Measurement> out;
     while (!s.pending.empty()) {
-        out.push_back(s.read(s.pending.front()));  // GL_QUERY_RESULT waits
+        if (auto m = s.read(s.pending.front())) out.push_back(*m);  // GL_QUERY_RESULT waits
         s.pending.pop_front();
     }
     if (!out.empty()) s.latest = out.back();
@@ -104,6 +117,9 @@ std::optional<GpuTimer::Measurement> GpuTimer::latest() const {
 }
 uint64_t GpuTimer::skipped() const {
     return state_ ? state_->skipped : 0;
+}
+uint64_t GpuTimer::rejected() const {
+    return state_ ? state_->rejected : 0;
 }
 
 }  // namespace engine::gfx

@@ -42,6 +42,8 @@ public:
     [[nodiscard]] std::optional<Measurement> latest() const;
     /// begin() calls skipped because every query was still pending.
     [[nodiscard]] uint64_t skipped() const;
+    /// Results dropped as impossible (longer than the wall time from begin() to read-back).
+    [[nodiscard]] uint64_t rejected() const;
 
 private:
     struct State;
