@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -649,6 +650,179 @@ TEST(WireRendererTest, HundredWiresBytesAndFrameTime) {
     EXPECT_EQ(cpu_stats.multi_draw_calls, 1u);
     EXPECT_GE(static_cast<double>(cpu_stats.bytes_uploaded),
               6.0 * static_cast<double>(gpu_stats.bytes_uploaded));
+}
+
+// Retained ring storage under churn (fixed seed): every frame wires are spawned (new ids), changed (new rings,
+// new generation) and destroyed at random. Each frame the retained renderer's image equals, bit for bit, the
+// streaming renderer's (same records, sent every frame) and matches cpu-mesh within 2/255 (off silhouettes);
+// its bytes equal the CPU plan's (upload_plan.hpp); a destroyed wire is never drawn (the images would differ)
+// and its range is reused: far more ring bytes are written over the run than the storage holds, and it never
+// grows. At the end, with every wire gone, the storage drains to zero live bytes.
+TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    constexpr uint32_t kRetain = 4;
+    WireRenderer retained = make_renderer({.retain_frames = kRetain, .ring_storage_bytes = 48 * 1024});
+    WireRenderer streamed = make_renderer({.retain_rings = false});
+    wire::render::RingResidency model(kRetain);
+    const std::vector<uint8_t> bg = background_pixel(*ctx, retained);
+    std::mt19937 rng(99);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+
+    struct Wire {
+        wire::WirePipeline pipeline;
+        wire::PipelineSettings settings;
+        uint64_t id = 0, generation = 0;
+        bool alive = false;
+    };
+    std::vector<Wire> wires(14);
+    uint64_t next_id = 1000;
+    // Wire slot k lives in its own depth slab (z = -1.2 + 0.18 k, tubes thinner than the gap), so no two wires
+    // intersect: where they do, which one wins a pixel rests on sub-ulp depth differences, not on the path.
+    auto build = [&](Wire& w) {
+        const double z = -1.2 + 0.18 * static_cast<double>(&w - wires.data());
+        const double x = -2.4 + 4.2 * uni(rng), y = -1.0 + 2.2 * uni(rng);
+        const bool loop = uni(rng) < 0.2;
+        wire::WireNodes nodes;
+        if (loop) {
+            for (int i = 0; i < 6; ++i) {
+                const double a = 2.0 * std::numbers::pi * i / 6.0;
+                nodes.positions.push_back({x + 0.4 * std::cos(a), y + 0.2 * std::sin(a), z + 0.02 * std::sin(a)});
+            }
+        } else {
+            nodes = hanging_cable({x, y, z}, {x + 0.4 + uni(rng), y - 0.3 * uni(rng), z},
+                                  0.2 + 0.5 * uni(rng), 5 + static_cast<int>(uni(rng) * 6));
+        }
+        w.settings = wire_settings(0.02f + 0.04f * static_cast<float>(uni(rng)), 6 + static_cast<uint32_t>(uni(rng) * 8),
+                                   loop);
+        const wire::Status st = w.pipeline.update(nodes, w.settings);
+        ASSERT_TRUE(st.ok) << st.message;
+        ++w.generation;
+    };
+    auto list = [&](UploadPath path) {
+        DrawList out{.path = path, .items = {}};
+        for (const Wire& w : wires) {
+            if (!w.alive) continue;
+            const wire::RingSet& rings = w.pipeline.rings();
+            DrawItem item;
+            item.origin_m = rings.origin_m;
+            item.wire_id = w.id;
+            item.rings_generation = w.generation;
+            item.vertices = w.pipeline.mesh().vertices;
+            item.indices = w.pipeline.mesh().indices;
+            item.rings = rings.rings;
+            item.sides = w.settings.tube.sides;
+            item.closed = rings.closed;
+            item.caps = w.settings.tube.caps;
+            item.u_close = rings.closed ? static_cast<float>(rings.u.back()) : 0.0f;
+            out.items.push_back(item);
+        }
+        return out;
+    };
+
+    std::size_t ring_bytes_total = 0, spawned = 0, changed = 0, destroyed = 0, worst_mismatch = 0;
+    int worst_difference = 0;
+    for (int frame = 0; frame < 40; ++frame) {
+        for (Wire& w : wires) {
+            const double r = uni(rng);
+            if (!w.alive && r < 0.3) {
+                w.id = next_id++;  // a new entity: a new id
+                w.generation = 0;
+                build(w);
+                w.alive = true;
+                ++spawned;
+            } else if (w.alive && r < 0.15) {
+                build(w);  // same id, new rings
+                ++changed;
+            } else if (w.alive && r < 0.25) {
+                w.alive = false;
+                ++destroyed;
+            }
+        }
+        const DrawList gpu = list(UploadPath::gpu_rings);
+        FrameStats rs, ss;
+        const platform::Image a = render(*ctx, retained, gpu, scene_camera(), {}, &rs);
+        const platform::Image b = render(*ctx, streamed, gpu, scene_camera(), {}, &ss);
+        const platform::Image c = render(*ctx, streamed, list(UploadPath::cpu_mesh), scene_camera());
+        ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        ASSERT_TRUE(a.rgba == b.rgba) << "frame " << frame << ": retained and streamed rings differ";
+        const Comparison cmp = compare(c, a, bg.data(), 2);
+        EXPECT_EQ(cmp.off_silhouette, 0u) << "frame " << frame;
+        EXPECT_LE(static_cast<double>(cmp.mismatched), 0.005 * static_cast<double>(cmp.pixels)) << "frame " << frame;
+        worst_mismatch = std::max(worst_mismatch, cmp.mismatched);
+        worst_difference = std::max(worst_difference, cmp.max_difference);
+        const wire::render::RetainedFrame plan = wire::render::plan_retained_frame(gpu, model);
+        EXPECT_EQ(rs.bytes_uploaded, plan.bytes) << "frame " << frame;
+        EXPECT_EQ(rs.wires_uploaded, plan.wires_uploaded) << "frame " << frame;
+        EXPECT_EQ(rs.wires_evicted, plan.wires_evicted) << "frame " << frame;
+        EXPECT_EQ(ss.bytes_uploaded, wire::render::streamed_upload_bytes(gpu)) << "frame " << frame;
+        EXPECT_EQ(rs.triangles, ss.triangles);
+        ring_bytes_total += rs.ring_bytes_uploaded;
+        if (frame == 20) save(a, "wire_render_retained_churn.png");
+    }
+    std::printf("churn: %zu spawned, %zu changed, %zu destroyed; %zu ring bytes written into a %zu-byte storage "
+                "(%zu buffer(s)); vs cpu-mesh: worst frame %zu px over 2/255, max difference %d/255\n",
+                spawned, changed, destroyed, ring_bytes_total, retained.ring_storage_capacity(),
+                retained.allocated_ring_buffers().size(), worst_mismatch, worst_difference);
+    EXPECT_GT(spawned, 10u);
+    EXPECT_GT(changed, 10u);
+    EXPECT_GT(destroyed, 10u);
+    EXPECT_GT(ring_bytes_total, 2 * retained.ring_storage_capacity()) << "ranges must have been reused";
+    EXPECT_EQ(retained.allocated_ring_buffers().size(), 1u) << "reuse, not growth";
+
+    // Every wire destroyed: after the retention window the storage holds nothing.
+    for (Wire& w : wires) w.alive = false;
+    for (uint32_t f = 0; f <= kRetain + 1; ++f) {
+        render(*ctx, retained, list(UploadPath::gpu_rings), scene_camera());
+        glFinish();
+    }
+    render(*ctx, retained, list(UploadPath::gpu_rings), scene_camera());
+    EXPECT_EQ(retained.resident_wires(), 0u);
+    EXPECT_EQ(retained.ring_storage_live_bytes(), 0u);
+    EXPECT_EQ(retained.live_ring_buffers(), 1u);
+}
+
+// A small ring storage grows while wires are added: each image equals a roomy renderer's, old buffers are
+// deleted once their fences pass, at most a few live at once.
+TEST(WireRendererTest, RetainedRingStorageGrowsWithoutLeaks) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    Scene pool;
+    for (int i = 0; i < 24; ++i) {
+        const double x = -2.4 + 0.2 * i;
+        pool.add(hanging_cable({x, 1.3, -0.5}, {x + 0.3, -1.4, 0.4 - 0.05 * i}, 0.2, 5 + i % 4),
+                 wire_settings(0.03f + 0.002f * static_cast<float>(i), 8));
+    }
+    WireRenderer growing = make_renderer({.ring_storage_bytes = 256});
+    WireRenderer roomy = make_renderer({.ring_storage_bytes = std::size_t{8} << 20});
+    const DrawList all = pool.list(UploadPath::gpu_rings);
+    std::size_t growths = 0, max_live = 0;
+    for (std::size_t count = 1; count <= all.items.size(); count += 2) {
+        DrawList list{.path = UploadPath::gpu_rings,
+                      .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)}};
+        FrameStats stats;
+        const platform::Image got = render(*ctx, growing, list, scene_camera(), {}, &stats);
+        const platform::Image want = render(*ctx, roomy, list, scene_camera());
+        ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        EXPECT_TRUE(got.rgba == want.rgba) << count << " wires";
+        EXPECT_EQ(stats.wires_uploaded, count == 1 ? 1u : 2u) << "only the new wires";
+        growths += stats.buffer_grew ? 1 : 0;
+        max_live = std::max(max_live, growing.live_ring_buffers());
+    }
+    glFinish();
+    render(*ctx, growing, all, scene_camera());  // retired buffers are collected at the start of a frame
+    const std::vector<unsigned>& allocated = growing.allocated_ring_buffers();
+    std::printf("ring storage: %zu growths to %zu bytes, at most %zu live buffers\n", growths,
+                growing.ring_storage_capacity(), max_live);
+    EXPECT_GE(growths, 3u);
+    EXPECT_GE(allocated.size(), growths + 1);  // a frame may grow more than once
+    EXPECT_LE(max_live, 4u);
+    EXPECT_EQ(growing.live_ring_buffers(), 1u);
+    for (std::size_t i = 0; i + 1 < allocated.size(); ++i) {
+        const auto& other = roomy.allocated_ring_buffers();
+        EXPECT_FALSE(glIsBuffer(allocated[i]) && std::find(other.begin(), other.end(), allocated[i]) == other.end())
+            << "retired ring buffer " << allocated[i] << " still exists";
+    }
 }
 
 // The driver reports no error through KHR_debug for a debug context running both paths, growth included.
