@@ -1,6 +1,8 @@
 // `wiretool bench`: shared helpers (clocks, medians, upload sizes, tables).
 #include "bench_common.hpp"
 
+#include <wire/render/upload_plan.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -29,38 +31,20 @@ double median(std::vector<double> v) {
     return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
 }
 
-namespace {
-constexpr std::size_t kDrawRecordBytes = 32;       // detail::GpuDraw
-constexpr std::size_t kElementsCommandBytes = 20;  // DrawElementsIndirectCommand
-constexpr std::size_t kArraysCommandBytes = 16;    // DrawArraysIndirectCommand
-}  // namespace
-
+// The renderer's own accounting (wire/render/upload_plan.hpp), so computed and drawn bytes agree.
 std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices) {
-    return items * (kDrawRecordBytes + kElementsCommandBytes) + vertices * sizeof(wire::TubeVertex) +
-           indices * sizeof(uint32_t);
+    return items * (wire::render::kDrawRecordBytes + wire::render::kCommandBytes) +
+           vertices * sizeof(wire::TubeVertex) + indices * sizeof(uint32_t);
 }
 
 std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings) {
-    return items * (kDrawRecordBytes + kArraysCommandBytes) + rings * sizeof(wire::Ring);
+    // One command a wire (wires longer than kChunkBands bands take one more per chunk; upload_bytes counts them).
+    return items * (wire::render::kDrawRecordBytes + wire::render::kCommandBytes) +
+           rings * sizeof(wire::render::PackedRing);
 }
 
 std::size_t upload_bytes(const wire::DrawList& list) {
-    std::size_t items = 0, vertices = 0, indices = 0, rings = 0;
-    for (const wire::DrawItem& item : list.items) {
-        if (list.path == wire::UploadPath::cpu_mesh) {
-            if (item.vertices.empty() || item.indices.empty()) continue;
-            ++items;
-            vertices += item.vertices.size();
-            indices += item.indices.size();
-        } else {
-            const bool draws = !item.rings.empty() && (item.rings.size() > 1 || item.closed || item.caps);
-            if (!draws) continue;
-            ++items;
-            rings += item.rings.size();
-        }
-    }
-    return list.path == wire::UploadPath::cpu_mesh ? cpu_mesh_bytes(items, vertices, indices)
-                                                   : gpu_rings_bytes(items, rings);
+    return wire::render::streamed_upload_bytes(list);
 }
 
 bool selected(const Options& o, const std::string& scene) {

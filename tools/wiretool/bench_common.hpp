@@ -31,10 +31,10 @@ double wall_ms();
 /// Median of `v` (0 for an empty vector). Takes a copy.
 double median(std::vector<double> v);
 
-/// Bytes WireRenderer::draw() memcpy's into its mapped buffer for `list` (wire_renderer.cpp): per drawn item
-/// a 32-byte draw record and a 20-byte (cpu-mesh, DrawElementsIndirect) or 16-byte (gpu-rings,
-/// DrawArraysIndirect) command, plus vertices (32 B) and indices (4 B) or ring records (48 B). Items without
-/// geometry are skipped.
+/// Bytes WireRenderer::draw() memcpy's into its mapped buffers for `list` when every item is streamed
+/// (wire::render::streamed_upload_bytes): per drawn item a 32-byte draw record and 20-byte indirect commands
+/// (gpu-rings: one per 128 bands), plus vertices (32 B) and indices (4 B) or packed ring records (28 B). Items
+/// without geometry are skipped. The retained gpu-rings path: wire::render::plan_retained_frame.
 std::size_t upload_bytes(const wire::DrawList& list);
 /// The same for a cpu-mesh upload of `items` meshes with these totals.
 std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices);

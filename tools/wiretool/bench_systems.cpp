@@ -6,11 +6,13 @@
 #include "commands.hpp"
 
 #include <engine/ecs/registry.hpp>
+#include <engine/gfx/gpu_timer.hpp>
 #include <engine/gfx/lit_renderer.hpp>
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
 #include <wire/lod.hpp>
 #include <wire/reference.hpp>
+#include <wire/render/upload_plan.hpp>
 #include <wire/render/wire_renderer.hpp>
 #include <wire/rings.hpp>
 #include <wire/systems/api.hpp>
@@ -99,6 +101,7 @@ struct SceneRun {
     std::vector<std::array<double, kSystems>> system_cpu_ms;  // per measured frame
     std::vector<double> frame_cpu_ms, frame_wall_ms;
     std::vector<double> visible, rings, vertices, bytes;
+    std::vector<double> retained_bytes;  // gpu-rings: what the retained path sends (upload_plan.hpp's model)
     std::vector<double> visible_segments;  // per frame: segments of the visible wires (uniform counts)
     std::vector<Sample> samples;
     double max_error_px = 0.0;
@@ -112,7 +115,7 @@ struct RunSpec {
     int wires = 1000;
     bool sample_errors = true;
     int error_samples = 3;  // frames at which the screen error is measured (spread over the run)
-    /// Called after the systems of every measured frame (untimed), e.g. to draw the DrawList with GL.
+    /// Called after the systems of every frame, frame 0 included (untimed), e.g. to draw the DrawList with GL.
     std::function<void(const wire::systems::WireContext&, int frame)> after_frame;
 };
 
@@ -137,6 +140,7 @@ SceneRun run_scene(const RunSpec& spec) {
         sample_frames.push_back(1 + (spec.frames - 2) * k / std::max(1, spec.error_samples - 1));
 
     SceneRun out;
+    wire::render::RingResidency residency;  // the retained path's bookkeeping, as the renderer keeps it
     uint64_t since = 0;
     for (int f = 0; f < spec.frames; ++f) {
         place_camera(ctx.camera, spec.kind, f);
@@ -163,6 +167,10 @@ SceneRun run_scene(const RunSpec& spec) {
         timed(2, [&] { rings_system(registry, ctx); });
         timed(3, [&] { mesh_system(registry, ctx); });
         timed(4, [&] { draw_list_system(registry, ctx); });
+        const wire::render::RetainedFrame retained = spec.path == wire::UploadPath::gpu_rings
+                                                         ? wire::render::plan_retained_frame(ctx.draw_list, residency)
+                                                         : wire::render::RetainedFrame{};
+        if (spec.after_frame) spec.after_frame(ctx, f);
         if (f == 0) continue;  // the first frame builds everything: a loading cost, not a frame cost
 
         out.system_cpu_ms.push_back(cpu);
@@ -174,13 +182,13 @@ SceneRun run_scene(const RunSpec& spec) {
         out.rings.push_back(static_cast<double>(ctx.stats.rings));
         out.vertices.push_back(static_cast<double>(ctx.stats.vertices));
         out.bytes.push_back(static_cast<double>(upload_bytes(ctx.draw_list)));
+        out.retained_bytes.push_back(static_cast<double>(retained.bytes));
         double segments = 0.0;
         for (const wire::DrawItem& item : ctx.draw_list.items)
             segments += static_cast<double>(
                 registry.get<wire::systems::WireCurve>(Entity{static_cast<uint32_t>(item.wire_id)})
                     .curve.segment_count());
         out.visible_segments.push_back(segments);
-        if (spec.after_frame) spec.after_frame(ctx, f);
 
         if (!spec.sample_errors ||
             std::find(sample_frames.begin(), sample_frames.end(), f) == sample_frames.end())
@@ -313,15 +321,24 @@ std::vector<std::string> row(const std::string& scene, const std::string& mode, 
             num(error_px)};
 }
 
-// --gl: the real WireRenderer on a headless EGL context (Mesa llvmpipe), drawing every 10th frame of a run to
-// check that the computed upload size equals the renderer's FrameStats::bytes_uploaded. The framebuffer is
-// small: the bytes do not depend on it, and llvmpipe's fill rate would dominate otherwise.
+// --gl: the real WireRenderer on a headless EGL context (Mesa llvmpipe), drawing every frame of `standard` on
+// three paths (cpu-mesh and gpu-rings streamed by one renderer, gpu-rings retained by another): checks that the
+// computed upload size equals FrameStats::bytes_uploaded, and measures per frame the draw() call's wall time
+// (CPU: packing, memcpy, GL calls), the GPU time of the pass (GL_TIME_ELAPSED through engine::gfx::GpuTimer,
+// read back a few frames later) and draw + glFinish wall time. The framebuffer is small: the bytes do not
+// depend on it, and llvmpipe's fill rate would dominate otherwise.
+struct GlPath {
+    std::string name;
+    std::size_t frames = 0, mismatches = 0;
+    std::vector<double> renderer_bytes, computed_bytes, draw_ms, finish_ms, gpu_ms, systems_ms;
+    engine::gfx::GpuTimer timer;
+};
+
 struct GlCheck {
     std::unique_ptr<engine::platform::Context> context;
-    wire::render::WireRenderer renderer;
-    std::size_t frames = 0, mismatches = 0;
-    double renderer_bytes = 0.0, computed_bytes = 0.0;
-    std::vector<double> draw_wall_ms;
+    wire::render::WireRenderer streamed, retained;
+    wire::render::RingResidency model;  // what the retained renderer should send
+    GlPath paths[3];                    // cpu-mesh, gpu-rings, gpu-retained
     std::string error;
 
     bool init() {
@@ -332,31 +349,63 @@ struct GlCheck {
             return false;
         }
         context = std::move(created).value();
-        auto r = wire::render::WireRenderer::create();
-        if (!r) {
-            error = r.error().message;
-            return false;
+        for (bool keep : {false, true}) {
+            auto r = wire::render::WireRenderer::create({.retain_rings = keep});
+            if (!r) {
+                error = r.error().message;
+                return false;
+            }
+            wire::render::WireRenderer& renderer = keep ? retained : streamed;
+            renderer = std::move(r).value();
+            for (int i = 1; i < 4; ++i) renderer.add_material({.tint = {0.3f * i, 0.5f, 1.0f - 0.2f * i}});
         }
-        renderer = std::move(r).value();
-        for (int i = 1; i < 4; ++i) renderer.add_material({.tint = {0.3f * i, 0.5f, 1.0f - 0.2f * i}});
+        const char* names[3] = {"cpu-mesh", "gpu-rings", "gpu-retained"};
+        for (int i = 0; i < 3; ++i) {
+            paths[i].name = names[i];
+            paths[i].timer = engine::gfx::GpuTimer::create();
+        }
         return true;
     }
-    void draw(const wire::systems::WireContext& ctx, int frame, const std::filesystem::path& png) {
-        if (frame % 10 != 0) return;
+    void draw_one(GlPath& path, wire::render::WireRenderer& renderer, const wire::systems::WireContext& ctx,
+                  std::size_t computed, bool measured, const std::filesystem::path& png) {
         context->begin_frame();
         engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
         const double t0 = wall_ms();
+        path.timer.begin();
         const wire::render::FrameStats st = renderer.draw(ctx.draw_list, ctx.camera);
-        (void)engine::platform::read_pixels(
-            *context);  // waits for the frame: llvmpipe's threads stop before timing
-        draw_wall_ms.push_back(wall_ms() - t0);
+        path.timer.end();
+        const double t1 = wall_ms();
+        engine::gfx::finish_gpu();  // llvmpipe's threads finish the frame before the next path is timed
+        const double t2 = wall_ms();
         context->end_frame();
-        const std::size_t computed = upload_bytes(ctx.draw_list);
-        ++frames;
-        mismatches += st.bytes_uploaded != computed;
-        renderer_bytes += static_cast<double>(st.bytes_uploaded);
-        computed_bytes += static_cast<double>(computed);
+        for (const auto& m : path.timer.poll()) path.gpu_ms.push_back(m.frame == 0 ? -1.0 : m.ms);
+        if (!measured) return;
+        ++path.frames;
+        path.mismatches += st.bytes_uploaded != computed;
+        path.renderer_bytes.push_back(static_cast<double>(st.bytes_uploaded));
+        path.computed_bytes.push_back(static_cast<double>(computed));
+        path.draw_ms.push_back(t1 - t0);
+        path.finish_ms.push_back(t2 - t0);
         if (!png.empty()) (void)engine::platform::capture_png(*context, png);
+    }
+    void draw(const wire::systems::WireContext& ctx, int frame, int frames, const std::filesystem::path& dir) {
+        const bool measured = frame > 0;  // frame 0 uploads everything: loading, not a frame
+        const bool last = frame + 1 == frames;
+        if (ctx.draw_list.path == wire::UploadPath::cpu_mesh) {
+            draw_one(paths[0], streamed, ctx, upload_bytes(ctx.draw_list), measured,
+                     last ? dir / "bench_gl_cpu_mesh.png" : std::filesystem::path{});
+            return;
+        }
+        draw_one(paths[1], streamed, ctx, upload_bytes(ctx.draw_list), measured,
+                 last ? dir / "bench_gl_gpu_rings.png" : std::filesystem::path{});
+        const std::size_t planned = wire::render::plan_retained_frame(ctx.draw_list, model).bytes;
+        draw_one(paths[2], retained, ctx, planned, measured,
+                 last ? dir / "bench_gl_gpu_retained.png" : std::filesystem::path{});
+    }
+    void finish() {
+        for (GlPath& p : paths)
+            for (const auto& m : p.timer.finish()) p.gpu_ms.push_back(m.frame == 0 ? -1.0 : m.ms);
+        for (GlPath& p : paths) std::erase_if(p.gpu_ms, [](double v) { return v < 0.0; });  // frame 0
     }
 };
 
@@ -379,6 +428,9 @@ int run_systems_bench(const Options& o) {
     std::string thread_lines;
     GlCheck gl;
     std::string gl_note;
+    std::string scene_bytes;  // per scene: gpu-rings streamed and retained bytes, cpu-mesh bytes, ratios
+    double scene_bytes_cpu = 0.0;
+    double standard_systems_wall_cpu = 0.0, standard_systems_wall_gpu = 0.0;
     if (o.gl && !gl.init())
         gl_note = "- --gl: no headless GL context (" + gl.error + "); bytes are computed only.\n";
     const bool use_gl = o.gl && gl_note.empty();
@@ -401,17 +453,37 @@ int run_systems_bench(const Options& o) {
                          .error_samples = error_samples,
                          .after_frame = {}};
             if (use_gl && kind == SceneKind::standard) {
-                const std::filesystem::path png =
-                    o.out_dir / (cpu ? "bench_gl_cpu_mesh.png" : "bench_gl_gpu_rings.png");
-                spec.after_frame = [&gl, png](const wire::systems::WireContext& c, int f) {
-                    gl.draw(c, f, png);
+                const std::filesystem::path dir = o.out_dir;
+                spec.after_frame = [&gl, dir, scene_frames](const wire::systems::WireContext& c, int f) {
+                    gl.draw(c, f, scene_frames, dir);
                 };
             }
             SceneRun r = run_scene(spec);
             csv.add(row(name, cpu ? "cpu-mesh" : "gpu-rings", wires, median(r.visible), median(r.rings),
                         median(r.vertices), median(r.bytes), median(r.frame_cpu_ms), r.max_error_px));
+            if (!cpu) {
+                // The same frames through the retained ring storage: only changed wires' rings are sent.
+                csv.add(row(name, "gpu-retained", wires, median(r.visible), median(r.rings), median(r.vertices),
+                            median(r.retained_bytes), median(r.frame_cpu_ms), r.max_error_px));
+                scene_bytes += "| " + name + " | " + num(median(r.bytes), 8) + " | " +
+                               num(median(r.retained_bytes), 8) + " |";
+            } else {
+                scene_bytes_cpu = median(r.bytes);
+            }
+            if (kind == SceneKind::standard && use_gl) {
+                (cpu ? standard_systems_wall_cpu : standard_systems_wall_gpu) = median(r.frame_wall_ms);
+            }
             (cpu ? cpu_run : gpu_run) = std::move(r);
         }
+        if (scene_bytes_cpu > 0.0) {
+            std::snprintf(buf, sizeof buf, " %.8g | %.1fx | %.1fx |\n", scene_bytes_cpu,
+                          scene_bytes_cpu / std::max(1.0, median(gpu_run.bytes)),
+                          scene_bytes_cpu / std::max(1.0, median(gpu_run.retained_bytes)));
+            scene_bytes += buf;
+        } else {
+            scene_bytes += " 0 | - | - |\n";
+        }
+        scene_bytes_cpu = 0.0;
         // Uniform baseline at the cpu-mesh run's sampled frames.
         const Uniform u = search_uniform(cpu_run);
         std::vector<double> u_rings, u_vertices, u_bytes, a_vertices;
@@ -533,15 +605,28 @@ int run_systems_bench(const Options& o) {
             md += buf;
         }
     }
+    if (!scene_bytes.empty()) {
+        md += "\n## Bytes uploaded per frame (median)\n\n| scene | gpu-rings streamed | gpu-rings retained | "
+              "cpu-mesh | cpu-mesh / streamed | cpu-mesh / retained |\n| --- | --- | --- | --- | --- | --- |\n" +
+              scene_bytes + "\n(aims: retained >= 20x fewer than cpu-mesh on `standard`, >= 6x on `swaying`)\n";
+    }
     if (use_gl) {
-        std::snprintf(
-            buf, sizeof buf,
-            "- --gl: WireRenderer drew %zu frames of `standard` (both paths) headless; FrameStats::"
-            "bytes_uploaded matched the computed bytes on %zu of them (mean %.0f vs %.0f bytes); median "
-            "draw + finish %.1f ms wall at 480x270 (bench_gl_*.png: the last frame drawn)\n",
-            gl.frames, gl.frames - gl.mismatches, gl.frames ? gl.renderer_bytes / gl.frames : 0.0,
-            gl.frames ? gl.computed_bytes / gl.frames : 0.0, median(gl.draw_wall_ms));
-        gl_note += buf;
+        gl.finish();
+        md += "\n## --gl: WireRenderer on " + gl.context->gl_renderer() +
+              ", `standard`, 480x270, every frame (medians over frames 1..N)\n\n"
+              "| path | frames | bytes matched | bytes/frame (renderer) | systems wall ms | draw() wall ms | "
+              "GPU ms (timer) | draw + glFinish wall ms | end to end ms (systems + draw + finish) |\n"
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+        for (const GlPath& p : gl.paths) {
+            const double systems = &p == &gl.paths[0] ? standard_systems_wall_cpu : standard_systems_wall_gpu;
+            std::snprintf(buf, sizeof buf, "| %s | %zu | %zu | %.0f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+                          p.name.c_str(), p.frames, p.frames - p.mismatches, median(p.renderer_bytes), systems,
+                          median(p.draw_ms), median(p.gpu_ms), median(p.finish_ms), systems + median(p.finish_ms));
+            md += buf;
+        }
+        md += "\nGPU ms: GL_TIME_ELAPSED around the wire pass, read back without stalling (engine::gfx::GpuTimer); "
+              "systems wall ms: the five wire systems (the retained path runs the same systems as gpu-rings). "
+              "bench_gl_*.png: the last frame of each path.\n";
     }
     md += gl_note;
     if (!thread_lines.empty()) {

@@ -122,4 +122,8 @@ uint64_t GpuTimer::rejected() const {
     return state_ ? state_->rejected : 0;
 }
 
+void finish_gpu() {
+    glFinish();
+}
+
 }  // namespace engine::gfx

@@ -81,24 +81,32 @@ void check_bench_csv(const fs::path& dir) {
         "scene,method,mode,tolerance_px,wires,visible_wires,rings,vertices,bytes_uploaded,cpu_ms_per_frame,"
         "ns_per_vertex,max_screen_error_px");
     EXPECT_TRUE(fs::exists(dir / "bench.md"));
-    ASSERT_EQ(csv.rows.size(), 6u) << "2 scenes x {cpu-mesh, gpu-rings, uniform}";
+    ASSERT_EQ(csv.rows.size(), 8u) << "2 scenes x {cpu-mesh, gpu-rings, gpu-retained, uniform}";
     for (const auto& r : csv.rows) {
         for (const std::string& c : csv.columns) {
             if (c == "scene" || c == "method" || c == "mode") continue;
             const double v = number(r, c);
             EXPECT_TRUE(std::isfinite(v) && v >= 0.0) << c << " in " << r.at("scene") << "/" << r.at("mode");
         }
-        EXPECT_TRUE(r.at("mode") == "cpu-mesh" || r.at("mode") == "gpu-rings" || r.at("mode") == "uniform");
+        EXPECT_TRUE(r.at("mode") == "cpu-mesh" || r.at("mode") == "gpu-rings" || r.at("mode") == "gpu-retained" ||
+                    r.at("mode") == "uniform");
         EXPECT_EQ(number(r, "wires"), 1000.0);
     }
     for (const char* scene : {"standard", "offscreen"})
-        for (const char* mode : {"cpu-mesh", "gpu-rings", "uniform"})
+        for (const char* mode : {"cpu-mesh", "gpu-rings", "gpu-retained", "uniform"})
             EXPECT_NE(find(csv.rows, {{"scene", scene}, {"mode", mode}}), nullptr) << scene << " " << mode;
 
     const auto* cpu = find(csv.rows, {{"scene", "standard"}, {"mode", "cpu-mesh"}});
     const auto* gpu = find(csv.rows, {{"scene", "standard"}, {"mode", "gpu-rings"}});
     const auto* uni = find(csv.rows, {{"scene", "standard"}, {"mode", "uniform"}});
-    ASSERT_TRUE(cpu && gpu && uni);
+    const auto* kept = find(csv.rows, {{"scene", "standard"}, {"mode", "gpu-retained"}});
+    ASSERT_TRUE(cpu && gpu && uni && kept);
+    // Retained rings: the camera moves, the wires do not, so a frame sends little more than one draw record and
+    // command per visible wire (the aim: at least 20x fewer bytes than cpu-mesh). Bytes are exact
+    // counts, not timings.
+    EXPECT_LT(number(*kept, "bytes_uploaded"), number(*gpu, "bytes_uploaded"));
+    EXPECT_LE(20.0 * number(*kept, "bytes_uploaded"), number(*cpu, "bytes_uploaded"));
+    EXPECT_EQ(number(*kept, "rings"), number(*gpu, "rings"));
     EXPECT_GT(number(*cpu, "visible_wires"), 0.0);
     // Adaptive: fewer vertices than the uniform tessellation that reaches no better error.
     EXPECT_LT(number(*cpu, "vertices"), number(*uni, "vertices"));
@@ -107,7 +115,7 @@ void check_bench_csv(const fs::path& dir) {
     EXPECT_LT(number(*gpu, "bytes_uploaded"), number(*cpu, "bytes_uploaded"));
     EXPECT_EQ(number(*gpu, "rings"), number(*cpu, "rings")) << "both paths draw the same tessellation";
 
-    for (const char* mode : {"cpu-mesh", "gpu-rings"}) {
+    for (const char* mode : {"cpu-mesh", "gpu-rings", "gpu-retained"}) {
         const auto* off = find(csv.rows, {{"scene", "offscreen"}, {"mode", mode}});
         ASSERT_TRUE(off);
         EXPECT_EQ(number(*off, "visible_wires"), 0.0);

@@ -50,4 +50,7 @@ private:
     std::unique_ptr<State> state_;
 };
 
+/// glFinish: blocks until the GPU has done everything issued so far (benchmarks timing a frame end to end).
+void finish_gpu();
+
 }  // namespace engine::gfx
