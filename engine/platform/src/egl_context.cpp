@@ -1,11 +1,16 @@
-// Headless OpenGL 4.5 core context: EGL on Mesa's surfaceless platform (no display, no GPU needed; llvmpipe
-// renders), drawing into an RGBA8 + depth24 framebuffer object of the requested size.
+// Headless OpenGL 4.5 core context drawing into an RGBA8 + depth24 framebuffer object of the requested size.
+// The EGL display: a hardware EGL device when one exists (EGL_EXT_device_enumeration + EGL_EXT_platform_device:
+// the first device that is not Mesa's software device and gives an OpenGL 4.5 core context), otherwise Mesa's
+// surfaceless platform (no display, no GPU needed; llvmpipe renders). The choice is logged once (unless quiet)
+// and returned by headless_display(). WIRE_EGL_PLATFORM=surfaceless or =device forces one.
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "context_impl.hpp"
 
@@ -55,13 +60,96 @@ struct SharedDisplay {
     std::mutex mutex;
     EGLDisplay display = EGL_NO_DISPLAY;
     int users = 0;
+    std::string chosen;  ///< what headless_display() reports
 };
 SharedDisplay& shared_display() {
     static SharedDisplay d;
     return d;
 }
 
-Expected<EGLDisplay> acquire_display() {
+bool has_extension(const char* list, const char* name) {
+    if (list == nullptr) return false;
+    const std::string all = std::string(" ") + list + " ";
+    return all.find(std::string(" ") + name + " ") != std::string::npos;
+}
+
+using GetPlatformDisplay = EGLDisplay (*)(EGLenum, void*, const EGLint*);
+using QueryDevices = EGLBoolean (*)(EGLint, void**, EGLint*);
+using QueryDeviceString = const char* (*)(void*, EGLint);
+
+/// A display that can make an OpenGL 4.5 core context (checked by making one and destroying it).
+bool can_make_gl45(EGLDisplay display) {
+    if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) return false;
+    const EGLint config_attribs[] = {EGL_SURFACE_TYPE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint count = 0;
+    if (eglChooseConfig(display, config_attribs, &config, 1, &count) != EGL_TRUE || count == 0) return false;
+    const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+                                      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                      EGL_NONE};
+    EGLContext ctx = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attribs);
+    if (ctx == EGL_NO_CONTEXT) return false;
+    eglDestroyContext(display, ctx);
+    return true;
+}
+
+/// The first hardware EGL device that initializes and makes a GL 4.5 context; EGL_NO_DISPLAY if none.
+/// `tried` collects one line per device looked at (for the log and the error message).
+EGLDisplay hardware_device_display(const char* client_ext, GetPlatformDisplay get_platform_display,
+                                   std::string& chosen, std::string& tried) {
+    if (!(has_extension(client_ext, "EGL_EXT_device_enumeration") ||
+          has_extension(client_ext, "EGL_EXT_device_base")) ||
+        !has_extension(client_ext, "EGL_EXT_platform_device")) {
+        tried = "no EGL device enumeration (EGL_EXT_device_enumeration / EGL_EXT_platform_device)";
+        return EGL_NO_DISPLAY;
+    }
+    auto query_devices = reinterpret_cast<QueryDevices>(eglGetProcAddress("eglQueryDevicesEXT"));
+    auto query_string = reinterpret_cast<QueryDeviceString>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+    if (query_devices == nullptr || query_string == nullptr) {
+        tried = "eglQueryDevicesEXT is not available";
+        return EGL_NO_DISPLAY;
+    }
+    EGLint count = 0;
+    if (query_devices(0, nullptr, &count) != EGL_TRUE || count <= 0) {
+        tried = "no EGL devices";
+        return EGL_NO_DISPLAY;
+    }
+    std::vector<void*> devices(static_cast<std::size_t>(count));
+    if (query_devices(count, devices.data(), &count) != EGL_TRUE) {
+        tried = "eglQueryDevicesEXT failed";
+        return EGL_NO_DISPLAY;
+    }
+    for (EGLint i = 0; i < count; ++i) {
+        void* device = devices[static_cast<std::size_t>(i)];
+        const char* ext = query_string(device, EGL_EXTENSIONS);
+        std::string name = "EGL device " + std::to_string(i);
+        if (has_extension(ext, "EGL_EXT_device_drm")) {
+            if (const char* file = query_string(device, EGL_DRM_DEVICE_FILE_EXT))
+                name += " (" + std::string(file) + ")";
+        }
+        if (has_extension(ext, "EGL_MESA_device_software")) {
+            tried += name + ": software, skipped; ";
+            continue;
+        }
+        EGLDisplay display = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
+        EGLint major = 0, minor = 0;
+        if (display == EGL_NO_DISPLAY || eglInitialize(display, &major, &minor) != EGL_TRUE) {
+            tried += name + ": eglInitialize failed; ";
+            continue;
+        }
+        if (!can_make_gl45(display)) {
+            tried += name + ": no OpenGL 4.5 core context; ";
+            eglTerminate(display);
+            continue;
+        }
+        chosen = "hardware " + name;
+        return display;
+    }
+    if (tried.empty()) tried = "no hardware EGL device";
+    return EGL_NO_DISPLAY;
+}
+
+Expected<EGLDisplay> acquire_display(bool quiet) {
     SharedDisplay& shared = shared_display();
     std::lock_guard lock(shared.mutex);
     if (shared.users > 0) {
@@ -70,21 +158,38 @@ Expected<EGLDisplay> acquire_display() {
     }
     // Without any display, epoxy cannot know the EGL version yet: check the client extension string first.
     const char* client_ext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    if (client_ext == nullptr ||
-        std::string(client_ext).find("EGL_MESA_platform_surfaceless") == std::string::npos) {
-        return Error{"EGL: the surfaceless Mesa platform (EGL_MESA_platform_surfaceless) is not available"};
-    }
-    using GetPlatformDisplay = EGLDisplay (*)(EGLenum, void*, const EGLint*);
     auto get_platform_display =
         reinterpret_cast<GetPlatformDisplay>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
     if (get_platform_display == nullptr) return Error{"EGL: eglGetPlatformDisplayEXT is not available"};
-    EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    if (display == EGL_NO_DISPLAY) return egl_failure("no surfaceless display");
-    EGLint major = 0;
-    EGLint minor = 0;
-    if (eglInitialize(display, &major, &minor) != EGL_TRUE) return egl_failure("eglInitialize failed");
+    const char* forced_env = std::getenv("WIRE_EGL_PLATFORM");
+    const std::string forced = forced_env != nullptr ? forced_env : "";
+    if (!forced.empty() && forced != "device" && forced != "surfaceless") {
+        return Error{"EGL: WIRE_EGL_PLATFORM must be 'device' or 'surfaceless', got '" + forced + "'"};
+    }
+
+    std::string chosen, tried;
+    EGLDisplay display = EGL_NO_DISPLAY;
+    if (forced != "surfaceless") display = hardware_device_display(client_ext, get_platform_display, chosen, tried);
+    if (display == EGL_NO_DISPLAY && forced == "device") {
+        return Error{"EGL: WIRE_EGL_PLATFORM=device but no hardware EGL device works (" + tried + ")"};
+    }
+    if (display == EGL_NO_DISPLAY) {
+        if (!has_extension(client_ext, "EGL_MESA_platform_surfaceless")) {
+            return Error{"EGL: no hardware EGL device (" + tried +
+                         ") and the surfaceless Mesa platform (EGL_MESA_platform_surfaceless) is not available"};
+        }
+        display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        if (display == EGL_NO_DISPLAY) return egl_failure("no surfaceless display");
+        EGLint major = 0;
+        EGLint minor = 0;
+        if (eglInitialize(display, &major, &minor) != EGL_TRUE) return egl_failure("eglInitialize failed");
+        chosen = forced == "surfaceless" ? "Mesa surfaceless (forced by WIRE_EGL_PLATFORM)"
+                                         : "Mesa surfaceless (" + tried + ")";
+    }
+    if (!quiet) std::fprintf(stderr, "headless EGL: %s\n", chosen.c_str());
     shared.display = display;
     shared.users = 1;
+    shared.chosen = chosen;
     return display;
 }
 
@@ -181,9 +286,15 @@ private:
 
 }  // namespace
 
+std::string headless_display() {
+    SharedDisplay& shared = shared_display();
+    std::lock_guard lock(shared.mutex);
+    return shared.chosen;
+}
+
 Expected<std::unique_ptr<Context>> create_headless_context(const ContextDesc& desc_in) {
     const ContextDesc desc = with_defaults(desc_in);
-    Expected<EGLDisplay> display = acquire_display();
+    Expected<EGLDisplay> display = acquire_display(desc.quiet);
     if (!display) return display.error();
     EGLDisplay dpy = *display;
 

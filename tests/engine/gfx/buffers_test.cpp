@@ -204,33 +204,46 @@ TEST_F(GlBuffersTest, StreamBufferRegionsRotateAndGrow) {
     EXPECT_FALSE(glIsBuffer(sb.allocated_buffers().front()));
 }
 
-// Timer results come back a few frames later through poll(), never blocking; a pass that does more work takes
-// longer; finish() drains the rest.
+// Timer results come back through poll() once the GPU is done, in order, never blocking: with the GPU kept
+// idle between frames (glFinish) every frame's result is available at the next poll and none is skipped; a pass
+// doing more work takes longer; without waiting, frames whose queries are all pending are skipped, not waited
+// for, and every begin() is accounted for.
 TEST_F(GlBuffersTest, GpuTimerMeasuresWithoutStalling) {
     gfx::GpuTimer timer = gfx::GpuTimer::create(4);
     std::vector<gfx::GpuTimer::Measurement> got;
     for (int frame = 0; frame < 12; ++frame) {
         timer.begin();
         glClearColor(0.1f * static_cast<float>(frame % 3), 0.2f, 0.3f, 1.0f);
-        for (int i = 0; i < 1 + frame; ++i) glClear(GL_COLOR_BUFFER_BIT);
+        for (int i = 0; i < 1 + 4 * frame; ++i) glClear(GL_COLOR_BUFFER_BIT);
         timer.end();
-        glFlush();  // what a frame's end does: the driver starts the work
+        gfx::finish_gpu();
         for (const auto& m : timer.poll()) got.push_back(m);
     }
-    for (const auto& m : timer.finish()) got.push_back(m);
-    EXPECT_EQ(got.size() + timer.skipped() + timer.rejected(), 12u);
-    EXPECT_GE(got.size(), 6u);
-    std::printf("%zu measured, %llu skipped (all queries pending), %llu rejected\n", got.size(),
-                static_cast<unsigned long long>(timer.skipped()), static_cast<unsigned long long>(timer.rejected()));
+    EXPECT_EQ(timer.skipped(), 0u);
+    EXPECT_EQ(got.size() + timer.rejected(), 12u);
+    EXPECT_LE(timer.rejected(), 1u) << "only a query begun before any scene (llvmpipe) is impossible";
+    std::printf("%zu measured, %llu rejected:", got.size(), static_cast<unsigned long long>(timer.rejected()));
     for (std::size_t i = 0; i < got.size(); ++i) {
-        std::printf("frame %llu: %.4f ms\n", static_cast<unsigned long long>(got[i].frame), got[i].ms);
+        std::printf(" %.4f", got[i].ms);
         EXPECT_GE(got[i].ms, 0.0);
-        EXPECT_LT(got[i].ms, 10000.0);
         if (i > 0) EXPECT_GT(got[i].frame, got[i - 1].frame) << "results in order";
     }
-    EXPECT_GT(got.back().ms, got.front().ms) << "12 clears take longer than 2";
+    std::printf(" ms\n");
+    ASSERT_GE(got.size(), 2u);
+    EXPECT_GT(got.back().ms, got.front().ms) << "45 clears take longer than 5";
     ASSERT_TRUE(timer.latest().has_value());
     EXPECT_EQ(timer.latest()->frame, got.back().frame);
+
+    gfx::GpuTimer busy = gfx::GpuTimer::create(2);
+    std::size_t measured = 0;
+    for (int frame = 0; frame < 50; ++frame) {
+        busy.begin();
+        glClear(GL_COLOR_BUFFER_BIT);
+        busy.end();
+        measured += busy.poll().size();
+    }
+    measured += busy.finish().size();
+    EXPECT_EQ(measured + busy.skipped() + busy.rejected(), 50u);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

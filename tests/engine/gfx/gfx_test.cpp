@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -61,6 +63,34 @@ TEST_F(GfxTest, HeadlessContextIsGl45Core) {
     EXPECT_EQ(context->framebuffer_size().width, 64);
     EXPECT_EQ(context->framebuffer_size().height, 48);
     EXPECT_NE(context->framebuffer(), 0u);
+}
+
+// The headless backend says which EGL display it chose: a hardware EGL device when there is one, Mesa
+// surfaceless otherwise (these machines: no hardware device, llvmpipe).
+TEST_F(GfxTest, HeadlessDisplayChoiceIsReported) {
+    const std::string chosen = platform::headless_display();
+    std::printf("headless display: %s; GL renderer: %s\n", chosen.c_str(), context->gl_renderer().c_str());
+    const bool hardware = chosen.rfind("hardware EGL device", 0) == 0;
+    const bool surfaceless = chosen.rfind("Mesa surfaceless", 0) == 0;
+    EXPECT_TRUE(hardware || surfaceless) << chosen;
+    if (hardware) EXPECT_EQ(context->gl_renderer().find("llvmpipe"), std::string::npos);
+}
+
+// WIRE_EGL_PLATFORM forces the choice; a bad value is an error naming it. The display is chosen when the first
+// context of a process is made, so this runs with no other context alive.
+TEST(HeadlessDisplayTest, ChoiceCanBeForced) {
+    ::setenv("WIRE_EGL_PLATFORM", "bogus", 1);
+    auto bad = platform::create_headless_context({.width = 8, .height = 8, .quiet = true});
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().message.find("WIRE_EGL_PLATFORM"), std::string::npos) << bad.error().message;
+    ::setenv("WIRE_EGL_PLATFORM", "surfaceless", 1);
+    {
+        auto ctx = platform::create_headless_context({.width = 8, .height = 8, .quiet = true});
+        ::unsetenv("WIRE_EGL_PLATFORM");
+        ASSERT_TRUE(ctx.ok()) << ctx.error().message;
+        EXPECT_NE(platform::headless_display().find("forced"), std::string::npos) << platform::headless_display();
+    }
+    ::unsetenv("WIRE_EGL_PLATFORM");
 }
 
 TEST_F(GfxTest, BrokenVertexShaderReturnsDriverLog) {
