@@ -7,6 +7,7 @@
 #include <engine/assets/gltf.hpp>
 #include <engine/assets/subdivide.hpp>
 #include <engine/ecs/registry.hpp>
+#include <engine/gfx/gpu_timer.hpp>
 #include <engine/gfx/lit_renderer.hpp>
 #include <engine/scene/frustum.hpp>
 #include <wire/render/wire_renderer.hpp>
@@ -21,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #ifndef TUNNEL_ASSET_DIR
@@ -131,6 +133,8 @@ struct Level::State {
     double flight_z_m = 0.0;  // simulated rope time since frame 0 (drives the gusts)
     wire::render::FrameStats wire_stats{};
     std::vector<float> bucket;
+    engine::gfx::GpuTimer pieces_timer, wires_timer;  // GPU ms per pass, read back a few frames later
+    std::map<uint64_t, std::pair<double, double>> gpu_results;  // frame -> (pieces, wires) ms, -1 = not yet
 };
 
 Level::Level() : state_(std::make_unique<State>()) {}
@@ -266,6 +270,8 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
     auto renderer = wire::render::WireRenderer::create();
     if (!renderer) return renderer.error();
     s.wires = std::move(renderer).value();
+    s.pieces_timer = engine::gfx::GpuTimer::create();
+    s.wires_timer = engine::gfx::GpuTimer::create();
     s.wires.add_material({.tint = {0.16f, 0.16f, 0.17f}});  // rubber
     s.wires.add_material({.tint = {1.00f, 0.45f, 0.12f}});  // orange
     s.wires.add_material({.tint = {0.95f, 0.80f, 0.15f}});  // yellow
@@ -480,8 +486,20 @@ void Level::update_cables() {
     }
 }
 
+namespace {
+/// GPU time of one pass: begin() now, end() when the scope closes (early returns included).
+struct GpuPass {
+    engine::gfx::GpuTimer& timer;
+    explicit GpuPass(engine::gfx::GpuTimer& t) : timer(t) { timer.begin(); }
+    ~GpuPass() { timer.end(); }
+    GpuPass(const GpuPass&) = delete;
+    GpuPass& operator=(const GpuPass&) = delete;
+};
+}  // namespace
+
 void Level::draw_pieces() {
     State& s = *state_;
+    const GpuPass gpu_pass(s.pieces_timer);
     engine::gfx::clear({0.02f, 0.025f, 0.035f, 1.0f});
     stats_.piece_levels.fill(0);
     stats_.piece_triangles = 0;
@@ -556,13 +574,28 @@ void Level::draw_pieces() {
 
 void Level::draw_wires() {
     State& s = *state_;
-    s.wire_stats = {};
-    if (options_.draw_wires) {
-        wire::render::FrameSettings settings;
-        settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
-        settings.wireframe = options_.wireframe;
-        s.wire_stats = s.wires.draw(s.context.draw_list, camera_, settings);
+    {
+        const GpuPass gpu_pass(s.wires_timer);
+        s.wire_stats = {};
+        if (options_.draw_wires) {
+            wire::render::FrameSettings settings;
+            settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
+            settings.wireframe = options_.wireframe;
+            s.wire_stats = s.wires.draw(s.context.draw_list, camera_, settings);
+        }
     }
+    // GPU ms of both passes: the newest frame whose two results are available, never waited for.
+    for (const auto& m : s.pieces_timer.poll()) s.gpu_results.try_emplace(m.frame, -1.0, -1.0).first->second.first = m.ms;
+    for (const auto& m : s.wires_timer.poll()) s.gpu_results.try_emplace(m.frame, -1.0, -1.0).first->second.second = m.ms;
+    for (auto it = s.gpu_results.rbegin(); it != s.gpu_results.rend(); ++it) {
+        if (it->second.first < 0.0 || it->second.second < 0.0) continue;
+        stats_.gpu_ms_frame = static_cast<int64_t>(it->first);
+        stats_.pieces_gpu_ms = it->second.first;
+        stats_.wires_gpu_ms = it->second.second;
+        s.gpu_results.erase(s.gpu_results.begin(), it.base());  // this frame and older
+        break;
+    }
+    while (s.gpu_results.size() > 16) s.gpu_results.erase(s.gpu_results.begin());  // rejected results
     const wire::systems::FrameStats& ws = s.context.stats;
     stats_.wires = ws.wires;
     stats_.curves_built = ws.curves_built;

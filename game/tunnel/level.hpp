@@ -88,6 +88,11 @@ struct LevelFrameStats {
     std::array<int, 8> piece_levels{};  ///< pieces per subdivision level (wall)
     std::size_t curves_built = 0;
     std::size_t rings = 0;
+    /// GPU ms of the tunnel and wire passes (GL_TIME_ELAPSED, engine::gfx::GpuTimer): the newest results read
+    /// back without stalling, measured in frame gpu_ms_frame (a few frames ago; -1 and 0 ms before the first).
+    double pieces_gpu_ms = 0.0;
+    double wires_gpu_ms = 0.0;
+    int64_t gpu_ms_frame = -1;
 };
 
 /// A cable of the level, for tests and the debug panel.

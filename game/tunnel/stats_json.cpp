@@ -19,6 +19,8 @@ nlohmann::json frame_record(const LevelFrameStats& s, std::span<const engine::ec
     return {{"frame", s.frame},
             {"time_s", finite(s.time_s)},
             {"systems_ms", systems_ms},
+            {"gpu_ms", {{"tunnel.pieces", finite(s.pieces_gpu_ms)}, {"wire.render", finite(s.wires_gpu_ms)},
+                        {"frame", s.gpu_ms_frame}}},
             {"wires", s.wires},
             {"wires_drawn", s.wires_drawn},
             {"wire_vertices", s.wire_vertices},

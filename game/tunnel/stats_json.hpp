@@ -1,6 +1,8 @@
 // stats.json of `tunnel --headless`: one record per frame (per-system milliseconds from the ECS schedule,
 // wires drawn, vertices, bytes uploaded, rope node changes, subdivision levels) plus the run's summary.
 //   {"frames": [{"frame": 0, "time_s": 0.033, "systems_ms": {"tunnel.animate": 0.02, ...},
+//                "gpu_ms": {"tunnel.pieces": ms, "wire.render": ms, "frame": f},  (GPU timer queries of frame f,
+//                          a few frames back: read without stalling; f = -1 and 0 ms before the first result)
 //                "wires": 43, "wires_drawn": 38, "wire_vertices": 51234, "wire_triangles": ...,
 //                "piece_triangles": ..., "piece_vertices": ..., "bytes_uploaded": ..., "wire_bytes_uploaded":
 //                ..., "segment_bytes_uploaded": ..., "rope_nodes": ..., "nodes_inserted": 1, "nodes_removed":
