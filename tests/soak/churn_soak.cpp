@@ -70,7 +70,8 @@ void usage(std::FILE* out) {
                  "path switches every M frames (default 250); RSS and GL names are sampled every K frames\n"
                  "(default 10) into FILE: frame,rss_kb,gl_buffers,live_wires,vertices,bytes_uploaded.\n"
                  "Wires: MIN..MAX live (default 20 60) of 8..N nodes (default 40), LOD tolerance T px (default 0.5).\n"
-                 "The renderer's stream-buffer regions start at R KiB (default 64), so they grow during the run.\n"
+                 "The renderer's stream-buffer regions and its retained ring storage start at R KiB (default 64), so\n"
+                 "they grow during the run.\n"
                  "Exit status: 0 all checks held, 1 a check failed, 2 usage.\n");
 }
 
@@ -475,7 +476,9 @@ Sample Soak::sample(const wire::render::FrameStats& fs) {
              gl.textures, baseline_.textures, gl.vertex_arrays, baseline_.vertex_arrays, gl.programs,
              baseline_.programs, gl.shaders, baseline_.shaders, gl.framebuffers, baseline_.framebuffers);
     // Every live GL buffer is either one the renderer made before the soak, or a stream buffer still alive.
-    const int allowed = baseline_.buffers + static_cast<int>(renderer_->live_stream_buffers()) - 1;
+    // (The retained ring storage likewise: its current buffer plus retired ones waiting for fences.)
+    const int allowed = baseline_.buffers + static_cast<int>(renderer_->live_stream_buffers()) - 1 +
+                        static_cast<int>(renderer_->live_ring_buffers()) - 1;
     if (gl.buffers > allowed)
         fail("%d GL buffers live, at most %d expected (%d at start, %zu live stream buffers): a buffer leaks",
              gl.buffers, allowed, baseline_.buffers, renderer_->live_stream_buffers());
@@ -517,7 +520,9 @@ int Soak::run() {
         // Anisotropic filtering is most of llvmpipe's cost when a wire passes close to the camera; the soak is
         // not about texture quality.
         auto made = wire::render::WireRenderer::create(
-            {.region_bytes = static_cast<std::size_t>(opt_.region_kib) * 1024, .max_anisotropy = 1.0f});
+            {.region_bytes = static_cast<std::size_t>(opt_.region_kib) * 1024,
+             .max_anisotropy = 1.0f,
+             .ring_storage_bytes = static_cast<std::size_t>(opt_.region_kib) * 1024});  // grows too
         if (!made.ok()) {
             std::fprintf(stderr, "churn_soak: WireRenderer::create: %s\n", made.error().message.c_str());
             return 1;
@@ -628,6 +633,10 @@ int Soak::run() {
     for (const Sample& s : curve) gl_max = std::max(gl_max, s.gl_buffers);
     std::printf("gl buffers: %d at the start, at most %d; at most %zu live stream buffers, %zu allocated\n",
                 baseline_.buffers, gl_max, max_live_stream_, renderer_->allocated_stream_buffers().size());
+    std::printf("ring storage (gpu-rings retained): %zu bytes capacity, %zu live, %zu wires resident, %zu "
+                "buffers allocated\n",
+                renderer_->ring_storage_capacity(), renderer_->ring_storage_live_bytes(),
+                renderer_->resident_wires(), renderer_->allocated_ring_buffers().size());
     for (const engine::ecs::SystemStats& st : schedule_.stats())
         std::printf("  %-15s mean %.3f ms\n", st.name.c_str(), st.mean_ms);
     std::printf("  %-15s mean %.3f ms\n", "checks", check_s_ * 1e3 / static_cast<double>(opt_.frames));
