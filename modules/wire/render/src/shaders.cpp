@@ -49,7 +49,10 @@ constexpr std::string_view kRingsMain = R"(
 // Packed ring records (wire::render::PackedRing, 7 words): centre xyz, radius, u (floats), frame quaternion in
 // smallest-three form (2-bit index of the largest component, three 20-bit components).
 layout(std430, binding = 1) readonly buffer Rings { uint ring_words[]; };
-const float kTwoPi = 6.28318530717958647692;
+// cos and sin of 2 pi j / n for n = 3, 4, ... (n + 1 entries each, the last repeating j = 0), computed as
+// wire::write_tube's side table (double, then float): the two paths place rim vertices identically.
+layout(std430, binding = 2) readonly buffer Circle { vec2 circle[]; };
+vec2 circle_at(uint n, uint j) { return circle[n * (n + 1u) / 2u - 6u + j]; }
 const uint kCapVertexBase = 1073741824u;  // 1 << 30: vertex ids of the two caps (kCapVertexBase in upload_plan.hpp)
 
 struct Ring { vec3 centre_m; float radius_m; float u; vec3 normal; vec3 binormal; vec3 tangent; };
@@ -111,8 +114,8 @@ void main() {
     uint i = row == d.ring_count ? 0u : row;  // a closed wire's last row repeats ring 0 ...
     Ring r = load_ring(d, i);
     float u = row == d.ring_count ? d.u_close : r.u;  // ... with u = u_close
-    float phi = kTwoPi * float(s == n ? 0u : s) / float(n);
-    float cp = cos(phi), sp = sin(phi);
+    vec2 cs = circle_at(n, s);
+    float cp = cs.x, sp = cs.y;
     float slope = slope_at(d, i, r);
     float a = 1.0 / sqrt(1.0 + slope * slope);
     vec3 tb = (slope * a) * r.tangent;
@@ -130,8 +133,8 @@ void main() {
       pos = r.centre_m;
       uv = vec2(0.5);
     } else {
-      float phi = kTwoPi * float(c - 1u) / float(n);
-      float cp = cos(phi), sp = sin(phi);
+      vec2 cs = circle_at(n, c - 1u);
+      float cp = cs.x, sp = cs.y;
       pos = r.centre_m + (cp * (r.radius_m * r.normal) + sp * (r.radius_m * r.binormal));
       uv = vec2(0.5) + 0.5 * vec2(cp, sp);
     }

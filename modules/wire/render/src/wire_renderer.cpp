@@ -18,7 +18,9 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <cstring>
+#include <numbers>
 #include <numeric>
 
 namespace wire::render {
@@ -81,6 +83,7 @@ struct WireRenderer::State {
     gfx::RetainedBuffer ring_storage;  ///< retained packed rings (gpu-rings, retain_rings)
     RingResidency residency{180};
     gfx::Buffer pattern;                 ///< static index patterns of the ring expansion, one per side count
+    gfx::Buffer circle;                  ///< cos, sin of 2 pi j / n per side count n (the shader's circle[])
     std::vector<uint32_t> pattern_first; ///< first index of side count n's pattern (index n)
     uint32_t pattern_max_sides = 0;
     std::vector<gfx::Texture> textures;
@@ -102,6 +105,18 @@ struct WireRenderer::State {
         }
         Expected<gfx::Buffer> made = gfx::make_buffer(std::span<const uint32_t>(indices), "wire ring pattern");
         if (!made) return made.error();
+        // Side table as wire::write_tube computes it: entry (n, j) at n (n + 1) / 2 - 6 + j.
+        std::vector<float> table;
+        for (uint32_t n = 3; n <= top; ++n) {
+            for (uint32_t j = 0; j <= n; ++j) {
+                const double phi = 2.0 * std::numbers::pi * (j == n ? 0 : j) / n;
+                table.push_back(static_cast<float>(std::cos(phi)));
+                table.push_back(static_cast<float>(std::sin(phi)));
+            }
+        }
+        Expected<gfx::Buffer> circle_made = gfx::make_buffer(std::span<const float>(table), "wire ring circle");
+        if (!circle_made) return circle_made.error();
+        circle = std::move(circle_made).value();
         pattern = std::move(made).value();  // draws in flight keep the old one alive (GL deletes it later)
         pattern_first = std::move(first);
         pattern_max_sides = top;
@@ -487,6 +502,7 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
                               static_cast<GLintptr>(region.offset_bytes + geometry_offset),
                               static_cast<GLsizeiptr>(std::max<std::size_t>(geometry_bytes, 4)));
         }
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.circle.id());
         s.rings_vao.bind();  // its element buffer is the pattern
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, buffer);
