@@ -99,6 +99,16 @@ float slope_at(DrawData d, uint i, Ring ri) {
   return ds > 0.0 ? dr / ds : 0.0;
 }
 
+// vid / m for m >= 4 without an integer division (software rasterizers run vector integer division one lane
+// at a time): the float quotient is within 1 of the true one for vid < 2^24, then corrected exactly.
+uint div_row(uint vid, uint m) {
+  int q = int(float(vid) / float(m));
+  int r = int(vid) - q * int(m);
+  if (r < 0) q -= 1;
+  else if (r >= int(m)) q += 1;
+  return uint(q);
+}
+
 // Indexed: gl_VertexID is row * (n + 1) + s for the tube (row = ring, or ring_count for a closed wire's
 // repeat of ring 0), kCapVertexBase + cap * (n + 1) + k for the caps (k = 0 centre, 1 + j rim vertex j).
 void main() {
@@ -109,7 +119,7 @@ void main() {
   vec3 nrm;
   vec2 uv;
   if (vid < kCapVertexBase) {
-    uint row = vid / (n + 1u);
+    uint row = div_row(vid, n + 1u);
     uint s = vid - row * (n + 1u);
     uint i = row == d.ring_count ? 0u : row;  // a closed wire's last row repeats ring 0 ...
     Ring r = load_ring(d, i);
@@ -125,7 +135,7 @@ void main() {
   } else {
     // Caps: start cap faces -t, end cap +t; the index pattern orders the triangles (centre, rim, rim).
     uint k = vid - kCapVertexBase;
-    uint cap = k / (n + 1u);
+    uint cap = k >= n + 1u ? 1u : 0u;
     uint c = k - cap * (n + 1u);
     Ring r = load_ring(d, cap == 0u ? 0u : d.ring_count - 1u);
     nrm = (cap == 0u ? -1.0 : 1.0) * r.tangent;
