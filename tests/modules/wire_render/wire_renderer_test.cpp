@@ -782,6 +782,32 @@ TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
     EXPECT_EQ(retained.live_ring_buffers(), 1u);
 }
 
+// Turning the camera away and back: wires culled for fewer than retain_frames frames come back without
+// uploading a ring; culled for longer, they were evicted and upload again. Only draw records and commands move.
+TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer renderer = make_renderer({.retain_frames = 5});
+    const Scene scene = test_scene();
+    const DrawList all = scene.list(UploadPath::gpu_rings);
+    const DrawList none{.path = UploadPath::gpu_rings, .items = {}};
+    FrameStats stats;
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, all.items.size());
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, 0u);
+    EXPECT_EQ(stats.bytes_uploaded, all.items.size() * wire::render::kDrawRecordBytes +
+                                        stats.indirect_commands * wire::render::kCommandBytes);
+    for (int f = 0; f < 5; ++f) render(*ctx, renderer, none, scene_camera());
+    EXPECT_EQ(renderer.resident_wires(), all.items.size());
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, 0u) << "culled for 5 frames: still resident";
+    for (int f = 0; f < 6; ++f) render(*ctx, renderer, none, scene_camera(), {}, &stats);
+    EXPECT_EQ(renderer.resident_wires(), 0u);
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, all.items.size()) << "culled for 6 frames: evicted";
+}
+
 // A small ring storage grows while wires are added: each image equals a roomy renderer's, old buffers are
 // deleted once their fences pass, at most a few live at once.
 TEST(WireRendererTest, RetainedRingStorageGrowsWithoutLeaks) {
