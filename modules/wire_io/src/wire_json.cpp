@@ -1,6 +1,7 @@
 // Wire JSON reader: nlohmann::json parsing plus form checks with specific, located messages.
 #include <wire/io/wire_json.hpp>
 
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cerrno>
@@ -207,6 +208,43 @@ FrameSpec parse_wire_list(const json& j, Where at) {
     return f;
 }
 
+CameraSpec parse_camera(const json& j, Where at) {
+    if (!j.is_object())
+        at.fail("\"camera\" must be an object {\"eye\", \"target\", \"up\", \"fov_deg\"}, got " +
+                std::string(type_name(j)));
+    check_keys(j, {"eye", "target", "up", "fov_deg"}, at, "camera");
+    auto vec = [&](const char* key) {
+        const json& v = j[key];
+        if (!v.is_array() || v.size() != 3)
+            at.fail(std::string("camera ") + key + " must be an array [x, y, z]");
+        glm::dvec3 p;
+        static const char* axis[3] = {"x", "y", "z"};
+        for (int k = 0; k < 3; ++k) p[k] = finite_number(v[k], at, std::string("camera ") + key + " " + axis[k]);
+        return p;
+    };
+    CameraSpec c;
+    for (const char* key : {"eye", "target"})
+        if (!j.contains(key)) at.fail(std::string("camera lacks \"") + key + "\"");
+    c.eye_m = vec("eye");
+    c.target_m = vec("target");
+    const glm::dvec3 view = c.target_m - c.eye_m;
+    if (!(glm::length(view) > 0.0)) at.fail("camera eye and target must differ");
+    if (j.contains("up")) {
+        const glm::dvec3 up = vec("up");
+        // Compared as unit vectors, so the check does not overflow for huge coordinates.
+        if (!(glm::length(up) > 0.0) ||
+            !(glm::length(glm::cross(glm::normalize(view), glm::normalize(up))) > 1e-6))
+            at.fail("camera up must be non-zero and not parallel to target - eye");
+        c.up = up;
+    }
+    if (j.contains("fov_deg")) {
+        const double fov = finite_number(j["fov_deg"], at, "camera fov_deg");
+        if (!(fov > 0.0 && fov < 180.0)) at.fail("camera fov_deg must be in (0, 180), got " + number(fov));
+        c.fov_deg = fov;
+    }
+    return c;
+}
+
 }  // namespace
 
 Status parse_wire_json(std::string_view text, const std::string& source, SceneSpec& out) {
@@ -230,8 +268,9 @@ Status parse_wire_json(std::string_view text, const std::string& source, SceneSp
                 f_at.frame = static_cast<int>(k);
                 if (!frames[k].is_object() || !frames[k].contains("wires"))
                     f_at.fail("a frame must be an object {\"wires\": [...]}");
-                check_keys(frames[k], {"wires"}, f_at, "a frame");
+                check_keys(frames[k], {"wires", "camera"}, f_at, "a frame");
                 out.frames.push_back(parse_wire_list(frames[k]["wires"], f_at));
+                if (frames[k].contains("camera")) out.frames.back().camera = parse_camera(frames[k]["camera"], f_at);
                 if (k > 0 && out.frames[k].wires.size() != out.frames[0].wires.size())
                     f_at.fail("has " + std::to_string(out.frames[k].wires.size()) + " wires but frame 0 has " +
                               std::to_string(out.frames[0].wires.size()) + " (wires are matched by position)");

@@ -87,3 +87,40 @@ TEST(WireJson, MissingFileIsNamed) {
     EXPECT_FALSE(st.ok);
     EXPECT_NE(st.message.find("/no/such/cable.json: cannot open"), std::string::npos) << st.message;
 }
+
+TEST(WireJson, FrameCameraIsReadAndChecked) {
+    const SceneSpec f = parse_ok(R"({"frames": [
+        {"wires": [{"nodes": [[0,0,0],[1,0,0]]}], "camera": {"eye": [0,1,5], "target": [0,0,0]}},
+        {"wires": [{"nodes": [[0,0,0],[1,0,0]]}]},
+        {"wires": [{"nodes": [[0,0,0],[1,0,0]]}], "camera": {"eye": [0,9,0], "target": [0,0,0], "up": [0,0,-1],
+                                                               "fov_deg": 45}}]})");
+    ASSERT_EQ(f.frames.size(), 3u);
+    ASSERT_TRUE(f.frames[0].camera.has_value());
+    EXPECT_EQ(f.frames[0].camera->eye_m, glm::dvec3(0, 1, 5));
+    EXPECT_FALSE(f.frames[0].camera->up.has_value());
+    EXPECT_FALSE(f.frames[0].camera->fov_deg.has_value());
+    EXPECT_FALSE(f.frames[1].camera.has_value());
+    EXPECT_EQ(*f.frames[2].camera->up, glm::dvec3(0, 0, -1));
+    EXPECT_EQ(*f.frames[2].camera->fov_deg, 45.0);
+
+    const std::string wires = R"("wires": [{"nodes": [[0,0,0],[1,0,0]]}])";
+    auto with_camera = [&](const std::string& camera) {
+        return R"({"frames": [{)" + wires + R"(}, {)" + wires + R"(, "camera": )" + camera + "}]}";
+    };
+    EXPECT_EQ(parse_error(with_camera(R"({"eye": [0,0,5], "target": [0,0,0], "fov": 40})")),
+              "in.json: frame 1: unknown key 'fov' in camera");
+    EXPECT_EQ(parse_error(with_camera(R"({"eye": [0,0,5]})")), "in.json: frame 1: camera lacks \"target\"");
+    EXPECT_EQ(parse_error(with_camera(R"({"eye": [1,2,3], "target": [1,2,3]})")),
+              "in.json: frame 1: camera eye and target must differ");
+    EXPECT_EQ(parse_error(with_camera(R"({"eye": [0,5,0], "target": [0,0,0], "up": [0,1,0]})")),
+              "in.json: frame 1: camera up must be non-zero and not parallel to target - eye");
+    EXPECT_EQ(parse_error(with_camera(R"({"eye": [0,0,5], "target": [0,0,0], "fov_deg": 180})")),
+              "in.json: frame 1: camera fov_deg must be in (0, 180), got 180");
+    EXPECT_EQ(parse_error(with_camera(R"({"eye": [0,"a",5], "target": [0,0,0]})")),
+              "in.json: frame 1: camera eye y must be a number, got string");
+    EXPECT_EQ(parse_error(with_camera(R"([0,0,5])")),
+              "in.json: frame 1: \"camera\" must be an object {\"eye\", \"target\", \"up\", \"fov_deg\"}, got array");
+    // Only frames carry a camera.
+    EXPECT_EQ(parse_error(R"({)" + wires + R"(, "camera": {"eye": [0,0,5], "target": [0,0,0]}})"),
+              "in.json: unknown key 'camera' in the top level");
+}

@@ -39,8 +39,19 @@ struct WireSpec {
     std::optional<int> sides;
 };
 
+/// A frame's camera ({"eye", "target", "up", "fov_deg"}): read by `wiretool view` (other readers ignore it).
+/// The reader checks the form: finite numbers, eye != target, up not parallel to the view direction, fov in
+/// (0, 180) degrees.
+struct CameraSpec {
+    glm::dvec3 eye_m{};
+    glm::dvec3 target_m{};
+    std::optional<glm::dvec3> up;
+    std::optional<double> fov_deg;  ///< vertical field of view
+};
+
 struct FrameSpec {
     std::vector<WireSpec> wires;
+    std::optional<CameraSpec> camera;  ///< only in the {"frames": [...]} form
 };
 
 /// A parsed file: always one or more frames (a single wire or a wire list is one frame).
