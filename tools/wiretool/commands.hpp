@@ -20,5 +20,6 @@ using Action = std::function<int()>;
 Action add_mesh_command(CLI::App& app);
 Action add_bend_command(CLI::App& app);
 Action add_bench_command(CLI::App& app);
+Action add_view_command(CLI::App& app);
 
 }  // namespace wiretool

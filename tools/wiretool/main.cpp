@@ -1,11 +1,11 @@
-// wiretool: the command-line front end of the wire runtime (mesh, bend, bench).
+// wiretool: the command-line front end of the wire runtime (mesh, bend, bench, view).
 #include "commands.hpp"
 
 #include <cstdio>
 #include <vector>
 
 int main(int argc, char** argv) {
-    CLI::App app{"wiretool: wire meshes, bent environment meshes and benchmarks from the command line.\n"
+    CLI::App app{"wiretool: wire meshes, bent environment meshes, benchmarks and the runtime's view of a wire file from the command line.\n"
                  "Exit status: 0 success, 1 an output could not be written, 2 bad input or usage."};
     app.require_subcommand(1);
     std::vector<std::pair<CLI::App*, wiretool::Action>> commands;
@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     add(wiretool::add_mesh_command);
     add(wiretool::add_bend_command);
     add(wiretool::add_bench_command);
+    add(wiretool::add_view_command);
 
     try {
         app.parse(argc, argv);

@@ -1,5 +1,6 @@
 // `wiretool mesh`: wire JSON -> tube meshes (binary glTF) and ring records (CSV). A contract: see README.
 #include "commands.hpp"
+#include "ring_csv.hpp"
 
 #include <engine/assets/gltf.hpp>
 #include <wire/io/wire_json.hpp>
@@ -39,20 +40,6 @@ struct Output {
     std::size_t vertices = 0;
 };
 
-void append_csv(std::string& csv, std::size_t frame, std::size_t wire_index, const wire::RingSet& r) {
-    char line[640];
-    for (std::size_t i = 0; i < r.params.size(); ++i) {
-        const glm::dvec3 c = r.origin_m + r.centre_m[i];
-        const wire::Frame& f = r.frames[i];
-        const int n = std::snprintf(
-            line, sizeof line,
-            "%zu,%zu,%zu,%u,%.17g,%.17g,%.17g,%.17g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.17g\n", frame,
-            wire_index, i, r.params[i].segment, r.params[i].t, c.x, c.y, c.z, f.t.x, f.t.y, f.t.z, f.r.x, f.r.y,
-            f.r.z, f.s.x, f.s.y, f.s.z, double(r.rings[i].radius_m), r.u[i]);
-        csv.append(line, static_cast<std::size_t>(n));
-    }
-}
-
 engine::assets::MeshData to_mesh_data(const wire::TubeMesh& tube, std::size_t wire_index) {
     engine::assets::MeshData m;
     m.name = "wire_" + std::to_string(wire_index);
@@ -84,7 +71,7 @@ wire::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::v
             if (!st.ok) return wire::Status::error(where(o.input, f, scene.frames.size(), w) + ": " + st.message, st.node);
             out.vertices += pipelines[w].mesh().vertices.size();
             if (want_outputs) {
-                if (!o.csv_out.empty()) append_csv(out.csv, f, w, pipelines[w].rings());
+                if (!o.csv_out.empty()) append_ring_rows(out.csv, f, w, pipelines[w].rings());
                 if (last) out.meshes.push_back(to_mesh_data(pipelines[w].mesh(), w));
             }
         }
@@ -147,8 +134,7 @@ int run_mesh(MeshOptions o) {
     // Outputs last, each written atomically; if the second fails the first is removed: nothing partial stays.
     std::string error;
     if (!o.csv_out.empty()) {
-        const std::string header = "frame,wire,ring,segment,t,x,y,z,tx,ty,tz,nx,ny,nz,bx,by,bz,radius,u\n";
-        if (!write_atomically(o.csv_out, header + out.csv, error)) {
+        if (!write_atomically(o.csv_out, std::string(kRingCsvHeader) + "\n" + out.csv, error)) {
             std::cerr << "wiretool mesh: " << error << "\n";
             return exit_failure;
         }

@@ -1,0 +1,491 @@
+// `wiretool view`: a wire file through the real runtime (wire entities in the ECS, the installed wire systems and
+// the wire renderer in a headless GL context) to pixels, ring records and statistics. A contract: see README.
+#include "commands.hpp"
+#include "ring_csv.hpp"
+
+#include <engine/ecs/registry.hpp>
+#include <engine/ecs/schedule.hpp>
+#include <engine/gfx/lit_renderer.hpp>
+#include <engine/platform/capture.hpp>
+#include <engine/platform/context.hpp>
+#include <wire/io/wire_json.hpp>
+#include <wire/render/wire_renderer.hpp>
+#include <wire/spline.hpp>
+#include <wire/systems/api.hpp>
+#include <wire/systems/systems.hpp>
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace wiretool {
+namespace {
+
+using engine::ecs::Entity;
+
+constexpr double kDefaultFovDeg = 60.0;
+/// LodSettings::tolerance_px's documented default (0 -> 0.5 px); reported in the stats when --tolerance-px is not given.
+constexpr double kRuntimeDefaultTolerancePx = 0.5;
+constexpr double kFrameStepS = 1.0 / 60.0;
+/// Reference points per curve segment for the measured screen error (as wire::systems::scene_screen_error).
+constexpr int kErrorSamplesPerSegment = 64;
+constexpr const char* kPerFrameToken = "%04d";
+
+struct ViewOptions {
+    std::string input;
+    std::string camera;  ///< "EX,EY,EZ,TX,TY,TZ"
+    std::optional<double> fov_deg;
+    std::string size = "1280x720";
+    std::optional<double> tolerance_px;
+    std::optional<std::string> spline;
+    std::string path;  ///< cpu|gpu; empty: the runtime's default
+    std::string png_out, csv_out, stats_out;
+};
+
+/// A bad input or command line: exit 2, nothing written.
+struct BadInput {
+    std::string message;
+};
+
+std::string where(const std::string& file, std::size_t frame, std::size_t frames, std::size_t wire_index) {
+    std::string s = file + ": ";
+    if (frames > 1) s += "frame " + std::to_string(frame) + ", ";
+    return s + "wire " + std::to_string(wire_index);
+}
+
+// ---- command-line values ----
+
+bool parse_number(const std::string& text, double& out) {
+    std::istringstream in(text);
+    in >> out;
+    return !in.fail() && in.peek() == std::char_traits<char>::eof() && std::isfinite(out);
+}
+
+std::pair<int, int> parse_size(const std::string& text) {
+    const std::size_t x = text.find('x');
+    double w = 0, h = 0;
+    if (x == std::string::npos || !parse_number(text.substr(0, x), w) || !parse_number(text.substr(x + 1), h) ||
+        w != std::floor(w) || h != std::floor(h) || w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw BadInput{"--size: expected WxH with whole numbers in [1, 16384], got '" + text + "'"};
+    return {static_cast<int>(w), static_cast<int>(h)};
+}
+
+/// The camera in effect for a frame (world metres, double).
+struct CameraPose {
+    glm::dvec3 eye{}, target{}, up{0, 1, 0};
+    bool up_given = false;
+    double fov_deg = kDefaultFovDeg;
+};
+
+CameraPose parse_camera_option(const std::string& text) {
+    std::vector<double> v;
+    std::stringstream ss(text);
+    for (std::string cell; std::getline(ss, cell, ',');) {
+        double d = 0;
+        if (!parse_number(cell, d)) v.clear(), v.resize(7);  // force the error below
+        v.push_back(d);
+    }
+    if (v.size() != 6 || text.empty() || text.back() == ',')
+        throw BadInput{"--camera: expected EX,EY,EZ,TX,TY,TZ (6 finite numbers), got '" + text + "'"};
+    CameraPose c;
+    c.eye = {v[0], v[1], v[2]};
+    c.target = {v[3], v[4], v[5]};
+    if (!(glm::length(c.target - c.eye) > 0.0)) throw BadInput{"--camera: eye and target must differ"};
+    return c;
+}
+
+/// An up vector for lookAt: the given one, or +y, or (if +y is parallel to the view direction) -z / +z.
+glm::dvec3 usable_up(const CameraPose& c) {
+    const glm::dvec3 f = glm::normalize(c.target - c.eye);
+    if (c.up_given || glm::length(glm::cross(f, c.up)) > 1e-6) return c.up;
+    return f.y < 0 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 0, 1);
+}
+
+// ---- the scene ----
+
+/// Sphere around a frame's nodes (the centre of their box, half its diagonal plus the largest radius).
+struct Bounds {
+    glm::dvec3 centre{};
+    double radius_m = 0.0;
+};
+
+Bounds bounds_of(const wire::io::FrameSpec& frame, const std::vector<wire::systems::Style>& styles) {
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    double thickest = 0.0;
+    for (std::size_t w = 0; w < frame.wires.size(); ++w) {
+        for (const glm::dvec3& p : frame.wires[w].positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        thickest = std::max(thickest, static_cast<double>(styles[w].radius_m));
+        for (float r : frame.wires[w].radius) thickest = std::max(thickest, static_cast<double>(r));
+    }
+    return {0.5 * (lo + hi), 0.5 * glm::length(hi - lo) + thickest};
+}
+
+/// Default camera: looks at the centre of the first frame's bounds from the front-right-above diagonal (+x, +y, +z),
+/// far enough that the bounding sphere fits the narrower of the two fields of view.
+CameraPose default_camera(const Bounds& b, double fov_deg, double aspect) {
+    const double half_y = 0.5 * fov_deg * std::numbers::pi / 180.0;
+    const double half_x = std::atan(std::tan(half_y) * aspect);
+    const double r = std::max(b.radius_m, 1e-6);
+    CameraPose c;
+    c.target = b.centre;
+    c.eye = b.centre + glm::normalize(glm::dvec3(1, 1, 1)) * (r / std::sin(std::min(half_x, half_y)));
+    c.fov_deg = fov_deg;
+    return c;
+}
+
+/// The runtime's Style for one wire of the file. The spline: --spline, else the file's type, else the runtime's
+/// default (wire::SplineSettings{}); the rest of the spline settings from the file (wire_io's resolve_settings).
+wire::systems::Style style_of(const wire::io::WireSpec& spec, const std::optional<std::string>& spline_override,
+                              const std::string& at) {
+    wire::io::SettingsOverrides overrides;
+    overrides.spline_type = spline_override;
+    wire::PipelineSettings resolved;
+    if (wire::Status st = wire::io::resolve_settings(spec, overrides, resolved); !st.ok)
+        throw BadInput{at + ": " + st.message};
+    wire::systems::Style style;
+    style.spline = resolved.spline;
+    if (!spline_override && !spec.spline_type) {
+        const wire::SplineSettings runtime_default{};
+        style.spline.kind = runtime_default.kind;
+        style.spline.alpha = runtime_default.kind == wire::SplineKind::catmull_rom && spec.alpha ? *spec.alpha
+                                                                                                 : runtime_default.alpha;
+    }
+    if (spec.radius_m) style.radius_m = static_cast<float>(*spec.radius_m);
+    if (spec.sides) style.max_sides = static_cast<uint32_t>(*spec.sides);
+    style.closed = spec.closed.value_or(false);
+    style.caps = spec.caps.value_or(true);
+    return style;
+}
+
+bool same_style(const wire::systems::Style& a, const wire::systems::Style& b) {
+    const wire::SplineSettings &x = a.spline, &y = b.spline;
+    return a.radius_m == b.radius_m && a.max_sides == b.max_sides && a.material == b.material && a.caps == b.caps &&
+           a.closed == b.closed && x.kind == y.kind && x.alpha == y.alpha && x.tension == y.tension &&
+           x.bias == y.bias && x.continuity == y.continuity && x.curvature_tension == y.curvature_tension;
+}
+
+bool same_nodes(const wire::io::WireSpec& a, const wire::io::WireSpec& b) {
+    if (a.positions != b.positions || a.ids != b.ids || a.stretch != b.stretch || a.radius != b.radius ||
+        a.tcb != b.tcb || a.physics.size() != b.physics.size())
+        return false;
+    for (std::size_t i = 0; i < a.physics.size(); ++i) {
+        const wire::io::NodePhysics &p = a.physics[i], &q = b.physics[i];
+        if (p.theta != q.theta || p.Iz != q.Iz || p.L != q.L || p.dL != q.dL || p.A != q.A) return false;
+    }
+    return true;
+}
+
+// ---- outputs: written to temporary names, renamed into place only when everything succeeded ----
+
+class Outputs {
+public:
+    ~Outputs() { discard(); }
+
+    /// A temporary path beside `final_path` (same directory, so the rename is atomic).
+    std::string stage(const std::string& final_path) {
+        pending_.push_back({final_path, final_path + ".tmp"});
+        return pending_.back().second;
+    }
+    [[nodiscard]] bool stage_text(const std::string& final_path, const std::string& text, std::string& error) {
+        const std::string tmp = stage(final_path);
+        std::filesystem::path parent = std::filesystem::path(final_path).parent_path();
+        std::error_code ec;
+        if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+        std::ofstream file(tmp, std::ios::binary | std::ios::trunc);
+        file.write(text.data(), static_cast<std::streamsize>(text.size()));
+        file.close();
+        if (!file) error = final_path + ": cannot write";
+        return static_cast<bool>(file);
+    }
+    /// Renames every staged file into place; on a failure removes what was renamed and what was staged.
+    [[nodiscard]] bool commit(std::string& error) {
+        std::vector<std::string> done;
+        for (const auto& [final_path, tmp] : pending_) {
+            if (std::rename(tmp.c_str(), final_path.c_str()) != 0) {
+                error = final_path + ": cannot write";
+                for (const std::string& d : done) std::remove(d.c_str());
+                discard();
+                return false;
+            }
+            done.push_back(final_path);
+        }
+        pending_.clear();
+        return true;
+    }
+    void discard() {
+        for (const auto& p : pending_) std::remove(p.second.c_str());
+        pending_.clear();
+    }
+
+private:
+    std::vector<std::pair<std::string, std::string>> pending_;
+};
+
+std::string per_frame_path(const std::string& pattern, std::size_t frame) {
+    char number[32];
+    std::snprintf(number, sizeof number, "%04zu", frame);
+    std::string s = pattern;
+    for (std::size_t at = s.find(kPerFrameToken); at != std::string::npos; at = s.find(kPerFrameToken, at))
+        s.replace(at, std::string(kPerFrameToken).size(), number);
+    return s;
+}
+
+// ---- the run ----
+
+struct Failure {
+    int status;
+    std::string message;
+};
+
+int run_view(const ViewOptions& o) try {
+    // 1. Everything the command line and the file say, checked before anything runs or is written.
+    const auto [width, height] = parse_size(o.size);
+    const double aspect = static_cast<double>(width) / height;
+    std::optional<CameraPose> cli_camera;
+    if (!o.camera.empty()) cli_camera = parse_camera_option(o.camera);
+    const double cli_fov = o.fov_deg.value_or(kDefaultFovDeg);
+    wire::UploadPath path = wire::systems::WireContext{}.path;
+    if (o.path == "cpu") path = wire::UploadPath::cpu_mesh;
+    if (o.path == "gpu") path = wire::UploadPath::gpu_rings;
+
+    wire::io::SceneSpec scene;
+    if (wire::Status st = wire::io::load_wire_json(o.input, scene); !st.ok) throw BadInput{st.message};
+    const std::size_t frames = scene.frames.size();
+    const std::size_t wires = scene.frames.front().wires.size();
+    std::vector<std::vector<wire::systems::Style>> styles(frames);
+    for (std::size_t f = 0; f < frames; ++f) {
+        for (std::size_t w = 0; w < wires; ++w) {
+            const std::string at = where(o.input, f, frames, w);
+            const wire::io::WireSpec& spec = scene.frames[f].wires[w];
+            wire::systems::Style style = style_of(spec, o.spline, at);
+            style.material = static_cast<uint32_t>(w % 6);
+            // The curve stage's own checks (fewer than 2 distinct nodes, ...), so a bad frame late in the file is
+            // reported before any frame is drawn.
+            wire::SplineSettings spline = style.spline;
+            spline.closed = style.closed;
+            spline.radius_m = style.radius_m;
+            wire::Curve curve;
+            if (wire::Status st = wire::build_curve(wire::io::to_wire_nodes(spec), spline, curve); !st.ok)
+                throw BadInput{at + ": " + st.message};
+            styles[f].push_back(style);
+        }
+    }
+    std::vector<CameraPose> cameras(frames);
+    {
+        CameraPose current = cli_camera ? *cli_camera : default_camera(bounds_of(scene.frames[0], styles[0]), cli_fov, aspect);
+        current.fov_deg = cli_fov;
+        for (std::size_t f = 0; f < frames; ++f) {
+            if (const auto& c = scene.frames[f].camera) {
+                current.eye = c->eye_m;
+                current.target = c->target_m;
+                current.up = c->up.value_or(glm::dvec3(0, 1, 0));
+                current.up_given = c->up.has_value();
+                if (c->fov_deg) current.fov_deg = *c->fov_deg;
+            }
+            cameras[f] = current;
+        }
+    }
+
+    // 2. The runtime, as a game sets it up: headless GL context, wire renderer, registry, the installed systems.
+    auto created = engine::platform::create_headless_context(
+        {.backend = engine::platform::Backend::headless, .width = width, .height = height, .quiet = true});
+    if (!created) throw Failure{exit_failure, "cannot create a headless GL context: " + created.error().message};
+    std::unique_ptr<engine::platform::Context> gl = std::move(created).value();
+    auto made = wire::render::WireRenderer::create();
+    if (!made) throw Failure{exit_failure, "cannot create the wire renderer: " + made.error().message};
+    wire::render::WireRenderer renderer = std::move(made).value();
+    // Material 0 is the renderer's copper weave; wires cycle through it and five more tints.
+    for (const glm::vec3 tint : {glm::vec3(0.25f, 0.55f, 1.0f), glm::vec3(0.95f, 0.80f, 0.15f),
+                                 glm::vec3(0.85f, 0.15f, 0.12f), glm::vec3(0.20f, 0.75f, 0.30f),
+                                 glm::vec3(0.80f, 0.80f, 0.82f)})
+        (void)renderer.add_material({.tint = tint});
+
+    engine::ecs::Registry registry;
+    engine::ecs::Schedule schedule;
+    wire::systems::WireContext ctx;
+    ctx.path = path;
+    ctx.viewport_width_px = width;
+    ctx.viewport_height_px = height;
+    if (o.tolerance_px) ctx.lod.tolerance_px = *o.tolerance_px;
+    std::vector<wire::systems::ErrorReport> runtime_errors;
+    ctx.on_error = [&](const wire::systems::ErrorReport& e) { runtime_errors.push_back(e); };
+    wire::systems::install(schedule, ctx);
+    wire::render::FrameStats drawn;
+    schedule.add("wire.render", [&](engine::ecs::Registry&, const engine::ecs::FrameContext&) {
+        wire::render::FrameSettings settings;
+        settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
+        drawn = renderer.draw(ctx.draw_list, ctx.camera, settings);
+    });
+
+    std::vector<Entity> entities;
+    std::unordered_map<uint64_t, std::size_t> wire_of_entity;
+    for (std::size_t w = 0; w < wires; ++w) {
+        entities.push_back(wire::systems::spawn_wire(registry, wire::io::to_wire_nodes(scene.frames[0].wires[w]),
+                                                     styles[0][w]));
+        wire_of_entity[engine::ecs::to_integral(entities.back())] = w;
+    }
+
+    // 3. The frames.
+    Outputs outputs;
+    const bool png_every_frame = o.png_out.find(kPerFrameToken) != std::string::npos;
+    std::string csv = std::string(kRingCsvHeader) + ",sides\n";
+    nlohmann::ordered_json frame_records = nlohmann::ordered_json::array();
+    for (std::size_t f = 0; f < frames; ++f) {
+        if (f > 0) {
+            for (std::size_t w = 0; w < wires; ++w) {
+                if (!same_nodes(scene.frames[f].wires[w], scene.frames[f - 1].wires[w]))
+                    wire::systems::set_nodes(registry, entities[w], wire::io::to_wire_nodes(scene.frames[f].wires[w]));
+                if (!same_style(styles[f][w], styles[f - 1][w]))
+                    wire::systems::set_style(registry, entities[w], styles[f][w]);
+            }
+        }
+        const CameraPose& pose = cameras[f];
+        const Bounds b = bounds_of(scene.frames[f], styles[f]);
+        // Clip planes around this frame's wires (their curve may bulge a little past the nodes' box).
+        const double reach = 1.25 * b.radius_m;
+        const double distance = glm::length(pose.eye - b.centre);
+        const double far_m = 1.01 * (distance + reach);
+        const double near_m = std::max(0.5 * (distance - reach), 1e-5 * far_m);
+        engine::scene::Camera& cam = ctx.camera;
+        cam.position = glm::vec3(pose.eye);
+        cam.target = glm::vec3(pose.target);
+        cam.up = glm::vec3(usable_up(pose));
+        cam.fov_y_rad = static_cast<float>(pose.fov_deg * std::numbers::pi / 180.0);
+        cam.aspect = static_cast<float>(aspect);
+        cam.near_m = static_cast<float>(near_m);
+        cam.far_m = static_cast<float>(far_m);
+
+        gl->begin_frame();
+        engine::gfx::clear({0.10f, 0.10f, 0.12f, 1.0f});
+        drawn = {};
+        schedule.run(registry, kFrameStepS);
+        if (!runtime_errors.empty()) {
+            const wire::systems::ErrorReport& e = runtime_errors.front();
+            const auto it = wire_of_entity.find(engine::ecs::to_integral(e.entity));
+            throw BadInput{where(o.input, f, frames, it == wire_of_entity.end() ? 0 : it->second) + ": " + e.message};
+        }
+
+        // What the LOD chose and what it drew, per wire in file order.
+        std::vector<const wire::DrawItem*> item_of(wires, nullptr);
+        for (const wire::DrawItem& item : ctx.draw_list.items) {
+            const auto it = wire_of_entity.find(item.wire_id);
+            if (it != wire_of_entity.end()) item_of[it->second] = &item;
+        }
+        nlohmann::ordered_json wire_records = nlohmann::ordered_json::array();
+        double frame_error = 0.0;
+        for (std::size_t w = 0; w < wires; ++w) {
+            const wire::DrawItem* item = item_of[w];
+            double error_px = 0.0;
+            std::size_t rings = 0;
+            long sides = 0;
+            if (item != nullptr) {
+                error_px = wire::systems::wire_screen_error(registry, ctx, entities[w], kErrorSamplesPerSegment).max_px;
+                rings = item->rings.size();
+                sides = static_cast<long>(item->sides);
+                if (!o.csv_out.empty())
+                    append_ring_rows(csv, f, w, registry.get<wire::systems::WireRings>(entities[w]).rings, sides);
+            }
+            frame_error = std::max(frame_error, error_px);
+            wire_records.push_back({{"wire", w},
+                                    {"visible", item != nullptr},
+                                    {"rings", rings},
+                                    {"sides", sides},
+                                    {"max_screen_error_px", error_px}});
+        }
+        nlohmann::ordered_json systems_ms = nlohmann::ordered_json::object();
+        for (const engine::ecs::SystemStats& s : schedule.stats()) systems_ms[s.name] = s.last_ms;
+        frame_records.push_back({{"frame", f},
+                                 {"visible_wires", ctx.stats.visible_wires},
+                                 {"rings", ctx.stats.rings},
+                                 {"vertices", drawn.vertices},
+                                 {"triangles", drawn.triangles},
+                                 {"bytes_uploaded", drawn.bytes_uploaded},
+                                 {"systems_ms", systems_ms},
+                                 {"max_screen_error_px", frame_error},
+                                 {"wires", wire_records}});
+
+        if (!o.png_out.empty() && (png_every_frame || f + 1 == frames)) {
+            const std::string final_path = png_every_frame ? per_frame_path(o.png_out, f) : o.png_out;
+            const std::string tmp = outputs.stage(final_path);
+            if (auto st = engine::platform::write_png(tmp, engine::platform::read_pixels(*gl)); !st)
+                throw Failure{exit_failure, final_path + ": cannot write (" + st.error().message + ")"};
+        }
+        gl->end_frame();
+    }
+
+    // 4. Text outputs, then everything renamed into place together.
+    std::string error;
+    if (!o.csv_out.empty() && !outputs.stage_text(o.csv_out, csv, error)) throw Failure{exit_failure, error};
+    if (!o.stats_out.empty()) {
+        nlohmann::ordered_json stats = {
+            {"frames", frame_records},
+            {"summary",
+             {{"width", width},
+              {"height", height},
+              {"tolerance_px", o.tolerance_px.value_or(kRuntimeDefaultTolerancePx)},
+              {"gl_renderer", gl->gl_renderer()}}}};
+        if (!outputs.stage_text(o.stats_out, stats.dump(1) + "\n", error)) throw Failure{exit_failure, error};
+    }
+    if (!outputs.commit(error)) throw Failure{exit_failure, error};
+    return exit_ok;
+} catch (const BadInput& e) {
+    std::cerr << "wiretool view: " << e.message << "\n";
+    return exit_bad_input;
+} catch (const Failure& e) {
+    std::cerr << "wiretool view: " << e.message << "\n";
+    return e.status;
+}
+
+}  // namespace
+
+Action add_view_command(CLI::App& app) {
+    auto o = std::make_shared<ViewOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "view",
+        "Run wires (JSON) through the real runtime (ECS wire systems, screen-space LOD, wire renderer, headless GL) "
+        "and write what it drew: a PNG, one CSV row per drawn ring, per-frame statistics with the measured screen "
+        "error. IN.json is what `mesh` reads (one wire, {\"wires\": [...]} or {\"frames\": [{\"wires\": [...]}, ...]}); "
+        "a frame may carry \"camera\": {\"eye\": [x,y,z], \"target\": [x,y,z], \"up\": [x,y,z], \"fov_deg\": f} (up "
+        "and fov_deg optional), which replaces --camera/--fov from that frame on. Frames step 1/60 s.");
+    cmd->add_option("input", o->input, "Wire JSON file")->required();
+    cmd->add_option("--camera", o->camera,
+                    "EX,EY,EZ,TX,TY,TZ: eye and target in metres (default: the first frame's wires framed from the "
+                    "front-right-above diagonal)");
+    cmd->add_option("--fov", o->fov_deg, "Vertical field of view in degrees (default 60)")
+        ->check(CLI::Range(1e-3, 179.999));
+    cmd->add_option("--size", o->size, "Image size WxH in pixels (default 1280x720)");
+    cmd->add_option("--tolerance-px", o->tolerance_px, "LOD screen-space tolerance in pixels (default: the runtime's, 0.5)")
+        ->check(CLI::Range(1e-6, 1e6));
+    cmd->add_option("--spline", o->spline,
+                    "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear); default: the file's, else the "
+                    "runtime's")
+        ->check(CLI::IsMember({"uniform", "centripetal", "chordal", "c2", "auto", "automatic", "catmull-rom", "linear"}));
+    cmd->add_option("--path", o->path, "Upload path: cpu (meshes built on the CPU) or gpu (ring records, expanded in "
+                                       "the vertex shader); default: the runtime's")
+        ->check(CLI::IsMember({"cpu", "gpu"}));
+    cmd->add_option("--png", o->png_out,
+                    "Write the last frame as PNG; if OUT contains %04d, every frame (%04d = frame number)");
+    cmd->add_option("--csv", o->csv_out, "Write one row per ring of every visible wire and frame (the mesh ring CSV "
+                                         "plus the sides the LOD chose)");
+    cmd->add_option("--stats", o->stats_out, "Write per-frame statistics (JSON) with the measured screen error");
+    return [o] { return run_view(*o); };
+}
+
+}  // namespace wiretool
