@@ -1,0 +1,437 @@
+// `wiretool view` against its contract: a camera flying from 1 m to 2 km from three wires through the real runtime
+// (rings and vertices fall, the measured screen error stays within the tolerance on every frame, the PNG shows the
+// wires where their ring centres project, the CSV agrees with the stats), the defaults, per-frame cameras, and the
+// error paths (exit 2, located message, nothing written).
+#include <engine/platform/capture.hpp>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr int kFlightFrames = 16;
+constexpr double kFarthestM = 2000.0;
+
+struct ToolRun {
+    int status = -1;
+    std::string err;
+};
+
+/// Three wires inside a sphere of radius ~0.4 m around the origin: a hanging cable, a helix, a wavy run.
+json three_wires() {
+    json wires = json::array();
+    json cable = json::array(), helix = json::array(), wavy = json::array();
+    for (int i = 0; i < 12; ++i) {
+        const double x = -0.35 + 0.7 * i / 11.0;
+        cable.push_back({x, 0.15 * (std::cosh(x / 0.3) - std::cosh(0.35 / 0.3)) + 0.1, 0.0});
+    }
+    for (int i = 0; i < 16; ++i) helix.push_back({0.12 * std::cos(0.6 * i), -0.3 + 0.03 * i, 0.12 * std::sin(0.6 * i)});
+    for (int i = 0; i < 13; ++i) wavy.push_back({-0.3 + 0.05 * i, -0.1 + 0.08 * std::sin(0.7 * i), 0.15 * std::cos(0.5 * i)});
+    wires.push_back({{"radius", 0.01}, {"nodes", cable}});
+    wires.push_back({{"radius", 0.006}, {"spline", {{"type", "chordal"}}}, {"nodes", helix}});
+    wires.push_back({{"radius", 0.008}, {"nodes", wavy}});
+    return wires;
+}
+
+const glm::dvec3 kFlightDirection = glm::normalize(glm::dvec3(0.3, 0.4, 1.0));
+
+/// Camera distance of flight frame k: 1 m to 2 km, geometric.
+double flight_distance(int k) { return std::pow(kFarthestM, static_cast<double>(k) / (kFlightFrames - 1)); }
+
+json flight_scene() {
+    json frames = json::array();
+    for (int k = 0; k < kFlightFrames; ++k) {
+        const glm::dvec3 eye = kFlightDirection * flight_distance(k);
+        json camera = {{"eye", {eye.x, eye.y, eye.z}}, {"target", {0, 0, 0}}};
+        if (k == 0) {
+            camera["up"] = {0, 1, 0};
+            camera["fov_deg"] = 60;
+        }
+        frames.push_back({{"wires", three_wires()}, {"camera", camera}});
+    }
+    return {{"frames", frames}};
+}
+
+class WiretoolView : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() /
+               ("wiretool_view_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    std::string write(const std::string& name, const std::string& text) const {
+        std::ofstream(path(name)) << text;
+        return path(name);
+    }
+    ToolRun run(const std::string& args) const {
+        const std::string err = (dir_.parent_path() / (dir_.filename().string() + "_stderr.txt")).string();
+        const std::string cmd = std::string(WIRETOOL_PATH) + " view " + args + " 2> " + err + " > /dev/null";
+        ToolRun r;
+        const int raw = std::system(cmd.c_str());
+        r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+        std::ifstream in(err);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        r.err = ss.str();
+        fs::remove(err);
+        return r;
+    }
+    /// Files in the test directory (the inputs included), sorted.
+    std::vector<std::string> listing() const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::recursive_directory_iterator(dir_)) names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+    static json read_json(const std::string& file) {
+        std::ifstream in(file);
+        return json::parse(in);
+    }
+    static std::vector<std::vector<double>> read_csv(const std::string& file, std::string& header) {
+        std::ifstream in(file);
+        std::getline(in, header);
+        std::vector<std::vector<double>> rows;
+        for (std::string line; std::getline(in, line);) {
+            std::vector<double> cells;
+            std::stringstream ss(line);
+            for (std::string c; std::getline(ss, c, ',');) cells.push_back(std::stod(c));
+            rows.push_back(cells);
+        }
+        return rows;
+    }
+    fs::path dir_;
+};
+
+// CSV columns.
+enum Col { kFrame = 0, kWire = 1, kRing = 2, kX = 5, kY = 6, kZ = 7, kRadius = 17, kSides = 19, kColumns = 20 };
+
+/// Pixel position (x right, y down, pixel centres at +0.5) of a world point, by glm's lookAt/perspective: an
+/// independent projection, not the tool's.
+struct Projector {
+    glm::dmat4 clip_from_world;
+    double width, height;
+    Projector(const glm::dvec3& eye, const glm::dvec3& target, double fov_deg, double w, double h)
+        : clip_from_world(glm::perspective(fov_deg * std::numbers::pi / 180.0, w / h, 0.01, 1e5) *
+                          glm::lookAt(eye, target, glm::dvec3(0, 1, 0))),
+          width(w),
+          height(h) {}
+    glm::dvec2 px(const glm::dvec3& p) const {
+        const glm::dvec4 c = clip_from_world * glm::dvec4(p, 1.0);
+        return {(c.x / c.w + 1.0) * 0.5 * width, (1.0 - c.y / c.w) * 0.5 * height};
+    }
+};
+
+double distance_to_piece(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
+    const glm::dvec2 ab = b - a;
+    const double l2 = glm::dot(ab, ab);
+    const double h = l2 > 0 ? std::clamp(glm::dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + h * ab));
+}
+
+bool same_rgb(const uint8_t* a, const uint8_t* b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
+
+TEST_F(WiretoolView, CameraFlyingFrom1mTo2km) {
+    const std::string in = write("fly.json", flight_scene().dump());
+    const ToolRun r = run(in + " --png " + path("f_%04d.png") + " --csv " + path("rings.csv") + " --stats " +
+                          path("stats.json"));
+    ASSERT_EQ(r.status, 0) << r.err;
+
+    const json stats = read_json(path("stats.json"));
+    const json& summary = stats.at("summary");
+    EXPECT_EQ(summary.at("width"), 1280);
+    EXPECT_EQ(summary.at("height"), 720);
+    const double tolerance = summary.at("tolerance_px");
+    EXPECT_EQ(tolerance, 0.5);  // the runtime's default
+    EXPECT_FALSE(summary.at("gl_renderer").get<std::string>().empty());
+    const json& frames = stats.at("frames");
+    ASSERT_EQ(frames.size(), static_cast<std::size_t>(kFlightFrames));
+
+    // Rings and vertices fall as the camera recedes; the measured error stays within the tolerance.
+    for (int k = 0; k < kFlightFrames; ++k) {
+        const json& f = frames[static_cast<std::size_t>(k)];
+        EXPECT_EQ(f.at("frame"), k);
+        EXPECT_EQ(f.at("visible_wires"), 3) << "frame " << k;
+        for (const char* key : {"wire.curve", "wire.lod", "wire.rings", "wire.mesh", "wire.draw_list", "wire.render"})
+            EXPECT_TRUE(f.at("systems_ms").contains(key)) << key;
+        const double error = f.at("max_screen_error_px");
+        EXPECT_LE(error, tolerance * (1 + 1e-9)) << "frame " << k << " at " << flight_distance(k) << " m";
+        double worst_wire = 0.0;
+        std::size_t ring_sum = 0;
+        for (const json& w : f.at("wires")) {
+            EXPECT_TRUE(w.at("visible").get<bool>());
+            EXPECT_GE(w.at("sides").get<int>(), 1);
+            worst_wire = std::max(worst_wire, w.at("max_screen_error_px").get<double>());
+            ring_sum += w.at("rings").get<std::size_t>();
+        }
+        EXPECT_EQ(error, worst_wire);
+        EXPECT_EQ(f.at("rings").get<std::size_t>(), ring_sum);
+        EXPECT_GT(f.at("triangles").get<std::size_t>(), 0u);
+        EXPECT_GT(f.at("bytes_uploaded").get<std::size_t>(), 0u);
+        if (k > 0) {
+            const json& prev = frames[static_cast<std::size_t>(k - 1)];
+            EXPECT_LE(f.at("rings"), prev.at("rings")) << "frame " << k;
+            EXPECT_LE(f.at("vertices"), prev.at("vertices")) << "frame " << k;
+        }
+        std::printf("frame %2d  %8.2f m  rings %4zu  vertices %6zu  max error %.4f px\n", k, flight_distance(k),
+                    f.at("rings").get<std::size_t>(), f.at("vertices").get<std::size_t>(), error);
+    }
+    const json &first = frames.front(), &last = frames.back();
+    EXPECT_LT(last.at("rings").get<double>(), 0.8 * first.at("rings").get<double>());
+    EXPECT_LT(last.at("vertices").get<double>(), 0.6 * first.at("vertices").get<double>());
+    // The error measure is not vacuous: close up it uses a good part of the tolerance.
+    EXPECT_GT(first.at("max_screen_error_px").get<double>(), 0.2 * tolerance);
+
+    // The CSV agrees with the stats: rows per frame and wire, consecutive ring indices, the sides the LOD chose.
+    std::string header;
+    const auto rows = read_csv(path("rings.csv"), header);
+    EXPECT_EQ(header, "frame,wire,ring,segment,t,x,y,z,tx,ty,tz,nx,ny,nz,bx,by,bz,radius,u,sides");
+    std::map<std::pair<int, int>, std::vector<const std::vector<double>*>> by_wire;
+    for (const auto& row : rows) {
+        ASSERT_EQ(row.size(), static_cast<std::size_t>(kColumns));
+        by_wire[{static_cast<int>(row[kFrame]), static_cast<int>(row[kWire])}].push_back(&row);
+    }
+    std::size_t expected_rows = 0;
+    for (int k = 0; k < kFlightFrames; ++k) {
+        for (const json& w : frames[static_cast<std::size_t>(k)].at("wires")) {
+            const auto& got = by_wire[{k, w.at("wire").get<int>()}];
+            ASSERT_EQ(got.size(), w.at("rings").get<std::size_t>()) << "frame " << k << " wire " << w.at("wire");
+            for (std::size_t i = 0; i < got.size(); ++i) {
+                EXPECT_EQ((*got[i])[kRing], static_cast<double>(i));
+                EXPECT_EQ((*got[i])[kSides], w.at("sides").get<double>());
+            }
+            expected_rows += got.size();
+        }
+    }
+    EXPECT_EQ(rows.size(), expected_rows);
+
+    // Every frame has its PNG; the near ones show the wires where their ring centres project, and nothing else.
+    for (int k = 0; k < kFlightFrames; ++k) {
+        char name[32];
+        std::snprintf(name, sizeof name, "f_%04d.png", k);
+        EXPECT_TRUE(fs::exists(path(name))) << name;
+    }
+    for (int k : {0, 2, 4}) {  // 1 m, 2.8 m, 7.6 m
+        char name[32];
+        std::snprintf(name, sizeof name, "f_%04d.png", k);
+        const auto image = engine::platform::read_png(path(name));
+        ASSERT_TRUE(image.ok()) << name;
+        ASSERT_EQ(image->width, 1280);
+        ASSERT_EQ(image->height, 720);
+        const uint8_t* background = image->pixel(0, 0);
+        const Projector cam(kFlightDirection * flight_distance(k), glm::dvec3(0.0), 60.0, 1280, 720);
+        std::vector<std::vector<glm::dvec2>> centres(3);
+        double largest_radius_px = 0.0;
+        for (int w = 0; w < 3; ++w) {
+            for (const std::vector<double>* row : by_wire[{k, w}]) {
+                const glm::dvec3 p((*row)[kX], (*row)[kY], (*row)[kZ]);
+                centres[static_cast<std::size_t>(w)].push_back(cam.px(p));
+                const double z = glm::length(kFlightDirection * flight_distance(k) - p);
+                largest_radius_px = std::max(largest_radius_px, (*row)[kRadius] * 623.5 / z);
+            }
+        }
+        // Each ring centre is covered by its tube (a pixel within 1 px of it is not background).
+        std::size_t hits = 0, tried = 0;
+        for (const auto& wire : centres) {
+            for (const glm::dvec2& c : wire) {
+                const int cx = static_cast<int>(std::floor(c.x)), cy = static_cast<int>(std::floor(c.y));
+                if (cx < 1 || cy < 1 || cx >= 1279 || cy >= 719) continue;
+                ++tried;
+                bool covered = false;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx)
+                        covered = covered || !same_rgb(image->pixel(cx + dx, cy + dy), background);
+                hits += covered ? 1 : 0;
+            }
+        }
+        EXPECT_GT(tried, 60u) << name;
+        EXPECT_EQ(hits, tried) << name << ": ring centres drawn over background";
+        // Away from every projected centre polyline (farther than the tube's radius plus 2 px), only background.
+        std::size_t stray = 0, far_pixels = 0, drawn = 0;
+        for (int y = 0; y < 720; y += 2) {
+            for (int x = 0; x < 1280; x += 2) {
+                const bool bg = same_rgb(image->pixel(x, y), background);
+                drawn += bg ? 0 : 1;
+                const glm::dvec2 p(x + 0.5, y + 0.5);
+                double d = 1e30;
+                for (const auto& wire : centres)
+                    for (std::size_t i = 0; i + 1 < wire.size(); ++i) d = std::min(d, distance_to_piece(p, wire[i], wire[i + 1]));
+                if (d > largest_radius_px + 2.0) {
+                    ++far_pixels;
+                    stray += bg ? 0 : 1;
+                }
+            }
+        }
+        EXPECT_GT(drawn, 10u) << name;
+        EXPECT_EQ(stray, 0u) << name << ": drawn pixels away from the wires (of " << far_pixels << ")";
+    }
+}
+
+TEST_F(WiretoolView, DefaultCameraFramesTheWiresAndBothPathsAgree) {
+    const std::string in = write("wires.json", json{{"wires", three_wires()}}.dump());
+    ASSERT_EQ(run(in + " --png " + path("cpu.png") + " --stats " + path("cpu.json") + " --csv " + path("cpu.csv")).status, 0);
+    ASSERT_EQ(run(in + " --path gpu --png " + path("gpu.png") + " --stats " + path("gpu.json")).status, 0);
+    const json cpu = read_json(path("cpu.json")), gpu = read_json(path("gpu.json"));
+    ASSERT_EQ(cpu.at("frames").size(), 1u);
+    const json &fc = cpu.at("frames")[0], &fg = gpu.at("frames")[0];
+    EXPECT_EQ(fc.at("visible_wires"), 3);
+    EXPECT_EQ(fc.at("rings"), fg.at("rings"));
+    for (std::size_t w = 0; w < 3; ++w) {
+        EXPECT_EQ(fc.at("wires")[w].at("sides"), fg.at("wires")[w].at("sides"));
+        EXPECT_EQ(fc.at("wires")[w].at("rings"), fg.at("wires")[w].at("rings"));
+    }
+    EXPECT_LE(fc.at("max_screen_error_px").get<double>(), 0.5 * (1 + 1e-9));
+    EXPECT_LE(fg.at("max_screen_error_px").get<double>(), 0.5 * (1 + 1e-9));
+
+    // The default camera frames the wires: everything drawn lies well inside the image and spans a good part of it.
+    const auto image = engine::platform::read_png(path("cpu.png"));
+    ASSERT_TRUE(image.ok());
+    ASSERT_EQ(image->width, 1280);
+    ASSERT_EQ(image->height, 720);
+    int x0 = 1280, x1 = -1, y0 = 720, y1 = -1;
+    const uint8_t* background = image->pixel(0, 0);
+    for (int y = 0; y < 720; ++y)
+        for (int x = 0; x < 1280; ++x)
+            if (!same_rgb(image->pixel(x, y), background)) {
+                x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+            }
+    ASSERT_GE(x1, 0) << "nothing drawn";
+    EXPECT_GT(x0, 0);
+    EXPECT_LT(x1, 1279);
+    EXPECT_GT(y0, 0);
+    EXPECT_LT(y1, 719);
+    EXPECT_GT(std::max((x1 - x0) / 1280.0, (y1 - y0) / 720.0), 0.4);
+    // Both upload paths render the same image (up to rasterization differences on a few edge pixels).
+    const auto other = engine::platform::read_png(path("gpu.png"));
+    ASSERT_TRUE(other.ok());
+    std::size_t differ = 0, drawn = 0;
+    for (int y = 0; y < 720; ++y)
+        for (int x = 0; x < 1280; ++x) {
+            const bool a = !same_rgb(image->pixel(x, y), background), b = !same_rgb(other->pixel(x, y), background);
+            drawn += a || b;
+            differ += a != b;
+        }
+    EXPECT_LT(static_cast<double>(differ), 0.05 * static_cast<double>(drawn));
+
+    // A coarser tolerance spends fewer rings and stays within itself.
+    ASSERT_EQ(run(in + " --tolerance-px 3 --size 640x360 --stats " + path("coarse.json")).status, 0);
+    const json coarse = read_json(path("coarse.json"));
+    EXPECT_EQ(coarse.at("summary").at("tolerance_px"), 3.0);
+    EXPECT_EQ(coarse.at("summary").at("width"), 640);
+    EXPECT_LT(coarse.at("frames")[0].at("rings").get<int>(), fc.at("rings").get<int>());
+    EXPECT_LE(coarse.at("frames")[0].at("max_screen_error_px").get<double>(), 3.0 * (1 + 1e-9));
+}
+
+TEST_F(WiretoolView, FrameCameraOverridesTheCommandLineFromThatFrameOn) {
+    const json wires = three_wires();
+    const json scene = {{"frames",
+                         {{{"wires", wires}},
+                          {{"wires", wires}, {"camera", {{"eye", {0, 0, 2}}, {"target", {0, 0, 0}}, {"fov_deg", 30}}}},
+                          {{"wires", wires}}}}};
+    const std::string in = write("frames.json", scene.dump());
+    // --camera looks away from the wires: frame 0 shows nothing; frames 1 and 2 use the file's camera.
+    ASSERT_EQ(run(in + " --camera 0,0,2,0,0,5 --png " + path("last.png") + " --stats " + path("s.json")).status, 0);
+    const json s = read_json(path("s.json"));
+    ASSERT_EQ(s.at("frames").size(), 3u);
+    EXPECT_EQ(s.at("frames")[0].at("visible_wires"), 0);
+    EXPECT_EQ(s.at("frames")[0].at("rings"), 0);
+    EXPECT_EQ(s.at("frames")[0].at("wires")[0].at("visible"), false);
+    EXPECT_EQ(s.at("frames")[1].at("visible_wires"), 3);
+    EXPECT_EQ(s.at("frames")[2].at("visible_wires"), 3);
+    EXPECT_EQ(s.at("frames")[2].at("rings"), s.at("frames")[1].at("rings"));
+    // Without %04d only the last frame is written.
+    EXPECT_EQ(listing(), (std::vector<std::string>{"frames.json", "last.png", "s.json"}));
+}
+
+TEST_F(WiretoolView, BadInputExits2NamingWhereAndWritesNothing) {
+    const std::string outputs = " --png " + path("f_%04d.png") + " --csv " + path("r.csv") + " --stats " + path("s.json");
+    json scene = flight_scene();
+    scene["frames"][2]["wires"][1]["nodes"][3][1] = "up";
+    const std::string bad_node = write("bad_node.json", scene.dump());
+    ToolRun r = run(bad_node + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "wiretool view: " + bad_node + ": frame 2, wire 1, node 3: coordinate y must be a number, got string\n");
+
+    // A geometric error in the last frame (the curve stage's check) stops the run before any frame is written.
+    scene = flight_scene();
+    scene["frames"][kFlightFrames - 1]["wires"][0]["nodes"] = json::array({{1, 2, 3}, {1, 2, 3}, {1, 2, 3}});
+    const std::string degenerate = write("degenerate.json", scene.dump());
+    r = run(degenerate + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err.rfind("wiretool view: " + degenerate + ": frame 15, wire 0: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("at least 2 distinct nodes"), std::string::npos) << r.err;
+
+    scene = flight_scene();
+    scene["frames"][1]["camera"]["fov"] = 40;
+    const std::string bad_camera = write("bad_camera.json", scene.dump());
+    r = run(bad_camera + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "wiretool view: " + bad_camera + ": frame 1: unknown key 'fov' in camera\n");
+
+    r = run(path("missing.json") + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find(path("missing.json") + ": cannot open"), std::string::npos) << r.err;
+
+    const std::string good = write("good.json", json{{"wires", three_wires()}}.dump());
+    r = run(good + " --camera 1,2,3" + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "wiretool view: --camera: expected EX,EY,EZ,TX,TY,TZ (6 finite numbers), got '1,2,3'\n");
+    r = run(good + " --camera 1,2,3,1,2,3" + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "wiretool view: --camera: eye and target must differ\n");
+    r = run(good + " --size 640x" + outputs);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "wiretool view: --size: expected WxH with whole numbers in [1, 16384], got '640x'\n");
+    EXPECT_EQ(run(good + " --path vulkan" + outputs).status, 2);
+    EXPECT_EQ(run(good + " --spline bezier" + outputs).status, 2);
+    EXPECT_EQ(run(good + " --tolerance-px 0" + outputs).status, 2);
+
+    EXPECT_EQ(listing(), (std::vector<std::string>{"bad_camera.json", "bad_node.json", "degenerate.json", "good.json"}));
+}
+
+TEST_F(WiretoolView, AnOutputThatCannotBeWrittenExits1AndLeavesNothing) {
+    const std::string good = write("good.json", json{{"wires", three_wires()}}.dump());
+    fs::create_directories(path("taken/sub"));  // a non-empty directory where the CSV should go
+    const ToolRun r = run(good + " --size 320x180 --png " + path("v.png") + " --stats " + path("s.json") + " --csv " +
+                          path("taken"));
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+    EXPECT_EQ(listing(), (std::vector<std::string>{"good.json", "sub", "taken"}));
+}
+
+TEST_F(WiretoolView, HelpListsEveryOption) {
+    const std::string out = path("help.txt");
+    ASSERT_EQ(std::system((std::string(WIRETOOL_PATH) + " view --help > " + out).c_str()), 0);
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    for (const char* option :
+         {"--camera", "--fov", "--size", "--tolerance-px", "--spline", "--path", "--png", "--csv", "--stats", "camera"})
+        EXPECT_NE(ss.str().find(option), std::string::npos) << option;
+}
+
+}  // namespace
