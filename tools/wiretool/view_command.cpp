@@ -93,13 +93,14 @@ struct CameraPose {
 
 CameraPose parse_camera_option(const std::string& text) {
     std::vector<double> v;
+    bool numbers = !text.empty() && text.back() != ',';
     std::stringstream ss(text);
-    for (std::string cell; std::getline(ss, cell, ',');) {
+    for (std::string cell; numbers && std::getline(ss, cell, ',');) {
         double d = 0;
-        if (!parse_number(cell, d)) v.clear(), v.resize(7);  // force the error below
+        numbers = parse_number(cell, d);
         v.push_back(d);
     }
-    if (v.size() != 6 || text.empty() || text.back() == ',')
+    if (!numbers || v.size() != 6)
         throw BadInput{"--camera: expected EX,EY,EZ,TX,TY,TZ (6 finite numbers), got '" + text + "'"};
     CameraPose c;
     c.eye = {v[0], v[1], v[2]};
