@@ -359,11 +359,14 @@ int run_view(const ViewOptions& o) try {
         }
         const CameraPose& pose = cameras[f];
         const Bounds b = bounds_of(scene.frames[f], styles[f]);
-        // Clip planes around this frame's wires (their curve may bulge a little past the nodes' box).
+        // Clip planes around this frame's wires (their curve may bulge a little past the nodes' box): far just past
+        // them; near halfway to them, or, from inside or close by, a game-like 5 cm scaled down for small scenes (a
+        // tiny near plane would make the LOD refine every segment that crosses it to its maximum count).
         const double reach = 1.25 * b.radius_m;
         const double distance = glm::length(pose.eye - b.centre);
         const double far_m = 1.01 * (distance + reach);
-        const double near_m = std::max(0.5 * (distance - reach), 1e-5 * far_m);
+        const double close_near_m = std::max(1e-5 * far_m, std::min(0.05, 0.01 * reach));
+        const double near_m = std::max(0.5 * (distance - reach), close_near_m);
         engine::scene::Camera& cam = ctx.camera;
         cam.position = glm::vec3(pose.eye);
         cam.target = glm::vec3(pose.target);
