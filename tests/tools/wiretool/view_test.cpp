@@ -20,6 +20,7 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <random>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -289,6 +290,105 @@ TEST_F(WiretoolView, CameraFlyingFrom1mTo2km) {
         EXPECT_GT(drawn, 10u) << name;
         EXPECT_EQ(stray, 0u) << name << ": drawn pixels away from the wires (of " << far_pixels << ")";
     }
+}
+
+// A family of random scenes (fixed seeds): 2-5 wires of random shape, node count, radius and spline inside a sphere
+// of 0.45 m, seen along a random direction from 1 m to 2 km. On every frame of every scene the measured error stays
+// within the tolerance, and rings and vertices never grow as the camera recedes.
+json random_flight(std::mt19937_64& rng, int frames) {
+    auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+    auto unit = [&] {
+        for (;;) {
+            const glm::dvec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+            if (glm::length(v) > 0.1 && glm::length(v) <= 1.0) return glm::normalize(v);
+        }
+    };
+    const char* splines[] = {"centripetal", "chordal", "c2", "auto", ""};
+    json wires = json::array();
+    const int count = static_cast<int>(uniform(2, 6));
+    for (int w = 0; w < count; ++w) {
+        std::vector<glm::dvec3> p;
+        const int shape = static_cast<int>(uniform(0, 3));
+        const int n = static_cast<int>(uniform(4, 30));
+        if (shape == 0) {  // random walk
+            glm::dvec3 at(0.0), dir = unit();
+            for (int i = 0; i < n; ++i, at += dir * uniform(0.2, 1.0)) {
+                p.push_back(at);
+                dir = glm::normalize(dir + unit() * uniform(0.2, 1.2));
+            }
+        } else if (shape == 1) {  // hanging
+            const double a = uniform(0.15, 2.0);
+            const glm::dvec3 along = glm::normalize(glm::dvec3(uniform(-1, 1), 0.0, uniform(-1, 1)) + glm::dvec3(1e-3, 0, 0));
+            for (int i = 0; i < n; ++i) {
+                const double x = static_cast<double>(i) / (n - 1) - 0.5;
+                p.push_back(along * x + glm::dvec3(0, a * (std::cosh(x / a) - std::cosh(0.5 / a)), 0));
+            }
+        } else {  // helix
+            const double r = uniform(0.1, 0.5), pitch = uniform(0.02, 0.2), step = uniform(0.3, 1.0);
+            for (int i = 0; i < n; ++i) p.push_back({r * std::cos(i * step), pitch * i * step, r * std::sin(i * step)});
+        }
+        // Scale into a sphere of radius uniform(0.1, 0.45) m around a random point (the whole scene stays within 0.45 m).
+        glm::dvec3 lo(1e30), hi(-1e30);
+        for (const glm::dvec3& q : p) lo = glm::min(lo, q), hi = glm::max(hi, q);
+        const double size = uniform(0.1, 0.45);
+        const double scale = size / std::max(0.5 * glm::length(hi - lo), 1e-9);
+        const glm::dvec3 centre = unit() * (0.45 - size) * uniform(0.0, 1.0);
+        json nodes = json::array();
+        for (const glm::dvec3& q : p) {
+            const glm::dvec3 v = centre + (q - 0.5 * (lo + hi)) * scale;
+            nodes.push_back({v.x, v.y, v.z});
+        }
+        json wire = {{"radius", uniform(0.002, 0.015)}, {"nodes", nodes}};
+        const std::string spline = splines[static_cast<int>(uniform(0, 5))];
+        if (!spline.empty()) wire["spline"] = spline;
+        wires.push_back(wire);
+    }
+    const glm::dvec3 dir = unit();
+    json out = json::array();
+    for (int k = 0; k < frames; ++k) {
+        const glm::dvec3 eye = dir * std::pow(kFarthestM, static_cast<double>(k) / (frames - 1));
+        out.push_back({{"wires", wires}, {"camera", {{"eye", {eye.x, eye.y, eye.z}}, {"target", {0, 0, 0}}}}});
+    }
+    return {{"frames", out}};
+}
+
+TEST_F(WiretoolView, RandomScenesStayWithinTheToleranceOnEveryFrame) {
+    std::vector<double> ratios;  // max error / tolerance per frame
+    double worst = 0.0, near_rings = 0.0, far_rings = 0.0;
+    std::string worst_case;
+    for (int seed = 1; seed <= 6; ++seed) {
+        std::mt19937_64 rng(static_cast<uint64_t>(seed) * 7919u);
+        const std::string in = write("random.json", random_flight(rng, 10).dump());
+        const double tolerance = seed % 2 == 0 ? 0.5 : 1.0;
+        const std::string args = in + " --size 640x360 --tolerance-px " + std::to_string(tolerance) +
+                                 (seed % 3 == 0 ? " --path gpu" : "") + " --stats " + path("s.json");
+        const ToolRun r = run(args);
+        ASSERT_EQ(r.status, 0) << "seed " << seed << ": " << r.err;
+        const json frames = read_json(path("s.json")).at("frames");
+        ASSERT_EQ(frames.size(), 10u);
+        for (std::size_t k = 0; k < frames.size(); ++k) {
+            const double error = frames[k].at("max_screen_error_px");
+            EXPECT_LE(error, tolerance * (1 + 1e-9)) << "seed " << seed << " frame " << k;
+            ratios.push_back(error / tolerance);
+            if (error / tolerance > worst) {
+                worst = error / tolerance;
+                worst_case = "seed " + std::to_string(seed) + " frame " + std::to_string(k);
+            }
+            EXPECT_EQ(frames[k].at("visible_wires"), frames[0].at("wires").size()) << "seed " << seed;
+            if (k > 0) {
+                EXPECT_LE(frames[k].at("rings"), frames[k - 1].at("rings")) << "seed " << seed << " frame " << k;
+                EXPECT_LE(frames[k].at("vertices"), frames[k - 1].at("vertices")) << "seed " << seed << " frame " << k;
+            }
+        }
+        near_rings += frames.front().at("rings").get<double>();
+        far_rings += frames.back().at("rings").get<double>();
+    }
+    // Small, nearly straight wires may need one ring per segment even at 1 m; over the family the count falls.
+    EXPECT_LT(far_rings, 0.8 * near_rings);
+    std::sort(ratios.begin(), ratios.end());
+    std::printf("error / tolerance over %zu frames: median %.3f, p90 %.3f, max %.3f (%s); rings at 1 m %.0f, at 2 km %.0f\n",
+                ratios.size(), ratios[ratios.size() / 2], ratios[ratios.size() * 9 / 10], worst, worst_case.c_str(),
+                near_rings, far_rings);
 }
 
 TEST_F(WiretoolView, DefaultCameraFramesTheWiresAndBothPathsAgree) {
