@@ -272,6 +272,10 @@ TEST_F(WiretoolView, CameraFlyingFrom1mTo2km) {
         EXPECT_GT(tried, 60u) << name;
         EXPECT_EQ(hits, tried) << name << ": ring centres drawn over background";
         // Away from every projected centre polyline (farther than the tube's radius plus 2 px), only background.
+        const double margin = largest_radius_px + 2.0;
+        glm::dvec2 lo(1e30), hi(-1e30);  // box of the projected centres: outside it (plus margin) is far anyway
+        for (const auto& wire : centres)
+            for (const glm::dvec2& c : wire) lo = glm::min(lo, c), hi = glm::max(hi, c);
         std::size_t stray = 0, far_pixels = 0, drawn = 0;
         for (int y = 0; y < 720; y += 2) {
             for (int x = 0; x < 1280; x += 2) {
@@ -279,9 +283,11 @@ TEST_F(WiretoolView, CameraFlyingFrom1mTo2km) {
                 drawn += bg ? 0 : 1;
                 const glm::dvec2 p(x + 0.5, y + 0.5);
                 double d = 1e30;
-                for (const auto& wire : centres)
-                    for (std::size_t i = 0; i + 1 < wire.size(); ++i) d = std::min(d, distance_to_piece(p, wire[i], wire[i + 1]));
-                if (d > largest_radius_px + 2.0) {
+                if (p.x > lo.x - margin && p.x < hi.x + margin && p.y > lo.y - margin && p.y < hi.y + margin)
+                    for (const auto& wire : centres)
+                        for (std::size_t i = 0; i + 1 < wire.size(); ++i)
+                            d = std::min(d, distance_to_piece(p, wire[i], wire[i + 1]));
+                if (d > margin) {
                     ++far_pixels;
                     stray += bg ? 0 : 1;
                 }
