@@ -227,12 +227,42 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
     out[0].s = glm::cross(t0, r0);
 
     Transporter transport(in, settings, stats);
+    // A step that crosses whole segments (LOD below the node resolution: an interval spanning several segments)
+    // is carried through every segment boundary it crosses, so the frames equal those of one ring per segment at
+    // the rings both have (no twist pop when spans merge or split). Boundaries pa.segment+1 .. end-1 lie between.
+    const std::size_t n_seg = in.curve != nullptr ? in.curve->segment_count() : 0;
+    auto boundary_end = [&](const RingParam& pb, bool wrap) -> std::size_t {
+        return wrap ? n_seg : static_cast<std::size_t>(pb.segment) + (pb.t > 0.0 ? 1 : 0);
+    };
+    auto crosses = [&](const RingParam& pa, const RingParam& pb, bool wrap) {
+        return n_seg != 0 && boundary_end(pb, wrap) > static_cast<std::size_t>(pa.segment) + 1;
+    };
+    auto carry = [&](const RingParam& pa, const Sample& a, glm::dvec3 r, const RingParam& pb, const Sample& b,
+                     bool wrap) {
+        const std::size_t end = boundary_end(pb, wrap);
+        uint32_t seg = pa.segment;
+        double ta = pa.t;
+        Sample cur = a;
+        for (std::size_t k = static_cast<std::size_t>(pa.segment) + 1; k < end; ++k) {
+            const CubicBezier& c = in.curve->segments[k];
+            Sample next{c.b0 - in.origin_m, unit_tangent(c, 0.0)};
+            if (next.t == glm::dvec3(0.0)) next.t = cur.t;
+            r = transport.step(seg, ta, cur, r, 1.0, next);
+            seg = static_cast<uint32_t>(k);
+            ta = 0.0;
+            cur = next;
+        }
+        const double tb = !wrap && pb.segment == seg ? pb.t : 1.0;
+        return transport.step(seg, ta, cur, r, tb, b);
+    };
     auto general_step = [&](std::size_t i, const glm::dvec3& r_prev) {
         const RingParam& pa = in.params[i - 1];
         const RingParam& pb = in.params[i];
+        const Sample a{in.centre_m[i - 1], out[i - 1].t};
+        const Sample b{in.centre_m[i], out[i].t};
+        if (crosses(pa, pb, false)) return carry(pa, a, r_prev, pb, b, false);
         const double tb = pb.segment == pa.segment ? pb.t : 1.0;
-        return transport.step(pa.segment, pa.t, Sample{in.centre_m[i - 1], out[i - 1].t}, r_prev, tb,
-                              Sample{in.centre_m[i], out[i].t});
+        return transport.step(pa.segment, pa.t, a, r_prev, tb, b);
     };
     if (settings.method == FrameMethod::double_reflection) {
         // Pass 1, independent per step: the product of the two reflections as one matrix,
@@ -247,7 +277,8 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             const Sample a{in.centre_m[i - 1], out[i - 1].t};
             const Sample b{in.centre_m[i], out[i].t};
             glm::dvec3 w1{}, w2{};
-            if (mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
+            if (!crosses(in.params[i - 1], in.params[i], false) &&
+                mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
                 const double k = glm::dot(w2, w1);
                 glm::dmat3 m(1.0);
                 for (int c = 0; c < 3; ++c) {  // column c: e_c - w1 w1_c - w2 w2_c + k w2 w1_c
@@ -283,8 +314,11 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
     if (closed && n >= 1) {
         // Transport once more, from the last ring back to ring 0 (t = 1 of the last segment), and measure the twist.
         const RingParam& pa = in.params[n - 1];
-        const glm::dvec3 r_end = transport.step(pa.segment, pa.t, Sample{in.centre_m[n - 1], out[n - 1].t},
-                                                out[n - 1].r, 1.0, Sample{in.centre_m[0], out[0].t});
+        const Sample a{in.centre_m[n - 1], out[n - 1].t};
+        const Sample b{in.centre_m[0], out[0].t};
+        const glm::dvec3 r_end = crosses(pa, in.params[0], true)
+                                     ? carry(pa, a, out[n - 1].r, in.params[0], b, true)
+                                     : transport.step(pa.segment, pa.t, a, out[n - 1].r, 1.0, b);
         const double delta = std::atan2(glm::dot(glm::cross(out[0].r, r_end), out[0].t), glm::dot(out[0].r, r_end));
         stats.holonomy_rad = delta;
         if (!settings.keep_holonomy && delta != 0.0) {

@@ -230,95 +230,542 @@ void mark_culled(WireLod& lod, bool& changed) {
     lod.visible_segments = 0;
     lod.clamped_segments = 0;
     lod.changed_counts = 0;
+    lod.spans = 0;
+    lod.bounded = false;
 }
 
-}  // namespace
+double distance_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
+    const glm::dvec3 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
 
-bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
-                const BoundingSphere* bounds) {
-    if (bounds != nullptr && bounds->radius_m >= 0.0) {
+struct Sphere {
+    glm::dvec3 c;
+    double r;
+};
+
+// Smallest sphere enclosing two spheres.
+Sphere merge_spheres(const Sphere& a, const Sphere& b) {
+    const glm::dvec3 d = b.c - a.c;
+    const double dist = glm::length(d);
+    if (dist + b.r <= a.r) return a;
+    if (dist + a.r <= b.r) return b;
+    const double r = 0.5 * (dist + a.r + b.r);
+    return {a.c + d * ((r - a.r) / dist),
+            r * (1.0 + 1e-12)};  // rounding of the centre must not leave a point out
+}
+
+// Per-update working memory of one thread (grows once, then reused).
+struct Scratch {
+    std::vector<double> x, y, z;  // view-space control points, 4 per segment (structure of arrays)
+    std::vector<double> z_min, k;
+    std::vector<unsigned char> outside;
+    std::vector<uint32_t> old_counts;
+};
+Scratch& scratch() {
+    thread_local Scratch s;
+    return s;
+}
+
+// The span hierarchy walk: one pass over the nodes from the root, merging into one ring interval every node
+// whose chord deviation meets the tolerance: for `required` at the tolerance itself, for `counts` at the
+// hysteresis threshold (1 for a span merged in `old`, 1 / (1 + band) for a new one; never looser, so a counts
+// span always lies inside a required span). A node costs one depth (a dot product) when the wire's sphere is
+// inside the frustum; otherwise its inflated sphere is also tested against the planes (an off-screen span is
+// one interval).
+class SpanMerger {
+public:
+    // inside: the wire's sphere lies inside the frustum, and k bounds the off-axis factor over it.
+    SpanMerger(const LodBounds& b, const LodView& view, double eps, bool inside, double k, bool closed,
+               bool coarse_offscreen, double new_span_scale, std::span<const uint32_t> old)
+        : b_(b),
+          view_(view),
+          tf_(view),
+          c_(view.focal_px / eps),
+          k_(k),
+          k_cap_(std::sqrt(1.0 + view.tan_half_x * view.tan_half_x + view.tan_half_y * view.tan_half_y)),
+          closed_(closed),
+          inside_(inside),
+          coarse_offscreen_(coarse_offscreen),
+          new_scale_(new_span_scale),
+          old_(old),
+          sx_(std::sqrt(1.0 + view.tan_half_x * view.tan_half_x)),
+          sy_(std::sqrt(1.0 + view.tan_half_y * view.tan_half_y)) {}
+
+    [[nodiscard]] std::size_t root_level() const { return b_.level_offset.size() - 2; }
+    [[nodiscard]] std::size_t first(std::size_t level, std::size_t j) const { return j << level; }
+    [[nodiscard]] std::size_t last(std::size_t level, std::size_t j) const {
+        return std::min((j + 1) << level, b_.segments);
+    }
+
+    // Deviation over the tolerance at the node's nearest depth (<= 1: one interval meets the tolerance).
+    [[nodiscard]] double ratio(std::size_t level, std::size_t j) const {
+        const std::size_t s = first(level, j), e = last(level, j);
+        if (e - s > 1 && closed_ && 3 * (e - s) > b_.segments) {
+            return std::numeric_limits<double>::infinity();  // a loop keeps >= 3 intervals
+        }
+        const std::size_t i = b_.level_offset[level] + j;
+        const glm::dvec3 p(b_.span_x[i], b_.span_y[i], b_.span_z[i]);
+        const double r = b_.span_r[i];
+        const glm::dmat3& m = tf_.rotation;
+        const double z = -((m[0][2] * p.x + m[1][2] * p.y + m[2][2] * p.z) + tf_.translation.z);
+        if (!inside_) {
+            // Part of the wire is off screen: a span's chord may leave the screen, where the screen-edge cap
+            // of the off-axis factor does not hold; bound it over the span's own sphere instead (uncapped).
+            const glm::dvec3 q = tf_(p);
+            if (coarse_offscreen_) {
+                const double ri = r + b_.radius_max_m;
+                const bool out =
+                    q.x + q.z * view_.tan_half_x < -ri * sx_ || q.z * view_.tan_half_x - q.x < -ri * sx_ ||
+                    q.y + q.z * view_.tan_half_y < -ri * sy_ || q.z * view_.tan_half_y - q.y < -ri * sy_ ||
+                    q.z - view_.near_m < -ri || view_.far_m - q.z < -ri;
+                if (out) return 0.0;
+            }
+            double k = k_cap_;  // a span reaching behind the near plane: clamped as the per-segment pass does
+            if (z - r >= view_.near_m) {
+                const double a = (std::abs(q.x) + r) / (z - r), b = (std::abs(q.y) + r) / (z - r);
+                k = std::sqrt(1.0 + a * a + b * b);
+            }
+            return b_.span_deviation[i] * c_ * k / std::max(z - r, view_.near_m);
+        }
+        return b_.span_deviation[i] * c_ * k_ / std::max(z - r, view_.near_m);
+    }
+
+    [[nodiscard]] double counts_scale(std::size_t level, std::size_t j) const {
+        return was_merged(first(level, j), last(level, j)) ? 1.0 : new_scale_;
+    }
+
+    // Writes the spans into `required` and `counts` (other segments keep their values). Returns the number of
+    // counts intervals that cross more than one segment.
+    // For a wire inside the frustum: its depth range [z_lo, z_hi] decides whole levels of the hierarchy from
+    // the per-level deviation range, so the walk evaluates only the levels in between (usually one or two).
+    void set_depth_range(double z_lo, double z_hi) {
+        if (!inside_) return;
+        const std::size_t levels = b_.level_offset.size() - 1;
+        fit_level_ = -1;
+        fail_level_ = levels;
+        const double zh = std::max(z_hi, view_.near_m);
+        for (std::size_t l = 0; l < levels; ++l) {
+            const bool loop_limit = l > 0 && closed_ && 3 * (std::size_t{1} << l) > b_.segments;
+            if (!loop_limit && b_.level_deviation_max[l] * c_ * k_ <= new_scale_ * z_lo) {
+                fit_level_ = static_cast<std::ptrdiff_t>(l);
+            }
+            if (b_.level_deviation_min[l] * c_ * k_ > zh && fail_level_ == levels) fail_level_ = l;
+        }
+    }
+
+    uint32_t apply(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
+        uint32_t spans = 0;
+        walk(root_level(), 0, false, required, counts, spans);
+        return spans;
+    }
+
+private:
+    [[nodiscard]] bool was_merged(std::size_t s, std::size_t e) const {
+        if (s >= old_.size() || old_[s] != 1) return false;
+        for (std::size_t i = s + 1; i < e; ++i)
+            if (old_[i] != 0) return false;
+        return true;
+    }
+    static void set_span(std::vector<uint32_t>& v, std::size_t s, std::size_t e) {
+        v[s] = 1;
+        for (std::size_t i = s + 1; i < e; ++i) v[i] = 0;
+    }
+    void walk(std::size_t level, std::size_t j, bool required_done, std::vector<uint32_t>& required,
+              std::vector<uint32_t>& counts, uint32_t& spans) const {
+        const std::size_t s = first(level, j), e = last(level, j);
+        if (s >= e) return;
+        // Levels the wire-wide bounds decide: every node fits (at the strictest threshold), or none does.
+        const double r = level >= fail_level_ ? std::numeric_limits<double>::infinity()
+                         : static_cast<std::ptrdiff_t>(level) <= fit_level_ ? 0.0
+                                                                            : ratio(level, j);
+        if (!required_done && r <= 1.0) {
+            set_span(required, s, e);
+            required_done = true;
+        }
+        if (r <= new_scale_ ||
+            (r <= 1.0 && was_merged(s, e))) {  // counts_scale() without the scan when decided
+            set_span(counts, s, e);
+            spans += e - s > 1 ? 1u : 0u;
+            return;
+        }
+        if (level == 0) return;
+        walk(level - 1, 2 * j, required_done, required, counts, spans);
+        walk(level - 1, 2 * j + 1, required_done, required, counts, spans);
+    }
+
+    const LodBounds& b_;
+    const LodView& view_;
+    ViewTransform tf_;
+    double c_, k_, k_cap_;
+    std::ptrdiff_t fit_level_ = -1;
+    std::size_t fail_level_ = std::numeric_limits<std::size_t>::max();
+    bool closed_;
+    bool inside_;
+    bool coarse_offscreen_;
+    double new_scale_;
+    std::span<const uint32_t> old_;
+    double sx_, sy_;
+};
+
+struct Limits {
+    double eps;
+    uint32_t max_rings, max_sides;
+    double band;
+    explicit Limits(const LodSettings& settings)
+        : eps(tolerance_or_default(settings.tolerance_px)),
+          max_rings(settings.max_rings_per_segment ? settings.max_rings_per_segment : default_max_rings),
+          max_sides(std::max<uint32_t>(settings.max_sides ? settings.max_sides : default_max_sides, 3)),
+          band(settings.hysteresis_band == 0.0 ? default_band : settings.hysteresis_band) {}
+};
+
+// Per-segment pass: required Wang counts (and visibility, depth) of every segment, structure-of-arrays so the
+// transform and the depth/off-axis loops vectorize. Returns false if the wire is culled by the hull test.
+// Control points to view space (structure of arrays) and every segment's hull depth and off-axis factor, into
+// scratch(): x, y, z, z_min, k.
+void hull_depths(const Curve& curve, const LodView& view) {
+    const std::size_t n = curve.segment_count();
+    Scratch& sc = scratch();
+    sc.x.resize(4 * n);
+    sc.y.resize(4 * n);
+    sc.z.resize(4 * n);
+    sc.z_min.resize(n);
+    sc.k.resize(n);
+    sc.outside.resize(n);
+    // World -> view for every control point (the same arithmetic as ViewTransform: rotation * p +
+    // translation).
+    const ViewTransform tf(view);
+    const glm::dmat3& m = tf.rotation;
+    const glm::dvec3 t = tf.translation;
+    const double* p = &curve.segments[0].b0.x;  // CubicBezier is 4 dvec3: 12 doubles
+    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
+    double* xs = sc.x.data();
+    double* ys = sc.y.data();
+    double* zs = sc.z.data();
+    for (std::size_t i = 0; i < 4 * n; ++i) {
+        const double px = p[3 * i], py = p[3 * i + 1], pz = p[3 * i + 2];
+        xs[i] = (m[0][0] * px + m[1][0] * py + m[2][0] * pz) + t.x;
+        ys[i] = (m[0][1] * px + m[1][1] * py + m[2][1] * pz) + t.y;
+        zs[i] = -((m[0][2] * px + m[1][2] * py + m[2][2] * pz) + t.z);
+    }
+    // Hull depth and off-axis factor per segment (hull_depth() without branches).
+    const double near = view.near_m, tx = view.tan_half_x, ty = view.tan_half_y;
+    double* zmin = sc.z_min.data();
+    double* ks = sc.k.data();
+    for (std::size_t i = 0; i < n; ++i) {
+        double z = std::numeric_limits<double>::infinity(), a = 0.0, b = 0.0;
+        for (std::size_t c = 0; c < 4; ++c) {
+            const double qz = zs[4 * i + c];
+            const double den = std::max(qz, near);
+            z = std::min(z, qz);
+            a = std::max(a, std::abs(xs[4 * i + c]) / den);
+            b = std::max(b, std::abs(ys[4 * i + c]) / den);
+        }
+        const bool in_front = z >= near;
+        a = in_front ? std::min(a, tx) : tx;
+        b = in_front ? std::min(b, ty) : ty;
+        zmin[i] = std::max(z, near);
+        ks[i] = std::sqrt(1.0 + a * a + b * b);
+    }
+}
+
+bool per_segment_required(const Curve& curve, const LodView& view, const LodSettings& settings,
+                          const Limits& lim, const LodBounds* bounds, double radius, WireLod& lod,
+                          double& wire_z, double& wire_k) {
+    const std::size_t n = curve.segment_count();
+    hull_depths(curve, view);
+    Scratch& sc = scratch();
+    const double* xs = sc.x.data();
+    const double* ys = sc.y.data();
+    const double* zs = sc.z.data();
+    const double* zmin = sc.z_min.data();
+    const double* ks = sc.k.data();
+    const PlaneTest planes(view, radius);
+    unsigned wire_outside = 63u;
+    for (std::size_t i = 0; i < n; ++i) {
+        unsigned o = 63u;
+        for (std::size_t c = 0; c < 4; ++c)
+            o &= planes.outside(glm::dvec3(xs[4 * i + c], ys[4 * i + c], zs[4 * i + c]));
+        sc.outside[i] = static_cast<unsigned char>(o);
+        wire_outside &= o;
+    }
+    if (wire_outside != 0) return false;
+
+    lod.required.resize(n);
+    wire_z = std::numeric_limits<double>::infinity();
+    wire_k = 1.0;
+    const double scale = lim.eps / view.focal_px;
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool seg_visible = sc.outside[i] == 0;
+        uint32_t raw = 1;
+        if (seg_visible || !settings.coarse_offscreen_segments) {
+            const double eps_world = scale * zmin[i] / ks[i];
+            const double mm = bounds != nullptr
+                                  ? bounds->wang_m[i]
+                                  : std::max(glm::length(curve.segments[i].b0 - 2.0 * curve.segments[i].b1 +
+                                                         curve.segments[i].b2),
+                                             glm::length(curve.segments[i].b1 - 2.0 * curve.segments[i].b2 +
+                                                         curve.segments[i].b3));
+            // wang_ring_count() on the cached M.
+            if (!(eps_world > 0.0) || !std::isfinite(mm)) {
+                raw = lim.max_rings;
+            } else {
+                const double c = std::ceil(std::sqrt(3.0 * mm / (4.0 * eps_world)));
+                raw = !(c < static_cast<double>(lim.max_rings))
+                          ? lim.max_rings
+                          : std::max<uint32_t>(1, static_cast<uint32_t>(c));
+                if (raw >= lim.max_rings && !(c <= static_cast<double>(lim.max_rings)))
+                    ++lod.clamped_segments;
+            }
+            if (seg_visible) {
+                ++lod.visible_segments;
+                wire_z = std::min(wire_z, zmin[i]);
+                wire_k = std::max(wire_k, ks[i]);
+            }
+        }
+        lod.required[i] = raw;
+    }
+    return true;
+}
+
+bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
+                     const LodBounds& bounds, bool sphere_cull, bool use_bound) {
+    const std::size_t n = curve.segment_count();
+    if (sphere_cull && bounds.sphere.radius_m >= 0.0) {
         const ViewTransform tf(view);
-        if (PlaneTest(view, bounds->radius_m).outside(tf(bounds->centre_m)) != 0) {
+        if (PlaneTest(view, bounds.sphere.radius_m).outside(tf(bounds.sphere.centre_m)) != 0) {
             bool changed = false;
             mark_culled(lod, changed);
             return changed;
         }
     }
-    const double eps = tolerance_or_default(settings.tolerance_px);
-    const uint32_t max_rings = settings.max_rings_per_segment ? settings.max_rings_per_segment : default_max_rings;
-    const uint32_t max_sides = std::max<uint32_t>(settings.max_sides ? settings.max_sides : default_max_sides, 3);
-    const double band = settings.hysteresis_band == 0.0 ? default_band : settings.hysteresis_band;
-    const std::size_t n = curve.segment_count();
+    if (n == 0) {
+        bool changed = false;
+        mark_culled(lod, changed);
+        return changed;
+    }
+    const Limits lim(settings);
+    const double radius = bounds.radius_max_m;
+    const bool merge = !settings.keep_node_resolution && bounds.segments == n && !bounds.level_offset.empty();
 
-    double radius = 0.0;
-    for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
+    Scratch& sc = scratch();
+    sc.old_counts.assign(lod.counts.begin(), lod.counts.end());
+    const bool restart = sc.old_counts.size() != n;
+    if (restart) sc.old_counts.assign(n, 0);
+    const std::span<const uint32_t> old(sc.old_counts);
 
     lod.clamped_segments = 0;
     lod.changed_counts = 0;
     lod.visible_segments = 0;
+    lod.spans = 0;
+    lod.bounded = false;
 
-    // The hull test: every control point to view space once, the planes each segment's hull is entirely outside
-    // of, and their intersection over the wire (non-zero: the whole wire is outside one plane: culled).
-    thread_local std::vector<ViewHull> hulls;
-    thread_local std::vector<unsigned char> outside;
-    hulls.resize(n);
-    outside.resize(n);
-    const ViewTransform tf(view);
-    const PlaneTest planes(view, radius);
-    unsigned wire_outside = 63u;
-    for (std::size_t i = 0; i < n; ++i) {
-        hulls[i] = tf.hull(curve.segments[i]);
-        outside[i] = static_cast<unsigned char>(planes.outside(hulls[i]));
-        wire_outside &= outside[i];
+    // The per-wire bound (sphere of the whole wire), also the spans' off-axis factor (every span lies
+    // inside).
+    SphereScreenBound sb;
+    if (bounds.sphere.radius_m >= 0.0) {
+        sb = sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
+    } else {
+        sb.k = std::sqrt(1.0 + view.tan_half_x * view.tan_half_x + view.tan_half_y * view.tan_half_y);
     }
-    if (n == 0 || wire_outside != 0) {
+    SpanMerger merger(bounds, view, lim.eps, sb.inside, sb.k, curve.closed,
+                      settings.coarse_offscreen_segments, lim.band < 0.0 ? 1.0 : 1.0 / (1.0 + lim.band), old);
+    merger.set_depth_range(sb.z_lo_m, sb.z_hi_m);
+
+    // A sphere inside the frustum whose conservative side count is 3 (so the exact one is too) is decided
+    // here.
+    bool decided = false, whole = false;
+    double wire_z = std::numeric_limits<double>::infinity();
+    double wire_k = 1.0;
+    if (use_bound && bounds.sphere.radius_m >= 0.0 && sb.inside) {
+        const std::size_t root = merger.root_level();
+        if (merge && merger.ratio(root, 0) <= merger.counts_scale(root, 0)) {
+            // The whole wire is one interval for the counts (hysteresis threshold), so for the tolerance too.
+            lod.required.assign(n, 0);
+            lod.required[0] = 1;
+            lod.counts.assign(n, 0);
+            lod.counts[0] = 1;
+            lod.spans = n > 1 ? 1u : 0u;
+            decided = true;
+            whole = true;
+        } else if (one_ring_per_segment(bounds, sb)) {
+            lod.required.assign(n, 1);
+            decided = true;
+        }
+        if (decided) {
+            lod.bounded = true;
+            lod.visible_segments = static_cast<uint32_t>(n);  // the sphere is inside the frustum
+            if (sides_for_radius(radius, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) == 3) {
+                wire_z = sb.z_lo_m;  // the conservative side count is the least: so is the exact one
+                wire_k = sb.k;
+            } else {
+                hull_depths(curve, view);  // the exact side count needs the segments' depths
+                const Scratch& d = scratch();
+                for (std::size_t i = 0; i < n; ++i) {
+                    wire_z = std::min(wire_z, d.z_min[i]);
+                    wire_k = std::max(wire_k, d.k[i]);
+                }
+            }
+        }
+    }
+    if (!decided && !per_segment_required(curve, view, settings, lim, &bounds, radius, lod, wire_z, wire_k)) {
         bool changed = false;
         mark_culled(lod, changed);
         return changed;
     }
 
-    const bool restart = lod.counts.size() != n;
-    if (restart) lod.counts.assign(n, 0);
-    lod.required.resize(n);
     lod.visible = true;
-
-    double wire_z = std::numeric_limits<double>::infinity();
-    double wire_k = 1.0;
-    bool changed = restart;
-    for (std::size_t i = 0; i < n; ++i) {
-        const CubicBezier& c = curve.segments[i];
-        uint32_t raw = 1;
-        const bool seg_visible = outside[i] == 0;
-        if (seg_visible || !settings.coarse_offscreen_segments) {
-            const HullDepth h = hull_depth(hulls[i], view);
-            bool clamped = false;
-            raw = wang_px(c, h, view, eps, max_rings, &clamped);
-            lod.clamped_segments += clamped ? 1u : 0u;
-            if (seg_visible) {
-                ++lod.visible_segments;
-                wire_z = std::min(wire_z, h.z_min);
-                wire_k = std::max(wire_k, h.k);
-            }
-        }
-        lod.required[i] = raw;
-        const uint32_t next = hysteresis_count(lod.counts[i], raw, band);
-        if (next != lod.counts[i]) {
-            ++lod.changed_counts;
-            changed = true;
-        }
-        lod.counts[i] = next;
+    if (!whole) {
+        // Per-segment hysteresis on the Wang counts (all >= 1), then the spans over both.
+        lod.counts.resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+            lod.counts[i] = hysteresis_count(old[i], lod.required[i], lim.band);
+        if (merge) lod.spans = merger.apply(lod.required, lod.counts);
     }
+    bool changed = restart;
+    for (std::size_t i = 0; i < n; ++i) lod.changed_counts += lod.counts[i] != old[i] ? 1u : 0u;
+    changed = changed || lod.changed_counts != 0;
+
     if (lod.visible_segments == 0) {
-        // The wire's hull meets the frustum but no single segment's does (the wire wraps around the view): draw
-        // it coarsely with the fewest sides; nothing of it is on screen.
+        // The wire's hull meets the frustum but no single segment's does (the wire wraps around the view):
+        // draw it coarsely with the fewest sides; nothing of it is on screen.
         wire_z = std::numeric_limits<double>::infinity();
     }
     lod.z_min_m = std::isfinite(wire_z) ? wire_z : 0.0;
-    lod.required_sides = std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, eps, max_sides) : 3u;
-    const uint32_t sides = restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, band);
+    lod.required_sides =
+        std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides) : 3u;
+    const uint32_t sides =
+        restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band);
     changed = changed || sides != lod.sides;
-    lod.sides = std::min(sides, max_sides);
+    lod.sides = std::min(sides, lim.max_sides);
     return changed;
+}
+
+}  // namespace
+
+void compute_lod_bounds(const Curve& curve, LodBounds& out) {
+    const std::size_t n = curve.segment_count();
+    out.segments = n;
+    out.sphere = curve_bounding_sphere(curve);
+    out.radius_max_m = 0.0;
+    for (const float r : curve.radius_m)
+        out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
+    out.wang_m.resize(n);
+    out.wang_m_max = 0.0;
+    out.span_x.clear();
+    out.span_y.clear();
+    out.span_z.clear();
+    out.span_r.clear();
+    out.span_deviation.clear();
+    out.level_offset.clear();
+    out.level_deviation_min.clear();
+    out.level_deviation_max.clear();
+    if (n == 0) return;
+    auto push = [&](const Sphere& sp, double deviation) {
+        out.span_x.push_back(sp.c.x);
+        out.span_y.push_back(sp.c.y);
+        out.span_z.push_back(sp.c.z);
+        out.span_r.push_back(sp.r);
+        out.span_deviation.push_back(deviation);
+    };
+    // Level 0: one node per segment.
+    out.level_offset.push_back(0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const CubicBezier& c = curve.segments[i];
+        out.wang_m[i] =
+            std::max(glm::length(c.b0 - 2.0 * c.b1 + c.b2), glm::length(c.b1 - 2.0 * c.b2 + c.b3));
+        out.wang_m_max = std::max(out.wang_m_max, out.wang_m[i]);
+        const glm::dvec3 lo = glm::min(glm::min(c.b0, c.b1), glm::min(c.b2, c.b3));
+        const glm::dvec3 hi = glm::max(glm::max(c.b0, c.b1), glm::max(c.b2, c.b3));
+        const double hull =
+            std::max(distance_to_chord(c.b1, c.b0, c.b3), distance_to_chord(c.b2, c.b0, c.b3));
+        double deviation = std::min(hull, 0.75 * out.wang_m[i]);
+        if (!std::isfinite(deviation)) deviation = std::numeric_limits<double>::infinity();
+        push(Sphere{0.5 * (lo + hi), 0.5 * glm::length(hi - lo) * (1.0 + 1e-12)}, deviation);
+    }
+    // Level l from level l - 1: a node of two children with chords A-M and M-B.
+    std::size_t width = n, level = 0;
+    while (width > 1) {
+        const std::size_t prev = out.level_offset[level];
+        const std::size_t next_width = (width + 1) / 2;
+        out.level_offset.push_back(static_cast<uint32_t>(out.span_x.size()));
+        ++level;
+        for (std::size_t j = 0; j < next_width; ++j) {
+            const std::size_t l = prev + 2 * j;
+            const Sphere left{{out.span_x[l], out.span_y[l], out.span_z[l]}, out.span_r[l]};
+            if (2 * j + 1 >= width) {
+                push(left, out.span_deviation[l]);
+                continue;
+            }
+            const std::size_t r = l + 1;
+            const Sphere right{{out.span_x[r], out.span_y[r], out.span_z[r]}, out.span_r[r]};
+            const std::size_t s = j << level;
+            const std::size_t mid = s + (std::size_t{1} << (level - 1));
+            const std::size_t e = std::min((j + 1) << level, n);
+            const double deviation =
+                std::max(out.span_deviation[l], out.span_deviation[r]) +
+                distance_to_chord(curve.segments[mid].b0, curve.segments[s].b0, curve.segments[e - 1].b3);
+            push(merge_spheres(left, right), deviation);
+        }
+        width = next_width;
+    }
+    out.level_offset.push_back(static_cast<uint32_t>(out.span_x.size()));
+    const std::size_t levels = out.level_offset.size() - 1;
+    out.level_deviation_min.assign(levels, std::numeric_limits<double>::infinity());
+    out.level_deviation_max.assign(levels, 0.0);
+    for (std::size_t l = 0; l < levels; ++l) {
+        for (std::size_t i = out.level_offset[l]; i < out.level_offset[l + 1]; ++i) {
+            out.level_deviation_min[l] = std::min(out.level_deviation_min[l], out.span_deviation[i]);
+            out.level_deviation_max[l] = std::max(out.level_deviation_max[l], out.span_deviation[i]);
+        }
+    }
+}
+
+SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_m, const LodView& view,
+                                      double tolerance_px) {
+    SphereScreenBound b;
+    const ViewTransform tf(view);
+    const glm::dvec3 q = tf(centre_m);
+    const PlaneTest out(view, radius_m);
+    b.outside = out.outside(q);
+    const double r = radius_m;
+    b.inside = q.x + q.z * out.tx >= out.rx && q.z * out.tx - q.x >= out.rx && q.y + q.z * out.ty >= out.ry &&
+               q.z * out.ty - q.y >= out.ry && q.z - view.near_m >= r && view.far_m - q.z >= r;
+    b.z_lo_m = std::max(q.z - r, view.near_m);
+    b.z_hi_m = q.z + r;
+    double a = view.tan_half_x, c = view.tan_half_y;
+    if (q.z - r > 0.0) {
+        a = std::min(a, (std::abs(q.x) + r) / (q.z - r));
+        c = std::min(c, (std::abs(q.y) + r) / (q.z - r));
+    }
+    b.k = std::sqrt(1.0 + a * a + c * c);
+    b.eps_world_m = tolerance_or_default(tolerance_px) * b.z_lo_m / (view.focal_px * b.k);
+    return b;
+}
+
+bool one_ring_per_segment(const LodBounds& bounds, const SphereScreenBound& b) {
+    // Wang: ceil(sqrt(3M / (4 eps))) == 1 iff 3M <= 4 eps; the margin covers the rounding of eps_world
+    // between the bound and the per-segment evaluation (which uses a larger eps_world anyway).
+    return std::isfinite(bounds.wang_m_max) && 3.0 * bounds.wang_m_max <= 4.0 * b.eps_world_m * (1.0 - 1e-9);
+}
+
+bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
+                const BoundingSphere* bounds) {
+    thread_local LodBounds lb;
+    compute_lod_bounds(curve, lb);
+    if (bounds != nullptr) lb.sphere = *bounds;
+    return update_lod_impl(curve, view, settings, lod, lb, bounds != nullptr && bounds->radius_m >= 0.0,
+                           false);
+}
+
+bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
+                const LodBounds& bounds) {
+    if (bounds.segments != curve.segment_count()) {
+        return update_lod(curve, view, settings, lod, static_cast<const BoundingSphere*>(nullptr));
+    }
+    return update_lod_impl(curve, view, settings, lod, bounds, true, true);
 }
 
 ScreenError measure_screen_error(const Curve& curve, std::span<const RingParam> params, const LodView& view,

@@ -171,8 +171,9 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         ring.radius_m = static_cast<float>(radius);
         ring.segment = p.segment;
 
-        // Arc length and u of the interval to the next ring (always within this segment: a step into the next
-        // segment ends at t = 1 of this one; for a closed wire the last interval returns to ring 0).
+        // Arc length and u of the interval to the next ring: the rest of this segment, every segment the interval
+        // crosses (LOD below the node resolution gives segments no ring of their own), and the next ring's part of
+        // its segment; for a closed wire the last interval returns to ring 0.
         if (i == 0) {
             out.arc_length_m[0] = 0.0;
             out.u[0] = u;
@@ -182,6 +183,14 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             const RingParam b = wrap ? params[0] : params[i + 1];
             const double tb = (!wrap && b.segment == p.segment) ? b.t : 1.0;
             Interval iv = integrate(seg, p.t, tb);
+            if (wrap || b.segment != p.segment) {
+                const std::size_t end = wrap ? curve.segment_count() : b.segment;
+                for (std::size_t k = p.segment + 1; k < end; ++k) {  // crossed segments, whole
+                    const Interval ik = integrate(SegmentCoeffs(curve, static_cast<uint32_t>(k)), 0.0, 1.0);
+                    iv.length_m += ik.length_m;
+                    iv.u += ik.u;
+                }
+            }
             if (!wrap && b.segment != p.segment && b.t > 0.0) {  // custom params: the next segment's part too
                 const Interval ib = integrate(SegmentCoeffs(curve, b.segment), 0.0, b.t);
                 iv.length_m += ib.length_m;

@@ -35,8 +35,9 @@ void segment_ring_counts(const Curve& curve, const TessellateSettings& settings,
 std::size_t ring_count(std::span<const uint32_t> counts, bool closed) {
     std::size_t n = 0;
     for (const uint32_t c : counts) {
-        n += std::max<uint32_t>(c, 1);
+        n += c;
     }
+    if (!counts.empty() && counts[0] == 0) ++n;  // segment 0 always starts a ring
     return n + ((!closed && !counts.empty()) ? 1 : 0);
 }
 
@@ -45,7 +46,7 @@ void place_rings(const Curve& curve, std::span<const uint32_t> counts, std::vect
     out.resize(ring_count(counts, curve.closed));
     std::size_t k = 0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
-        const uint32_t n = std::max<uint32_t>(counts[i], 1);
+        const uint32_t n = i == 0 ? std::max<uint32_t>(counts[i], 1) : counts[i];
         for (uint32_t j = 0; j < n; ++j) {
             // j / n (not j * (1/n)): exactly the rounded k/N the promise names.
             out[k++] = RingParam{static_cast<uint32_t>(i), j == 0 ? 0.0 : static_cast<double>(j) / n};

@@ -31,12 +31,22 @@ TEST(Tessellate, FixedParametersAreExact) {
 
 TEST(Tessellate, ExternalCountsAndDefaults) {
     const Curve c = helix_curve(1.0, 0.3, 1, 4);
-    const std::vector<uint32_t> counts = {1, 0, 3, 2};  // 0 counts as 1
+    // 0: the segment gets no ring (the interval from the previous ring crosses it); segment 0 always gets one.
+    const std::vector<uint32_t> counts = {1, 0, 3, 2};
     std::vector<RingParam> params;
     place_rings(c, counts, params);
-    ASSERT_EQ(params.size(), 1u + 1u + 3u + 2u + 1u);
-    EXPECT_EQ(params[2].segment, 2u);
-    EXPECT_EQ(params[3].t, 1.0 / 3.0);
+    ASSERT_EQ(params.size(), 1u + 0u + 3u + 2u + 1u);
+    EXPECT_EQ(ring_count(counts, false), params.size());
+    EXPECT_EQ(params[0].segment, 0u);
+    EXPECT_EQ(params[1].segment, 2u);
+    EXPECT_EQ(params[1].t, 0.0);
+    EXPECT_EQ(params[2].t, 1.0 / 3.0);
+    const std::vector<uint32_t> first_zero = {0, 0, 0, 0};
+    place_rings(c, first_zero, params);
+    ASSERT_EQ(params.size(), 2u);  // one interval over the whole wire
+    EXPECT_EQ(ring_count(first_zero, false), 2u);
+    EXPECT_EQ(params[1].segment, 3u);
+    EXPECT_EQ(params[1].t, 1.0);
     std::vector<uint32_t> defaults;
     segment_ring_counts(c, TessellateSettings{}, defaults);
     EXPECT_EQ(defaults, std::vector<uint32_t>(4, 8u));

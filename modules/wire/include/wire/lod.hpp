@@ -20,6 +20,28 @@
 // centre line's; for wires thinner than their bend radius (every physical cable) that is a few per cent.
 // z_min is clamped to the near plane: a segment that crosses it is refined as if it touched the near plane, which
 // is what its visible part needs. Points behind the near plane are not on screen and carry no guarantee.
+//
+// Below the node resolution (LodSettings::keep_node_resolution off, the default): one ring interval may span
+// several segments. For a span [s, e) of segments with chord C from its first point to its last, every point of
+// the span's curve is within `deviation` of C, computed once per curve (LodBounds): a segment's deviation is the
+// smaller of its control hull's distance to its chord (the distance to a segment is convex, so its maximum over
+// the hull is at a control point) and Wang's 3M/4 for one ring; a merged span of two halves with chords A-M and
+// M-B has deviation max(d_left, d_right) + dist(M, A-B) (a point within d of A-M is within d + dist(M, A-B) of
+// A-B, again by convexity). The span's curve and chord lie in a sphere enclosing its control points, so the
+// projection argument above holds with z_min and k bounded over that sphere: the span is one interval when
+// deviation * f_px * k <= eps_px * z_lo. k: over the wire's sphere when it lies inside the frustum (the screen
+// edge caps it); otherwise over the span's own sphere, uncapped (a span's chord may leave the screen). The rings of
+// a span still sit at t = 0 of a segment, so every ring keeps its segment and t; a segment with count 0 is crossed
+// by the interval that starts before it. Spans whose inflated sphere is outside the frustum are merged too
+// (coarse_offscreen_segments). A loop keeps at least 3 intervals. Hysteresis: a span merged in the previous update
+// stays merged while it meets the tolerance; a new one merges only below tolerance / (1 + band).
+//
+// The cheap pass (DESIGN 4.5, issue 11): a per-wire conservative bound (sphere_screen_bound) decides most wires
+// without per-segment Wang work: when the wire's sphere lies inside the frustum, either the whole wire merges into
+// one span, or every segment needs one ring (max M <= 4/3 eps_world at the sphere's nearest depth); the exact
+// side count then needs the segments' depths only when the conservative one is above 3. Both give exactly what
+// the per-segment evaluation gives (tested); the other wires take the per-segment path, laid out as
+// structure-of-arrays loops. The span walk visits only the hierarchy levels the wire's depth range leaves open.
 #pragma once
 
 #include "wire/curve.hpp"
@@ -77,19 +99,28 @@ struct LodSettings {
     /// stays in the hull, so off-screen anyway. Off: they are tessellated like visible ones (with z_min clamped to
     /// the near plane, so a segment behind the camera gets the maximum).
     bool coarse_offscreen_segments = true;
+    /// true: at least one ring per segment (the resolution of the nodes). false (default): a ring interval may
+    /// span several segments where the screen error allows (see the header comment); counts of 0 then mark the
+    /// segments an interval crosses.
+    bool keep_node_resolution = false;
 };
 
 /// One wire's LOD state for one camera (kept between frames for hysteresis).
+/// counts[i] == 0 (only without keep_node_resolution): segment i has no ring of its own; the ring interval that
+/// starts on an earlier segment crosses it. counts[0] is >= 1 whenever the wire is visible.
 struct WireLod {
     std::vector<uint32_t> counts;    ///< per segment: rings used (after hysteresis; >= required[i]); empty if culled
-    std::vector<uint32_t> required;  ///< per segment: rings the tolerance needs now (raw Wang count)
+    std::vector<uint32_t> required;  ///< per segment: rings the tolerance needs now (Wang count, or the spans)
     uint32_t sides = 0;              ///< radial sides used (>= required_sides); 0 if culled
     uint32_t required_sides = 0;
     bool visible = false;            ///< the wire's control hull, inflated by its radius, meets the frustum
     uint32_t visible_segments = 0;   ///< segments whose inflated hull meets the frustum
     uint32_t clamped_segments = 0;   ///< segments whose required count hit max_rings_per_segment (bound not met)
     uint32_t changed_counts = 0;     ///< segments whose count changed in the last update (flicker metric)
-    double z_min_m = 0.0;            ///< nearest depth of the visible segments (clamped to the near plane)
+    double z_min_m = 0.0;            ///< nearest depth of the visible segments (clamped to the near plane); a lower
+                                     ///< bound of it when `bounded` and the side count is 3
+    uint32_t spans = 0;              ///< ring intervals that cross more than one segment (in counts)
+    bool bounded = false;            ///< the per-wire bound decided the counts (no per-segment Wang evaluation)
 };
 
 /// A sphere enclosing a wire's tube: every control point of the curve, inflated by its largest radius. Computed
@@ -103,16 +134,62 @@ struct BoundingSphere {
 /// tube radius). An empty curve gives radius -1.
 [[nodiscard]] BoundingSphere curve_bounding_sphere(const Curve& curve);
 
-/// Updates `lod` for `curve` seen by `view`. With `bounds` (from curve_bounding_sphere), a wire whose sphere is
+/// View-independent LOD data of one curve, computed when the curve changes (O(segments)); update_lod() reads it
+/// every frame. The span hierarchy: level 0 holds one node per segment, level l one node per 2^l segments (the
+/// last node of a level may be shorter), up to one root node for the whole wire; node j of level l covers
+/// segments [j 2^l, min((j+1) 2^l, n)). Per node (structure of arrays): a sphere around its control points (not
+/// inflated by the tube radius) and its chord deviation (every curve point of the span is within it of the
+/// chord from the span's first point to its last; see the header comment).
+struct LodBounds {
+    BoundingSphere sphere{};             ///< curve_bounding_sphere(curve)
+    double radius_max_m = 0.0;           ///< largest tube radius
+    double wang_m_max = 0.0;             ///< max over segments of wang_m
+    std::vector<double> wang_m;          ///< per segment: Wang's M = max |B_i - 2B_{i+1} + B_{i+2}|
+    std::vector<double> span_x, span_y, span_z, span_r, span_deviation;  ///< per node, all levels, level 0 first
+    std::vector<uint32_t> level_offset;  ///< first node of each level; one more entry: the node count
+    std::vector<double> level_deviation_min, level_deviation_max;  ///< per level: range of span_deviation
+    std::size_t segments = 0;
+};
+
+/// Fills `out` for `curve` (reuses its capacity).
+void compute_lod_bounds(const Curve& curve, LodBounds& out);
+
+/// The per-wire conservative bound: what one sphere (centre_m, radius_m) tells about the view without looking
+/// inside it. Shared by the LOD pass and anything else that must decide a wire in O(1) per camera.
+struct SphereScreenBound {
+    unsigned outside = 0;      ///< frustum planes the sphere lies entirely outside of (non-zero: nothing visible)
+    bool inside = false;       ///< the sphere lies entirely inside the frustum
+    double z_lo_m = 0.0;       ///< lower bound of the depth over the sphere, clamped to the near plane
+    double z_hi_m = 0.0;       ///< upper bound of the depth over the sphere
+    double k = 1.0;            ///< upper bound of the off-axis factor over the sphere's on-screen points
+    double eps_world_m = 0.0;  ///< tolerance_px converted at (z_lo_m, k): tolerance_px * z_lo_m / (focal_px * k)
+};
+[[nodiscard]] SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_m, const LodView& view,
+                                                    double tolerance_px);
+
+/// True if, by the bound, every segment of the wire needs exactly one ring: Wang's count is 1 for every segment
+/// when max M <= 4/3 eps_world (a strict margin is kept against rounding).
+[[nodiscard]] bool one_ring_per_segment(const LodBounds& bounds, const SphereScreenBound& b);
+
+/// Updates `lod` for `curve` seen by `view`, evaluating every segment (the reference for the cheap pass below).
+/// With `bounds` (from curve_bounding_sphere), a wire whose sphere is
 /// outside one frustum plane is culled in O(1) before any per-segment work: the result is the same as the hull
 /// test's (the sphere contains every inflated control point), only cheaper, so an off-screen wire costs one
 /// sphere test per camera change. Culled wires (no visible segment) get visible = false, empty counts
-/// and sides 0: the caller builds no rings. Otherwise counts holds segment_count() entries >= 1, each at least
-/// what the tolerance requires (hysteresis may keep more, never fewer), and sides in [3, max_sides].
+/// and sides 0: the caller builds no rings. Otherwise counts holds segment_count() entries, >= 1 with
+/// keep_node_resolution (else 0 for segments a span crosses), each at least what the tolerance requires
+/// (hysteresis may keep more, never fewer), and sides in [3, max_sides].
 /// If the segment count differs from the previous update, hysteresis restarts from the raw counts.
 /// Returns whether counts or sides changed (the ring stage can skip the wire otherwise).
 bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
                 const BoundingSphere* bounds = nullptr);
+
+/// The same with the curve's LodBounds (what the wire systems call every frame): the sphere cull, then the
+/// per-wire bound, then the per-segment pass for the wires the bound does not decide. The result equals the
+/// per-segment evaluation's (update_lod without LodBounds) in counts, required, sides, visible, visible_segments
+/// and spans; only z_min_m may be a lower bound (when `bounded`).
+bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
+                const LodBounds& bounds);
 
 /// True if the control points of every segment, inflated by radius_m, are not all outside one frustum plane.
 [[nodiscard]] bool hull_visible(std::span<const CubicBezier> segments, double radius_m, const LodView& view);

@@ -34,9 +34,10 @@ struct TessellateSettings {
 /// Ring count of every segment of `curve` per `settings`, written into `counts` (resized to segment_count()).
 void segment_ring_counts(const Curve& curve, const TessellateSettings& settings, std::vector<uint32_t>& counts);
 
-/// Ring parameters in order along the wire: segment i gets counts[i] rings at t = k/counts[i], k = 0..counts[i]-1
-/// (a count of 0 is treated as 1); an open wire gets one more ring at t = 1 of its last segment, a closed wire does
-/// not (its first ring closes the loop). `out` is resized; no allocation when its capacity suffices.
+/// Ring parameters in order along the wire: segment i gets counts[i] rings at t = k/counts[i], k = 0..counts[i]-1;
+/// a count of 0 gives segment i no ring (the interval from the previous ring crosses it: LOD below the node
+/// resolution), except on segment 0, which always gets at least one; an open wire gets one more ring at t = 1 of
+/// its last segment, a closed wire does not (its first ring closes the loop). `out` is resized; no allocation when its capacity suffices.
 /// counts.size() must equal curve.segment_count().
 void place_rings(const Curve& curve, std::span<const uint32_t> counts, std::vector<RingParam>& out);
 

@@ -49,7 +49,7 @@ bool same_spline(const SplineSettings& a, const SplineSettings& b) {
 bool same_lod(const LodSettings& a, const LodSettings& b) {
     return a.tolerance_px == b.tolerance_px && a.max_rings_per_segment == b.max_rings_per_segment &&
            a.max_sides == b.max_sides && a.hysteresis_band == b.hysteresis_band &&
-           a.coarse_offscreen_segments == b.coarse_offscreen_segments;
+           a.coarse_offscreen_segments == b.coarse_offscreen_segments && a.keep_node_resolution == b.keep_node_resolution;
 }
 
 SplineSettings spline_of(const Style& style) {
@@ -144,7 +144,8 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         ++c.builds;
         if (job.status.ok) {
             ++c.generation;
-            c.bounds = curve_bounding_sphere(c.curve);
+            compute_lod_bounds(c.curve, c.lod_bounds);
+            c.bounds = c.lod_bounds.sphere;
             job.changed = true;
             c.previous_nodes = nodes;
         }
@@ -215,7 +216,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
         settings.max_sides = job.style->max_sides ? job.style->max_sides : kDefaultMaxSides;
         if (base.max_sides != 0) settings.max_sides = std::min(settings.max_sides, base.max_sides);
         WireLodState& s = *job.lod;
-        if (update_lod(job.curve->curve, ctx.view, settings, s.lod, &job.curve->bounds)) ++s.generation;
+        if (update_lod(job.curve->curve, ctx.view, settings, s.lod, job.curve->lod_bounds)) ++s.generation;
         ++s.updates;
         s.seen_curve = job.curve->generation;
         s.seen_view = view_generation;

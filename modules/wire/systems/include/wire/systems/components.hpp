@@ -38,6 +38,7 @@ struct WireCurve {
     SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
     uint64_t generation = 0;           ///< +1 each time `curve` changes
     BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test)
+    LodBounds lod_bounds{};            ///< of `curve`, recomputed with it (the LOD's per-wire bound and spans)
     uint64_t builds = 0;               ///< times the curve stage ran for this wire (test/statistics counter)
     bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
     bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
