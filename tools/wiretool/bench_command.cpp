@@ -44,7 +44,7 @@ Action add_bench_command(CLI::App& app) {
         ->check(CLI::Range(1, 64));
     cmd->add_option("--scenes", o->scenes, "Only these scenes, comma-separated")
         ->delimiter(',')
-        ->check(CLI::IsMember({"standard", "offscreen", "swaying", "catenary", "helix", "stretched_bend",
+        ->check(CLI::IsMember({"standard", "offscreen", "swaying", "far", "catenary", "helix", "stretched_bend",
                                "hairpin", "random_walk", "churn"}));
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
     cmd->add_flag(

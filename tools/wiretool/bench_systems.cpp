@@ -44,7 +44,7 @@ constexpr float kRadiusM = 0.015f;
 constexpr int kSystems = 5;
 constexpr const char* kSystemNames[kSystems] = {"curve", "lod", "rings", "mesh", "draw_list"};
 
-enum class SceneKind { standard, offscreen, swaying };
+enum class SceneKind { standard, offscreen, swaying, far };
 
 const char* scene_name(SceneKind k) {
     switch (k) {
@@ -54,6 +54,8 @@ const char* scene_name(SceneKind k) {
             return "offscreen";
         case SceneKind::swaying:
             return "swaying";
+        case SceneKind::far:
+            return "far";
     }
     return "?";
 }
@@ -74,6 +76,68 @@ wire::WireNodes hanging_wire(int i) {
     return n;
 }
 
+// `far`: a 2 km x 2 km landscape (rolling ground) with 10,000 cables of 64 nodes: power lines (three
+// conductors per span, 120-260 m spans between 18-26 m towers, sagging 2-4%) along 12 routes, and rigging (mast
+// stays, crane and ship rigging, 12-45 m, sloped, 1-3% slack) in 60 clusters. Deterministic in i.
+double ground_m(double x, double z) { return 12.0 * std::sin(x / 310.0) * std::cos(z / 270.0) + 6.0 * std::sin(z / 130.0); }
+
+struct FarWire {
+    wire::WireNodes nodes;
+    float radius_m = 0.015f;
+};
+
+FarWire far_wire(int i) {
+    constexpr int kPower = 6000;  // the rest are rigging
+    glm::dvec3 p1, p2;
+    double slack = 1.02;
+    float radius = 0.015f;
+    auto hash = [](int a, int b) {  // a fixed pseudo-random number in [0, 1)
+        const double v = std::sin(12.9898 * a + 78.233 * b) * 43758.5453;
+        return v - std::floor(v);
+    };
+    if (i < kPower) {
+        const int route = i % 12, k = i / 12;  // k: 500 conductors per route
+        const int span = k / 3, phase = k % 3;
+        const double angle = 0.4 + 0.52 * route + 0.1 * hash(route, 1);
+        const glm::dvec3 dir(std::cos(angle), 0.0, std::sin(angle));
+        const glm::dvec3 side(-dir.z, 0.0, dir.x);
+        const glm::dvec3 start(-900.0 + 150.0 * route, 0.0, -950.0 + 60.0 * route);
+        const double s0 = 190.0 * span, s1 = s0 + 120.0 + 140.0 * hash(route, span);
+        auto tower = [&](double s) {
+            glm::dvec3 p = start + dir * std::fmod(s, 2400.0) + side * (3.5 * (phase - 1));
+            p.x = std::fmod(p.x + 3000.0, 2000.0) - 1000.0;
+            p.z = std::fmod(p.z + 3000.0, 2000.0) - 1000.0;
+            p.y = ground_m(p.x, p.z) + 18.0 + 8.0 * hash(route, static_cast<int>(s));
+            return p;
+        };
+        p1 = tower(s0);
+        p2 = p1 + dir * (s1 - s0);
+        p2.y = ground_m(p2.x, p2.z) + 18.0 + 8.0 * hash(route, span + 7);
+        slack = 1.02 + 0.02 * hash(i, 3);
+        radius = 0.015f;
+    } else {
+        const int j = i - kPower, cluster = j % 60, k = j / 60;
+        const glm::dvec3 base(-950.0 + 1900.0 * hash(cluster, 11), 0.0, -950.0 + 1900.0 * hash(cluster, 13));
+        const double mast = 15.0 + 30.0 * hash(cluster, 17);
+        const double a = 6.2831853 * hash(cluster * 97 + k, 19);
+        const double reach = 12.0 + 30.0 * hash(cluster * 89 + k, 23);
+        p1 = base + glm::dvec3(0.0, ground_m(base.x, base.z) + mast * (0.5 + 0.5 * hash(k, 29)), 0.0);
+        p2 = base + glm::dvec3(reach * std::cos(a), 0.0, reach * std::sin(a));
+        p2.y = ground_m(p2.x, p2.z) + 1.0 + 6.0 * hash(k, 31);
+        slack = 1.01 + 0.02 * hash(i, 37);
+        radius = 0.008f + 0.012f * static_cast<float>(hash(i, 41));
+    }
+    const double length_m = glm::length(p2 - p1) * slack;
+    wire::Catenary cable;
+    (void)cable.solve(p1, p2, length_m);  // never vertically aligned: every cable has a horizontal run
+    std::vector<double> s(kNodes);
+    for (int k = 0; k < kNodes; ++k) s[static_cast<std::size_t>(k)] = length_m * k / (kNodes - 1);
+    FarWire w;
+    w.nodes.positions = cable.points_at_arc_lengths(s);
+    w.radius_m = radius;
+    return w;
+}
+
 // standard/swaying: flies slowly into the field, swaying, so every frame moves the camera. offscreen: the
 // same motion sideways, 12 m in front of the field and looking away from it: every wire is behind the camera.
 void place_camera(engine::scene::Camera& cam, SceneKind kind, int frame) {
@@ -81,6 +145,13 @@ void place_camera(engine::scene::Camera& cam, SceneKind kind, int frame) {
     if (kind == SceneKind::offscreen) {
         cam.position = {3.0f * std::sin(0.02f * t), 5.0f + std::sin(0.03f * t), 12.0f};
         cam.target = cam.position + glm::vec3(0.4f * std::sin(0.01f * t), -0.15f, 1.0f);
+        return;
+    }
+    if (kind == SceneKind::far) {
+        // Flying over the landscape 45 m up, along a gentle curve, looking ahead and a little down.
+        const float x = -700.0f + 2.5f * t, z = -600.0f + 1.5f * t + 40.0f * std::sin(0.01f * t);
+        cam.position = {x, static_cast<float>(ground_m(x, z)) + 45.0f, z};
+        cam.target = cam.position + glm::vec3(0.8f + 0.1f * std::sin(0.02f * t), -0.12f, 0.6f);
         return;
     }
     cam.position = {3.0f * std::sin(0.02f * t), 5.0f + std::sin(0.03f * t), 8.0f - 0.15f * t};
@@ -128,10 +199,16 @@ SceneRun run_scene(const RunSpec& spec) {
     ctx.viewport_width_px = 1920;
     ctx.viewport_height_px = 1080;
     ctx.camera.aspect = 16.0f / 9.0f;
-    ctx.camera.far_m = 500.0f;
+    ctx.camera.far_m = spec.kind == SceneKind::far ? 3000.0f : 500.0f;
     ctx.lod.tolerance_px = kTolerancePx;
     std::vector<Entity> wires;
     for (int i = 0; i < spec.wires; ++i) {
+        if (spec.kind == SceneKind::far) {
+            FarWire w = far_wire(i);
+            wires.push_back(wire::systems::spawn_wire(registry, std::move(w.nodes),
+                                                      {.radius_m = w.radius_m, .material = static_cast<uint32_t>(i % 4)}));
+            continue;
+        }
         wires.push_back(wire::systems::spawn_wire(
             registry, hanging_wire(i), {.radius_m = kRadiusM, .material = static_cast<uint32_t>(i % 4)}));
     }
@@ -202,7 +279,8 @@ SceneRun run_scene(const RunSpec& spec) {
             s.curves.push_back(registry.get<wire::systems::WireCurve>(e).curve);
             const wire::WireLod& lod = registry.get<wire::systems::WireLodState>(e).lod;
             if (lod.z_min_m > 0.0) {
-                const double r_px = kRadiusM * ctx.view.focal_px / lod.z_min_m;
+                const double radius = registry.get<wire::systems::Style>(e).radius_m;
+                const double r_px = radius * ctx.view.focal_px / lod.z_min_m;
                 s.max_radial_scale_px = std::max(s.max_radial_scale_px, r_px);
                 s.adaptive_radial_px =
                     std::max(s.adaptive_radial_px, r_px * (1.0 - std::cos(std::numbers::pi / item.sides)));
@@ -413,7 +491,6 @@ struct GlCheck {
 
 int run_systems_bench(const Options& o) {
     const int frames = o.quick ? 16 : 120;
-    const int wires = 1000;
     const int error_samples = o.quick ? 2 : 3;
     Table csv;
     csv.header = {"scene",          "method",           "mode",          "tolerance_px",
@@ -424,7 +501,8 @@ int run_systems_bench(const Options& o) {
     double standard_cpu_ms = 0.0, offscreen_cpu_ms = -1.0;
     double bytes_cpu = 0.0, bytes_gpu = 0.0;
     double adaptive_vertices_at_samples = 0.0, uniform_vertices_at_samples = 0.0;
-    std::array<double, kSystems> standard_systems{};
+    double far_adaptive_vertices = 0.0, far_uniform_vertices = 0.0, far_cpu_ms = -1.0;
+    std::array<double, kSystems> standard_systems{}, far_systems{};
     std::string thread_lines;
     GlCheck gl;
     std::string gl_note;
@@ -435,9 +513,10 @@ int run_systems_bench(const Options& o) {
         gl_note = "- --gl: no headless GL context (" + gl.error + "); bytes are computed only.\n";
     const bool use_gl = o.gl && gl_note.empty();
 
-    for (SceneKind kind : {SceneKind::standard, SceneKind::offscreen, SceneKind::swaying}) {
+    for (SceneKind kind : {SceneKind::standard, SceneKind::offscreen, SceneKind::swaying, SceneKind::far}) {
         const std::string name = scene_name(kind);
         if (!selected(o, name)) continue;
+        const int wires = kind == SceneKind::far ? 10000 : 1000;
         const int scene_frames = kind == SceneKind::swaying && o.quick ? 8 : frames;
         SceneRun cpu_run, gpu_run;
         for (wire::UploadPath path : {wire::UploadPath::cpu_mesh, wire::UploadPath::gpu_rings}) {
@@ -509,21 +588,27 @@ int run_systems_bench(const Options& o) {
             cpu_run.samples.size());
         notes += buf;
 
+        // Adaptive and uniform vertices at the same sampled frames (same visible wires).
+        auto vertices_at_samples = [&](double& adaptive, double& uniform) {
+            for (const Sample& s : cpu_run.samples) {
+                adaptive += static_cast<double>(s.adaptive_vertices);
+                for (const wire::Curve& c : s.curves) {
+                    const std::size_t r = u.rings_per_segment * c.segment_count() + 1;
+                    uniform += static_cast<double>(wire::tube_counts(r, false, {.sides = u.sides}).vertices);
+                }
+            }
+        };
         if (kind == SceneKind::standard) {
             standard_cpu_ms = median(cpu_run.frame_cpu_ms);
             standard_systems = system_medians(cpu_run);
             bytes_cpu = median(cpu_run.bytes);
             bytes_gpu = median(gpu_run.bytes);
-            for (const Sample& s : cpu_run.samples)
-                adaptive_vertices_at_samples += static_cast<double>(s.adaptive_vertices);
-            // The uniform count at the same sampled frames (same visible wires).
-            for (const Sample& s : cpu_run.samples) {
-                for (const wire::Curve& c : s.curves) {
-                    const std::size_t r = u.rings_per_segment * c.segment_count() + 1;
-                    uniform_vertices_at_samples +=
-                        static_cast<double>(wire::tube_counts(r, false, {.sides = u.sides}).vertices);
-                }
-            }
+            vertices_at_samples(adaptive_vertices_at_samples, uniform_vertices_at_samples);
+        }
+        if (kind == SceneKind::far) {
+            far_cpu_ms = median(cpu_run.frame_cpu_ms);
+            far_systems = system_medians(cpu_run);
+            vertices_at_samples(far_adaptive_vertices, far_uniform_vertices);
         }
         if (kind == SceneKind::offscreen) offscreen_cpu_ms = median(cpu_run.frame_cpu_ms);
 
@@ -560,17 +645,19 @@ int run_systems_bench(const Options& o) {
     std::string md = "# wiretool bench: wire systems\n\n";
     std::snprintf(
         buf, sizeof buf,
-        "%d hanging wires of %d nodes (catenaries 10 m across), 1920x1080, 60 degree field of view, "
+        "%d hanging wires of %d nodes (catenaries 10 m across; `far`: 10,000 cables over a 2 km landscape), "
+        "1920x1080, 60 degree field of view, "
         "tolerance %.2f px, %d frames of a moving camera (medians exclude frame 0, which builds "
         "everything)%s; "
         "%d thread(s). `standard`: static nodes; `swaying`: every node moves every frame; `offscreen`: "
-        "the same wires, all behind the camera. CPU time is process CPU time of the five systems "
+        "the same wires, all behind the camera; `far`: power lines (120-260 m spans) and rigging (12-45 m) over "
+        "2 km x 2 km of rolling ground, a camera flying 45 m up. CPU time is process CPU time of the five systems "
         "(curve, lod, rings, mesh, draw_list) per frame. `bytes_uploaded` is computed exactly as "
         "WireRenderer::draw() would memcpy it from the frame's DrawList (no GL is run). `uniform`: a fixed "
         "ring count per segment and one side count, the smallest whose measured maximum screen error is "
         "no worse than the adaptive run's; its CPU time is the curve stage plus building its rings and "
         "mesh for every visible wire (what it costs whenever the wires move).\n\n",
-        wires, kNodes, kTolerancePx, frames, o.quick ? " (--quick; `swaying` runs 8 frames)" : "", o.threads);
+        1000, kNodes, kTolerancePx, frames, o.quick ? " (--quick; `swaying` runs 8 frames)" : "", o.threads);
     md += buf;
     md += csv.markdown();
     md += "\n" + notes;
@@ -592,6 +679,13 @@ int run_systems_bench(const Options& o) {
                 uniform_vertices_at_samples / adaptive_vertices_at_samples);
             md += buf;
         }
+        if (standard_systems[1] > 0.0) {
+            double total = 0.0;
+            for (double v : standard_systems) total += v;
+            std::snprintf(buf, sizeof buf, "- lod share of the five systems (`standard`, cpu-mesh): %.1f%% (aim <= 25%%)\n",
+                          100.0 * standard_systems[1] / total);
+            md += buf;
+        }
         if (bytes_gpu > 0.0) {
             std::snprintf(buf, sizeof buf,
                           "- gpu-rings vs cpu-mesh bytes per frame: %.0f vs %.0f, %.1fx fewer (aim >= 6x)\n",
@@ -609,6 +703,21 @@ int run_systems_bench(const Options& o) {
         md += "\n## Bytes uploaded per frame (median)\n\n| scene | gpu-rings streamed | gpu-rings retained | "
               "cpu-mesh | cpu-mesh / streamed | cpu-mesh / retained |\n| --- | --- | --- | --- | --- | --- |\n" +
               scene_bytes + "\n(aims: retained >= 20x fewer than cpu-mesh on `standard`, >= 6x on `swaying`)\n";
+    }
+    if (far_cpu_ms >= 0.0) {
+        md += "\nPer-system CPU ms per frame, `far` (10,000 cables), cpu-mesh (median):";
+        for (int i = 0; i < kSystems; ++i) {
+            std::snprintf(buf, sizeof buf, " %s %.3f;", kSystemNames[i], far_systems[static_cast<std::size_t>(i)]);
+            md += buf;
+        }
+        md += "\n\n";
+        if (far_adaptive_vertices > 0.0) {
+            std::snprintf(buf, sizeof buf,
+                          "- adaptive vs uniform at equal max screen error (`far`, same sampled frames): %.0f vs %.0f "
+                          "vertices, %.1fx fewer (aim >= 10x)\n",
+                          far_adaptive_vertices, far_uniform_vertices, far_uniform_vertices / far_adaptive_vertices);
+            md += buf;
+        }
     }
     if (use_gl) {
         gl.finish();

@@ -294,7 +294,7 @@ public:
           sx_(std::sqrt(1.0 + view.tan_half_x * view.tan_half_x)),
           sy_(std::sqrt(1.0 + view.tan_half_y * view.tan_half_y)) {}
 
-    [[nodiscard]] std::size_t root_level() const { return b_.level_offset.size() - 2; }
+    [[nodiscard]] std::size_t root_level() const { return b_.levels - 1; }
     [[nodiscard]] std::size_t first(std::size_t level, std::size_t j) const { return j << level; }
     [[nodiscard]] std::size_t last(std::size_t level, std::size_t j) const {
         return std::min((j + 1) << level, b_.segments);
@@ -306,9 +306,9 @@ public:
         if (e - s > 1 && closed_ && 3 * (e - s) > b_.segments) {
             return std::numeric_limits<double>::infinity();  // a loop keeps >= 3 intervals
         }
-        const std::size_t i = b_.level_offset[level] + j;
-        const glm::dvec3 p(b_.span_x[i], b_.span_y[i], b_.span_z[i]);
-        const double r = b_.span_r[i];
+        const double* nd = b_.node_data(level, j);
+        const glm::dvec3 p(nd[0], nd[1], nd[2]);
+        const double r = nd[3];
         const glm::dmat3& m = tf_.rotation;
         const double z = -((m[0][2] * p.x + m[1][2] * p.y + m[2][2] * p.z) + tf_.translation.z);
         if (!inside_) {
@@ -328,9 +328,9 @@ public:
                 const double a = (std::abs(q.x) + r) / (z - r), b = (std::abs(q.y) + r) / (z - r);
                 k = std::sqrt(1.0 + a * a + b * b);
             }
-            return b_.span_deviation[i] * c_ * k / std::max(z - r, view_.near_m);
+            return nd[4] * c_ * k / std::max(z - r, view_.near_m);
         }
-        return b_.span_deviation[i] * c_ * k_ / std::max(z - r, view_.near_m);
+        return nd[4] * c_ * k_ / std::max(z - r, view_.near_m);
     }
 
     [[nodiscard]] double counts_scale(std::size_t level, std::size_t j) const {
@@ -343,16 +343,16 @@ public:
     // the per-level deviation range, so the walk evaluates only the levels in between (usually one or two).
     void set_depth_range(double z_lo, double z_hi) {
         if (!inside_) return;
-        const std::size_t levels = b_.level_offset.size() - 1;
+        const std::size_t levels = b_.levels;
         fit_level_ = -1;
         fail_level_ = levels;
         const double zh = std::max(z_hi, view_.near_m);
         for (std::size_t l = 0; l < levels; ++l) {
             const bool loop_limit = l > 0 && closed_ && 3 * (std::size_t{1} << l) > b_.segments;
-            if (!loop_limit && b_.level_deviation_max[l] * c_ * k_ <= new_scale_ * z_lo) {
+            if (!loop_limit && b_.level_deviation_max(l) * c_ * k_ <= new_scale_ * z_lo) {
                 fit_level_ = static_cast<std::ptrdiff_t>(l);
             }
-            if (b_.level_deviation_min[l] * c_ * k_ > zh && fail_level_ == levels) fail_level_ = l;
+            if (b_.level_deviation_min(l) * c_ * k_ > zh && fail_level_ == levels) fail_level_ = l;
         }
     }
 
@@ -503,7 +503,7 @@ bool per_segment_required(const Curve& curve, const LodView& view, const LodSett
         if (seg_visible || !settings.coarse_offscreen_segments) {
             const double eps_world = scale * zmin[i] / ks[i];
             const double mm = bounds != nullptr
-                                  ? bounds->wang_m[i]
+                                  ? bounds->wang_m(i)
                                   : std::max(glm::length(curve.segments[i].b0 - 2.0 * curve.segments[i].b1 +
                                                          curve.segments[i].b2),
                                              glm::length(curve.segments[i].b1 - 2.0 * curve.segments[i].b2 +
@@ -548,7 +548,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     }
     const Limits lim(settings);
     const double radius = bounds.radius_max_m;
-    const bool merge = !settings.keep_node_resolution && bounds.segments == n && !bounds.level_offset.empty();
+    const bool merge = !settings.keep_node_resolution && bounds.segments == n && bounds.levels > 0;
 
     Scratch& sc = scratch();
     sc.old_counts.assign(lod.counts.begin(), lod.counts.end());
@@ -650,76 +650,73 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     out.segments = n;
     out.sphere = curve_bounding_sphere(curve);
     out.radius_max_m = 0.0;
-    for (const float r : curve.radius_m)
-        out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
-    out.wang_m.resize(n);
+    for (const float r : curve.radius_m) out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
     out.wang_m_max = 0.0;
-    out.span_x.clear();
-    out.span_y.clear();
-    out.span_z.clear();
-    out.span_r.clear();
-    out.span_deviation.clear();
-    out.level_offset.clear();
-    out.level_deviation_min.clear();
-    out.level_deviation_max.clear();
+    out.levels = 0;
+    out.data.clear();
     if (n == 0) return;
-    auto push = [&](const Sphere& sp, double deviation) {
-        out.span_x.push_back(sp.c.x);
-        out.span_y.push_back(sp.c.y);
-        out.span_z.push_back(sp.c.z);
-        out.span_r.push_back(sp.r);
-        out.span_deviation.push_back(deviation);
+    // Level widths and where each level starts (root first).
+    uint32_t levels = 1;
+    while (out.level_width(levels - 1) > 1) ++levels;
+    out.levels = levels;
+    std::size_t nodes = 0;
+    for (std::size_t l = levels; l-- > 0;) {
+        out.level_start[l] = static_cast<uint32_t>(nodes);
+        nodes += out.level_width(l);
+    }
+    out.data.assign(2 * levels + 5 * nodes + n, 0.0);
+    double* wang = out.data.data() + 2 * levels + 5 * nodes;
+    auto put = [&](std::size_t level, std::size_t j, const Sphere& sp, double deviation) {
+        double* d = out.data.data() + 2 * levels + 5 * (out.level_start[level] + j);
+        d[0] = sp.c.x;
+        d[1] = sp.c.y;
+        d[2] = sp.c.z;
+        d[3] = sp.r;
+        d[4] = deviation;
+    };
+    auto sphere_of = [&](std::size_t level, std::size_t j) {
+        const SpanNode node = out.node(level, j);
+        return Sphere{node.centre_m, node.radius_m};
     };
     // Level 0: one node per segment.
-    out.level_offset.push_back(0);
     for (std::size_t i = 0; i < n; ++i) {
         const CubicBezier& c = curve.segments[i];
-        out.wang_m[i] =
-            std::max(glm::length(c.b0 - 2.0 * c.b1 + c.b2), glm::length(c.b1 - 2.0 * c.b2 + c.b3));
-        out.wang_m_max = std::max(out.wang_m_max, out.wang_m[i]);
+        wang[i] = std::max(glm::length(c.b0 - 2.0 * c.b1 + c.b2), glm::length(c.b1 - 2.0 * c.b2 + c.b3));
+        out.wang_m_max = std::max(out.wang_m_max, wang[i]);
         const glm::dvec3 lo = glm::min(glm::min(c.b0, c.b1), glm::min(c.b2, c.b3));
         const glm::dvec3 hi = glm::max(glm::max(c.b0, c.b1), glm::max(c.b2, c.b3));
-        const double hull =
-            std::max(distance_to_chord(c.b1, c.b0, c.b3), distance_to_chord(c.b2, c.b0, c.b3));
-        double deviation = std::min(hull, 0.75 * out.wang_m[i]);
+        const double hull = std::max(distance_to_chord(c.b1, c.b0, c.b3), distance_to_chord(c.b2, c.b0, c.b3));
+        double deviation = std::min(hull, 0.75 * wang[i]);
         if (!std::isfinite(deviation)) deviation = std::numeric_limits<double>::infinity();
-        push(Sphere{0.5 * (lo + hi), 0.5 * glm::length(hi - lo) * (1.0 + 1e-12)}, deviation);
+        put(0, i, Sphere{0.5 * (lo + hi), 0.5 * glm::length(hi - lo) * (1.0 + 1e-12)}, deviation);
     }
     // Level l from level l - 1: a node of two children with chords A-M and M-B.
-    std::size_t width = n, level = 0;
-    while (width > 1) {
-        const std::size_t prev = out.level_offset[level];
-        const std::size_t next_width = (width + 1) / 2;
-        out.level_offset.push_back(static_cast<uint32_t>(out.span_x.size()));
-        ++level;
-        for (std::size_t j = 0; j < next_width; ++j) {
-            const std::size_t l = prev + 2 * j;
-            const Sphere left{{out.span_x[l], out.span_y[l], out.span_z[l]}, out.span_r[l]};
+    for (std::size_t level = 1; level < levels; ++level) {
+        const std::size_t width = out.level_width(level - 1);
+        for (std::size_t j = 0; j < out.level_width(level); ++j) {
+            const SpanNode left = out.node(level - 1, 2 * j);
             if (2 * j + 1 >= width) {
-                push(left, out.span_deviation[l]);
+                put(level, j, sphere_of(level - 1, 2 * j), left.deviation_m);
                 continue;
             }
-            const std::size_t r = l + 1;
-            const Sphere right{{out.span_x[r], out.span_y[r], out.span_z[r]}, out.span_r[r]};
+            const SpanNode right = out.node(level - 1, 2 * j + 1);
             const std::size_t s = j << level;
             const std::size_t mid = s + (std::size_t{1} << (level - 1));
             const std::size_t e = std::min((j + 1) << level, n);
             const double deviation =
-                std::max(out.span_deviation[l], out.span_deviation[r]) +
+                std::max(left.deviation_m, right.deviation_m) +
                 distance_to_chord(curve.segments[mid].b0, curve.segments[s].b0, curve.segments[e - 1].b3);
-            push(merge_spheres(left, right), deviation);
+            put(level, j, merge_spheres(sphere_of(level - 1, 2 * j), sphere_of(level - 1, 2 * j + 1)), deviation);
         }
-        width = next_width;
     }
-    out.level_offset.push_back(static_cast<uint32_t>(out.span_x.size()));
-    const std::size_t levels = out.level_offset.size() - 1;
-    out.level_deviation_min.assign(levels, std::numeric_limits<double>::infinity());
-    out.level_deviation_max.assign(levels, 0.0);
     for (std::size_t l = 0; l < levels; ++l) {
-        for (std::size_t i = out.level_offset[l]; i < out.level_offset[l + 1]; ++i) {
-            out.level_deviation_min[l] = std::min(out.level_deviation_min[l], out.span_deviation[i]);
-            out.level_deviation_max[l] = std::max(out.level_deviation_max[l], out.span_deviation[i]);
+        double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+        for (std::size_t j = 0; j < out.level_width(l); ++j) {
+            lo = std::min(lo, out.node(l, j).deviation_m);
+            hi = std::max(hi, out.node(l, j).deviation_m);
         }
+        out.data[2 * l] = lo;
+        out.data[2 * l + 1] = hi;
     }
 }
 

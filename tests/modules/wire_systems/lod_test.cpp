@@ -605,20 +605,22 @@ TEST(LodSpans, DeviationBoundsTheChordDistance) {
         LodBounds b;
         compute_lod_bounds(curve, b);
         const std::size_t n = curve.segment_count();
-        ASSERT_EQ(b.level_offset.back(), b.span_x.size());
-        ASSERT_EQ(b.level_offset[b.level_offset.size() - 2] + 1, b.span_x.size()) << "one root node";
-        for (std::size_t level = 0; level + 1 < b.level_offset.size(); ++level) {
-            for (std::size_t j = 0; b.level_offset[level] + j < b.level_offset[level + 1]; ++j) {
-                const std::size_t node = b.level_offset[level] + j;
+        ASSERT_GT(b.levels, 0u);
+        ASSERT_EQ(b.level_width(b.levels - 1), 1u) << "one root node";
+        for (std::size_t level = 0; level < b.levels; ++level) {
+            for (std::size_t j = 0; j < b.level_width(level); ++j) {
+                const SpanNode node = b.node(level, j);
                 const std::size_t s = j << level, e = std::min((j + 1) << level, n);
                 ASSERT_LT(s, e);
+                ASSERT_LE(b.level_deviation_min(level), node.deviation_m);
+                ASSERT_GE(b.level_deviation_max(level), node.deviation_m);
                 const glm::dvec3 a = curve.segments[s].b0, c = curve.segments[e - 1].b3;
-                const glm::dvec3 centre(b.span_x[node], b.span_y[node], b.span_z[node]);
+                const glm::dvec3 centre = node.centre_m;
                 double d = 0.0;
                 for (std::size_t seg = s; seg < e; ++seg) {
                     const CubicBezier& cb = curve.segments[seg];
                     for (const glm::dvec3& p : {cb.b0, cb.b1, cb.b2, cb.b3})
-                        ASSERT_LE(glm::length(p - centre), b.span_r[node] * (1 + 1e-12) + 1e-12);
+                        ASSERT_LE(glm::length(p - centre), node.radius_m * (1 + 1e-12) + 1e-12);
                     for (int k = 0; k <= 64; ++k) {
                         const glm::dvec3 p = position(cb, k / 64.0);
                         const glm::dvec3 ac = c - a;
@@ -627,11 +629,11 @@ TEST(LodSpans, DeviationBoundsTheChordDistance) {
                         d = std::max(d, glm::length(p - (a + h * ac)));
                     }
                 }
-                ASSERT_LE(d, b.span_deviation[node] * (1 + 1e-9) + 1e-12)
+                ASSERT_LE(d, node.deviation_m * (1 + 1e-9) + 1e-12)
                     << "wire " << i << " level " << level;
-                if (b.span_deviation[node] > 0) {
-                    worst = std::max(worst, d / b.span_deviation[node]);
-                    sum += d / b.span_deviation[node];
+                if (node.deviation_m > 0) {
+                    worst = std::max(worst, d / node.deviation_m);
+                    sum += d / node.deviation_m;
                     ++nodes_checked;
                 }
             }

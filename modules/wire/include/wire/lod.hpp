@@ -134,21 +134,43 @@ struct BoundingSphere {
 /// tube radius). An empty curve gives radius -1.
 [[nodiscard]] BoundingSphere curve_bounding_sphere(const Curve& curve);
 
+/// A node of the span hierarchy: a sphere around the span's control points (not inflated by the tube radius)
+/// and its chord deviation (every curve point of the span is within it of the chord from the span's first point
+/// to its last; see the header comment).
+struct SpanNode {
+    glm::dvec3 centre_m{};
+    double radius_m = 0.0;
+    double deviation_m = 0.0;
+};
+
 /// View-independent LOD data of one curve, computed when the curve changes (O(segments)); update_lod() reads it
 /// every frame. The span hierarchy: level 0 holds one node per segment, level l one node per 2^l segments (the
 /// last node of a level may be shorter), up to one root node for the whole wire; node j of level l covers
-/// segments [j 2^l, min((j+1) 2^l, n)). Per node (structure of arrays): a sphere around its control points (not
-/// inflated by the tube radius) and its chord deviation (every curve point of the span is within it of the
-/// chord from the span's first point to its last; see the header comment).
+/// segments [j 2^l, min((j+1) 2^l, n)). Everything per frame lives in one allocation, the root level first (the
+/// LOD pass of 10,000 wires is bound by cache misses, not arithmetic).
 struct LodBounds {
-    BoundingSphere sphere{};             ///< curve_bounding_sphere(curve)
-    double radius_max_m = 0.0;           ///< largest tube radius
-    double wang_m_max = 0.0;             ///< max over segments of wang_m
-    std::vector<double> wang_m;          ///< per segment: Wang's M = max |B_i - 2B_{i+1} + B_{i+2}|
-    std::vector<double> span_x, span_y, span_z, span_r, span_deviation;  ///< per node, all levels, level 0 first
-    std::vector<uint32_t> level_offset;  ///< first node of each level; one more entry: the node count
-    std::vector<double> level_deviation_min, level_deviation_max;  ///< per level: range of span_deviation
+    BoundingSphere sphere{};    ///< curve_bounding_sphere(curve)
+    double radius_max_m = 0.0;  ///< largest tube radius
+    double wang_m_max = 0.0;    ///< max over segments of wang_m()
     std::size_t segments = 0;
+    uint32_t levels = 0;                        ///< hierarchy levels (0 for an empty curve)
+    std::array<uint32_t, 34> level_start{};     ///< index of node 0 of each level (root level first in memory)
+    std::vector<double> data;                   ///< per level (min, max) deviation; nodes; Wang's M per segment
+
+    [[nodiscard]] std::size_t level_width(std::size_t level) const {
+        return (segments + (std::size_t{1} << level) - 1) >> level;
+    }
+    [[nodiscard]] const double* node_data(std::size_t level, std::size_t j) const {
+        return data.data() + 2 * levels + 5 * (level_start[level] + j);
+    }
+    [[nodiscard]] SpanNode node(std::size_t level, std::size_t j) const {
+        const double* d = node_data(level, j);
+        return {{d[0], d[1], d[2]}, d[3], d[4]};
+    }
+    [[nodiscard]] double level_deviation_min(std::size_t level) const { return data[2 * level]; }
+    [[nodiscard]] double level_deviation_max(std::size_t level) const { return data[2 * level + 1]; }
+    /// Wang's M = max |B_i - 2B_{i+1} + B_{i+2}| of segment i.
+    [[nodiscard]] double wang_m(std::size_t i) const { return data[data.size() - segments + i]; }
 };
 
 /// Fills `out` for `curve` (reuses its capacity).
