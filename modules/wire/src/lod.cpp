@@ -232,6 +232,7 @@ void mark_culled(WireLod& lod, bool& changed) {
     lod.changed_counts = 0;
     lod.spans = 0;
     lod.bounded = false;
+    lod.coherence.valid = false;
 }
 
 double distance_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
@@ -333,12 +334,18 @@ public:
         return nd[4] * c_ * k_ / std::max(z - r, view_.near_m);
     }
 
+    // Smallest factor by which any ratio decided so far may change before crossing a threshold (1 or the new
+    // span threshold).
+    void note(double r) const {
+        if (!(r > 0.0) || !std::isfinite(r)) return;
+        margin_ = std::min({margin_, std::max(r, 1.0 / r), std::max(r / new_scale_, new_scale_ / r)});
+    }
+    [[nodiscard]] double margin() const { return margin_; }
+
     [[nodiscard]] double counts_scale(std::size_t level, std::size_t j) const {
         return was_merged(first(level, j), last(level, j)) ? 1.0 : new_scale_;
     }
 
-    // Writes the spans into `required` and `counts` (other segments keep their values). Returns the number of
-    // counts intervals that cross more than one segment.
     // For a wire inside the frustum: its depth range [z_lo, z_hi] decides whole levels of the hierarchy from
     // the per-level deviation range, so the walk evaluates only the levels in between (usually one or two).
     void set_depth_range(double z_lo, double z_hi) {
@@ -349,13 +356,19 @@ public:
         const double zh = std::max(z_hi, view_.near_m);
         for (std::size_t l = 0; l < levels; ++l) {
             const bool loop_limit = l > 0 && closed_ && 3 * (std::size_t{1} << l) > b_.segments;
-            if (!loop_limit && b_.level_deviation_max(l) * c_ * k_ <= new_scale_ * z_lo) {
+            const double fit = b_.level_deviation_max(l) * c_ * k_ / (new_scale_ * z_lo);
+            if (!loop_limit && fit <= 1.0) {
                 fit_level_ = static_cast<std::ptrdiff_t>(l);
             }
-            if (b_.level_deviation_min(l) * c_ * k_ > zh && fail_level_ == levels) fail_level_ = l;
+            if (!loop_limit && fit > 0.0 && std::isfinite(fit)) margin_ = std::min(margin_, std::max(fit, 1.0 / fit));
+            const double fail = b_.level_deviation_min(l) * c_ * k_ / zh;
+            if (fail > 1.0 && fail_level_ == levels) fail_level_ = l;
+            if (fail > 0.0 && std::isfinite(fail)) margin_ = std::min(margin_, std::max(fail, 1.0 / fail));
         }
     }
 
+    // Writes the spans into `required` and `counts` (other segments keep their values). Returns the number of
+    // counts intervals that cross more than one segment.
     uint32_t apply(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
         uint32_t spans = 0;
         walk(root_level(), 0, false, required, counts, spans);
@@ -378,9 +391,13 @@ private:
         const std::size_t s = first(level, j), e = last(level, j);
         if (s >= e) return;
         // Levels the wire-wide bounds decide: every node fits (at the strictest threshold), or none does.
-        const double r = level >= fail_level_ ? std::numeric_limits<double>::infinity()
-                         : static_cast<std::ptrdiff_t>(level) <= fit_level_ ? 0.0
-                                                                            : ratio(level, j);
+        double r = 0.0;
+        if (level >= fail_level_) {
+            r = std::numeric_limits<double>::infinity();
+        } else if (static_cast<std::ptrdiff_t>(level) > fit_level_) {
+            r = ratio(level, j);
+            note(r);
+        }
         if (!required_done && r <= 1.0) {
             set_span(required, s, e);
             required_done = true;
@@ -400,6 +417,7 @@ private:
     const LodView& view_;
     ViewTransform tf_;
     double c_, k_, k_cap_;
+    mutable double margin_ = std::numeric_limits<double>::infinity();
     std::ptrdiff_t fit_level_ = -1;
     std::size_t fail_level_ = std::numeric_limits<std::size_t>::max();
     bool closed_;
@@ -530,6 +548,45 @@ bool per_segment_required(const Curve& curve, const LodView& view, const LodSett
     return true;
 }
 
+bool same_settings(const WireLod::Coherence& c, const Limits& lim, const LodSettings& s) {
+    return c.tolerance_px == lim.eps && c.band == lim.band && c.max_sides == lim.max_sides &&
+           c.max_rings == lim.max_rings && c.coarse_offscreen == s.coarse_offscreen_segments &&
+           c.keep_node_resolution == s.keep_node_resolution;
+}
+
+// The coherence test (WireLod::Coherence): true if the state of the last update stands for this camera.
+bool reuse(const Curve& curve, const LodView& view, const LodSettings& settings, const Limits& lim,
+           const LodBounds& bounds, WireLod& lod) {
+    const WireLod::Coherence& c = lod.coherence;
+    if (!c.valid || c.bounds != &bounds || c.bounds_version != bounds.version || !lod.visible ||
+        lod.counts.size() != curve.segment_count() || !same_settings(c, lim, settings)) {
+        return false;
+    }
+    const SphereScreenBound sb = sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
+    if (!sb.inside || sides_for_radius(bounds.radius_max_m, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) != 3) {
+        return false;
+    }
+    if (!c.whole && !one_ring_per_segment(bounds, sb)) return false;
+    // Every point of the sphere moved by at most delta in view space: |R' - R| |p - e'| + |e' - e|.
+    const ViewTransform tf(view);
+    double rf = 0.0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            const double d = tf.rotation[i][j] - c.rotation[i][j];
+            rf += d * d;
+        }
+    const double delta = std::sqrt(rf) * (glm::length(bounds.sphere.centre_m - view.eye_m) + bounds.sphere.radius_m) +
+                         glm::length(view.eye_m - c.eye_m);
+    if (!(c.z_lo_m - delta > view.near_m)) return false;
+    const double kr = sb.k / c.k;
+    const double factor = std::max(kr * c.z_lo_m / (c.z_lo_m - delta), (c.z_lo_m + delta) / (c.z_lo_m * kr));
+    if (!(factor * (1.0 + 1e-9) < c.margin)) return false;
+    lod.z_min_m = sb.z_lo_m;
+    lod.changed_counts = 0;
+    ++lod.reused;
+    return true;
+}
+
 bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
                      const LodBounds& bounds, bool sphere_cull, bool use_bound) {
     const std::size_t n = curve.segment_count();
@@ -549,6 +606,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     const Limits lim(settings);
     const double radius = bounds.radius_max_m;
     const bool merge = !settings.keep_node_resolution && bounds.segments == n && bounds.levels > 0;
+    if (use_bound && reuse(curve, view, settings, lim, bounds, lod)) return false;
+    lod.coherence.valid = false;
 
     Scratch& sc = scratch();
     sc.old_counts.assign(lod.counts.begin(), lod.counts.end());
@@ -576,12 +635,14 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
 
     // A sphere inside the frustum whose conservative side count is 3 (so the exact one is too) is decided
     // here.
-    bool decided = false, whole = false;
+    bool decided = false, whole = false, conservative_sides = false;
     double wire_z = std::numeric_limits<double>::infinity();
     double wire_k = 1.0;
     if (use_bound && bounds.sphere.radius_m >= 0.0 && sb.inside) {
         const std::size_t root = merger.root_level();
-        if (merge && merger.ratio(root, 0) <= merger.counts_scale(root, 0)) {
+        const double root_ratio = merge ? merger.ratio(root, 0) : 0.0;
+        if (merge) merger.note(root_ratio);
+        if (merge && root_ratio <= merger.counts_scale(root, 0)) {
             // The whole wire is one interval for the counts (hysteresis threshold), so for the tolerance too.
             lod.required.assign(n, 0);
             lod.required[0] = 1;
@@ -600,6 +661,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
             if (sides_for_radius(radius, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) == 3) {
                 wire_z = sb.z_lo_m;  // the conservative side count is the least: so is the exact one
                 wire_k = sb.k;
+                conservative_sides = true;
             } else {
                 hull_depths(curve, view);  // the exact side count needs the segments' depths
                 const Scratch& d = scratch();
@@ -640,6 +702,24 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band);
     changed = changed || sides != lod.sides;
     lod.sides = std::min(sides, lim.max_sides);
+    if (use_bound && lod.bounded && sb.inside && conservative_sides && merger.margin() > 1.0) {
+        WireLod::Coherence& c = lod.coherence;
+        c.valid = true;
+        c.bounds = &bounds;
+        c.bounds_version = bounds.version;
+        c.eye_m = view.eye_m;
+        c.rotation = ViewTransform(view).rotation;
+        c.z_lo_m = sb.z_lo_m;
+        c.k = sb.k;
+        c.whole = whole;
+        c.margin = merger.margin();
+        c.tolerance_px = lim.eps;
+        c.band = lim.band;
+        c.max_sides = lim.max_sides;
+        c.max_rings = lim.max_rings;
+        c.coarse_offscreen = settings.coarse_offscreen_segments;
+        c.keep_node_resolution = settings.keep_node_resolution;
+    }
     return changed;
 }
 
@@ -653,6 +733,7 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     for (const float r : curve.radius_m) out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
     out.wang_m_max = 0.0;
     out.levels = 0;
+    ++out.version;
     out.data.clear();
     if (n == 0) return;
     // Level widths and where each level starts (root first).

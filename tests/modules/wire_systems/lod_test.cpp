@@ -591,6 +591,48 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
     EXPECT_GT(spans, 0u);
 }
 
+// The coherence test of the cheap pass (a wire whose decisions cannot have changed keeps its state) answers
+// exactly what a full update answers, on random wires seen from afar by a camera that drifts by small random
+// steps (and now and then jumps); it must answer a fair share of the updates.
+TEST(LodCheapPass, CoherenceReuseEqualsAFullUpdate) {
+    Rng rng(37);
+    std::size_t updates = 0, reused = 0;
+    for (int i = 0; i < 60; ++i) {
+        const WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
+        Curve curve;
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.005f}, curve).ok);
+        LodBounds bounds;
+        compute_lod_bounds(curve, bounds);
+        const BoundingSphere sphere = curve_bounding_sphere(curve);
+        const LodView start = make_camera(CameraKind::far_few_px, curve, rng);
+        const glm::dvec3 target = sphere.centre_m;
+        glm::dvec3 eye = start.eye_m;
+        const double distance = glm::length(eye - target);
+        WireLod cheap, reference;
+        for (int f = 0; f < 40; ++f) {
+            const double step = f % 13 == 12 ? 0.3 : uniform(rng, 1e-5, 3e-3);
+            eye += random_unit(rng) * step * distance;
+            const glm::dvec3 look = target + random_unit(rng) * 1e-3 * distance;
+            const LodView view = LodView::perspective(eye, look, glm::dvec3(0, 1, 0), kFov, kWidth, kHeight, 0.05, 1e6);
+            const uint64_t before = cheap.reused;
+            const bool c1 = update_lod(curve, view, LodSettings{}, cheap, bounds);
+            const bool c2 = update_lod(curve, view, LodSettings{}, reference, &sphere);
+            ++updates;
+            reused += cheap.reused - before;
+            ASSERT_EQ(cheap.visible, reference.visible) << "wire " << i << " frame " << f;
+            ASSERT_EQ(cheap.counts, reference.counts) << "wire " << i << " frame " << f;
+            ASSERT_EQ(cheap.required, reference.required) << "wire " << i << " frame " << f;
+            ASSERT_EQ(cheap.sides, reference.sides) << "wire " << i << " frame " << f;
+            ASSERT_EQ(cheap.required_sides, reference.required_sides) << "wire " << i << " frame " << f;
+            ASSERT_EQ(cheap.spans, reference.spans) << "wire " << i << " frame " << f;
+            ASSERT_EQ(c1, c2) << "wire " << i << " frame " << f;
+        }
+    }
+    std::printf("%zu updates, %zu answered by the coherence test\n", updates, reused);
+    EXPECT_GT(reused, updates / 5);
+    EXPECT_LT(reused, updates);
+}
+
 // The span deviation of LodBounds bounds the distance of every curve point of a span to its chord, and the
 // span sphere holds its control points: checked on dense samples of random wires, at every node of the
 // hierarchy.

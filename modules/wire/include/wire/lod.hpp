@@ -47,6 +47,7 @@
 #include "wire/curve.hpp"
 #include "wire/tessellate.hpp"
 
+#include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -108,6 +109,8 @@ struct LodSettings {
 /// One wire's LOD state for one camera (kept between frames for hysteresis).
 /// counts[i] == 0 (only without keep_node_resolution): segment i has no ring of its own; the ring interval that
 /// starts on an earlier segment crosses it. counts[0] is >= 1 whenever the wire is visible.
+struct LodBounds;
+
 struct WireLod {
     std::vector<uint32_t> counts;    ///< per segment: rings used (after hysteresis; >= required[i]); empty if culled
     std::vector<uint32_t> required;  ///< per segment: rings the tolerance needs now (Wang count, or the spans)
@@ -121,6 +124,24 @@ struct WireLod {
                                      ///< bound of it when `bounded` and the side count is 3
     uint32_t spans = 0;              ///< ring intervals that cross more than one segment (in counts)
     bool bounded = false;            ///< the per-wire bound decided the counts (no per-segment Wang evaluation)
+    uint64_t reused = 0;             ///< updates answered by the coherence test (statistics)
+
+    /// Coherence of the cheap pass: after an update the per-wire bound decided with 3 sides, the camera it was
+    /// made for and by what factor the span decisions' ratios (deviation * f * k / depth) may change before one
+    /// crosses a threshold. A later update whose camera moved so little that no point of the wire's sphere moved
+    /// enough in view space (and k changed little enough) keeps the state: a full update would give the same.
+    struct Coherence {
+        bool valid = false;
+        const LodBounds* bounds = nullptr;
+        uint64_t bounds_version = 0;
+        glm::dvec3 eye_m{};
+        glm::dmat3 rotation{1.0};
+        double z_lo_m = 0.0, k = 1.0, margin = 1.0;
+        double tolerance_px = 0.0, band = 0.0;
+        uint32_t max_sides = 0, max_rings = 0;
+        bool coarse_offscreen = true, keep_node_resolution = false;
+        bool whole = false;  ///< the whole wire was one interval (else: one ring per segment before the spans)
+    } coherence;
 };
 
 /// A sphere enclosing a wire's tube: every control point of the curve, inflated by its largest radius. Computed
@@ -154,6 +175,7 @@ struct LodBounds {
     double wang_m_max = 0.0;    ///< max over segments of wang_m()
     std::size_t segments = 0;
     uint32_t levels = 0;                        ///< hierarchy levels (0 for an empty curve)
+    uint64_t version = 0;                       ///< +1 each time compute_lod_bounds() fills it
     std::array<uint32_t, 34> level_start{};     ///< index of node 0 of each level (root level first in memory)
     std::vector<double> data;                   ///< per level (min, max) deviation; nodes; Wang's M per segment
 

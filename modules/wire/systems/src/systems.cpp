@@ -49,7 +49,8 @@ bool same_spline(const SplineSettings& a, const SplineSettings& b) {
 bool same_lod(const LodSettings& a, const LodSettings& b) {
     return a.tolerance_px == b.tolerance_px && a.max_rings_per_segment == b.max_rings_per_segment &&
            a.max_sides == b.max_sides && a.hysteresis_band == b.hysteresis_band &&
-           a.coarse_offscreen_segments == b.coarse_offscreen_segments && a.keep_node_resolution == b.keep_node_resolution;
+           a.coarse_offscreen_segments == b.coarse_offscreen_segments &&
+           a.keep_node_resolution == b.keep_node_resolution;
 }
 
 SplineSettings spline_of(const Style& style) {
