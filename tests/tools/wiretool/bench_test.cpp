@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -257,6 +258,38 @@ TEST(WiretoolBench, QuickRunHonoursTheContract) {
         SCOPED_TRACE("stability.md and plot");
         check_stability_and_plot(dir);
     }
+    if (!::testing::Test::HasFailure()) {
+        fs::remove_all(dir);
+        fs::remove(dir.string() + ".log");
+    }
+}
+
+// The `far` scene (10,000 cables over a 2 km landscape): the same rows as the other scenes, the uniform baseline
+// included, and the adaptive LOD below the node resolution drawing far fewer vertices within the tolerance.
+TEST(WiretoolBench, FarSceneRows) {
+    const fs::path dir = out_dir().string() + "_far";
+    fs::remove_all(dir);
+    const std::string cmd = std::string(WIRETOOL_PATH) + " bench --quick --no-accuracy --scenes far --out " +
+                            dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
+    const int raw = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "see " << dir.string() << ".log";
+    const Csv csv = read_csv(dir / "bench.csv");
+    ASSERT_EQ(csv.rows.size(), 3u) << "far x {cpu-mesh, gpu-rings, uniform}";
+    const auto* cpu = find(csv.rows, {{"scene", "far"}, {"mode", "cpu-mesh"}});
+    const auto* gpu = find(csv.rows, {{"scene", "far"}, {"mode", "gpu-rings"}});
+    const auto* uni = find(csv.rows, {{"scene", "far"}, {"mode", "uniform"}});
+    ASSERT_TRUE(cpu && gpu && uni);
+    for (const auto* r : {cpu, gpu, uni}) EXPECT_EQ(number(*r, "wires"), 10000.0);
+    EXPECT_GT(number(*cpu, "visible_wires"), 1000.0);
+    EXPECT_LT(number(*cpu, "visible_wires"), 10000.0) << "some cables are out of view";
+    EXPECT_LE(number(*cpu, "max_screen_error_px"), number(*cpu, "tolerance_px"));
+    EXPECT_LE(number(*uni, "max_screen_error_px"), number(*cpu, "max_screen_error_px") + 1e-9);
+    EXPECT_LT(number(*cpu, "rings"), number(*uni, "rings") / 3.0) << "spans below the node resolution";
+    EXPECT_EQ(number(*gpu, "rings"), number(*cpu, "rings"));
+    std::ifstream md(dir / "bench.md");
+    const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("Per-system CPU ms per frame, `far`"), std::string::npos);
+    EXPECT_NE(text.find("adaptive vs uniform at equal max screen error (`far`"), std::string::npos);
     if (!::testing::Test::HasFailure()) {
         fs::remove_all(dir);
         fs::remove(dir.string() + ".log");
