@@ -563,7 +563,9 @@ bool reuse(const Curve& curve, const LodView& view, const LodSettings& settings,
         return false;
     }
     const SphereScreenBound sb = sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
-    if (!sb.inside || sides_for_radius(bounds.radius_max_m, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) != 3) {
+    if (!sb.inside) return false;
+    if (!c.exact_sides &&
+        sides_for_radius(bounds.radius_max_m, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) != 3) {
         return false;
     }
     if (!c.whole && !one_ring_per_segment(bounds, sb)) return false;
@@ -581,7 +583,24 @@ bool reuse(const Curve& curve, const LodView& view, const LodSettings& settings,
     const double kr = sb.k / c.k;
     const double factor = std::max(kr * c.z_lo_m / (c.z_lo_m - delta), (c.z_lo_m + delta) / (c.z_lo_m * kr));
     if (!(factor * (1.0 + 1e-9) < c.margin)) return false;
-    lod.z_min_m = sb.z_lo_m;
+    double z_min = sb.z_lo_m;
+    if (c.exact_sides) {
+        // The segments' nearest depth moved by at most delta, their off-axis factors as a = |x|/z allows:
+        // sqrt(k^2 - 1) within (sqrt(k^2 - 1) -+ sqrt2 e) / (1 +- e), e = delta / z. The side count must not move.
+        const double e = delta / c.wire_z_m;
+        if (!(e < 0.5) || !(c.wire_z_m - delta > view.near_m)) return false;
+        const double ka = std::sqrt(std::max(c.wire_k * c.wire_k - 1.0, 0.0));
+        const double ka_hi = (ka + std::numbers::sqrt2 * e) / (1.0 - e);
+        const double ka_lo = std::max(0.0, (ka - std::numbers::sqrt2 * e) / (1.0 + e));
+        const double r = bounds.radius_max_m;
+        const uint32_t most =
+            sides_for_radius(r, c.wire_z_m - delta, std::sqrt(1.0 + ka_hi * ka_hi), view, lim.eps, lim.max_sides);
+        const uint32_t least =
+            sides_for_radius(r, c.wire_z_m + delta, std::sqrt(1.0 + ka_lo * ka_lo), view, lim.eps, lim.max_sides);
+        if (most != lod.required_sides || least != lod.required_sides) return false;
+        z_min = c.wire_z_m - delta;  // a lower bound of the segments' nearest depth
+    }
+    lod.z_min_m = z_min;
     lod.changed_counts = 0;
     ++lod.reused;
     return true;
@@ -702,7 +721,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band);
     changed = changed || sides != lod.sides;
     lod.sides = std::min(sides, lim.max_sides);
-    if (use_bound && lod.bounded && sb.inside && conservative_sides && merger.margin() > 1.0) {
+    if (use_bound && lod.bounded && sb.inside && merger.margin() > 1.0) {
         WireLod::Coherence& c = lod.coherence;
         c.valid = true;
         c.bounds = &bounds;
@@ -712,6 +731,9 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         c.z_lo_m = sb.z_lo_m;
         c.k = sb.k;
         c.whole = whole;
+        c.exact_sides = !conservative_sides;
+        c.wire_z_m = wire_z;
+        c.wire_k = wire_k;
         c.margin = merger.margin();
         c.tolerance_px = lim.eps;
         c.band = lim.band;

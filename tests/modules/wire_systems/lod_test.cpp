@@ -596,11 +596,15 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
 // steps (and now and then jumps); it must answer a fair share of the updates.
 TEST(LodCheapPass, CoherenceReuseEqualsAFullUpdate) {
     Rng rng(37);
-    std::size_t updates = 0, reused = 0;
+    std::size_t updates = 0, reused = 0, reused_exact_sides = 0;
     for (int i = 0; i < 60; ++i) {
         const WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
         Curve curve;
         ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.005f}, curve).ok);
+        if (i % 2 == 1) {  // thick: a few pixels of radius, so the side count comes from the segments' depths
+            const float radius = static_cast<float>(0.08 * curve_bounding_sphere(curve).radius_m);
+            ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok);
+        }
         LodBounds bounds;
         compute_lod_bounds(curve, bounds);
         const BoundingSphere sphere = curve_bounding_sphere(curve);
@@ -619,6 +623,7 @@ TEST(LodCheapPass, CoherenceReuseEqualsAFullUpdate) {
             const bool c2 = update_lod(curve, view, LodSettings{}, reference, &sphere);
             ++updates;
             reused += cheap.reused - before;
+            reused_exact_sides += cheap.reused != before && cheap.coherence.exact_sides ? 1 : 0;
             ASSERT_EQ(cheap.visible, reference.visible) << "wire " << i << " frame " << f;
             ASSERT_EQ(cheap.counts, reference.counts) << "wire " << i << " frame " << f;
             ASSERT_EQ(cheap.required, reference.required) << "wire " << i << " frame " << f;
@@ -626,10 +631,13 @@ TEST(LodCheapPass, CoherenceReuseEqualsAFullUpdate) {
             ASSERT_EQ(cheap.required_sides, reference.required_sides) << "wire " << i << " frame " << f;
             ASSERT_EQ(cheap.spans, reference.spans) << "wire " << i << " frame " << f;
             ASSERT_EQ(c1, c2) << "wire " << i << " frame " << f;
+            ASSERT_LE(cheap.z_min_m, reference.z_min_m) << "wire " << i << " frame " << f;
         }
     }
-    std::printf("%zu updates, %zu answered by the coherence test\n", updates, reused);
+    std::printf("%zu updates, %zu answered by the coherence test (%zu with sides from the segments' depths)\n",
+                updates, reused, reused_exact_sides);
     EXPECT_GT(reused, updates / 5);
+    EXPECT_GT(reused_exact_sides, updates / 20);
     EXPECT_LT(reused, updates);
 }
 

@@ -141,6 +141,8 @@ struct WireLod {
         uint32_t max_sides = 0, max_rings = 0;
         bool coarse_offscreen = true, keep_node_resolution = false;
         bool whole = false;  ///< the whole wire was one interval (else: one ring per segment before the spans)
+        bool exact_sides = false;           ///< sides from the segments' depths (wire_z_m, wire_k), not the sphere
+        double wire_z_m = 0.0, wire_k = 1.0;
     } coherence;
 };
 
