@@ -606,6 +606,85 @@ bool reuse(const Curve& curve, const LodView& view, const LodSettings& settings,
     return true;
 }
 
+// Wang's count of one segment from its hull depth, with the cached M (wang_ring_count() on it).
+uint32_t wang_cached(double m, double eps_world, const Limits& lim, uint32_t& clamped) {
+    if (!(eps_world > 0.0) || !std::isfinite(m)) return lim.max_rings;
+    const double c = std::ceil(std::sqrt(3.0 * m / (4.0 * eps_world)));
+    const uint32_t raw = !(c < static_cast<double>(lim.max_rings)) ? lim.max_rings
+                                                                     : std::max<uint32_t>(1, static_cast<uint32_t>(c));
+    if (raw >= lim.max_rings && !(c <= static_cast<double>(lim.max_rings))) ++clamped;
+    return raw;
+}
+
+enum class SegmentPass { done, culled, fallback };
+
+// The per-segment pass of a wire partly out of view whose side count the wire's sphere already fixes at 3:
+// each segment's sphere (LodBounds level 0) decides it when it lies inside the frustum (visible; one ring when
+// the sphere's depth allows) or outside a plane (off screen, so is its hull); only the other segments take the
+// hull test and hull depth. The same required counts and visibility as per_segment_required(); the depth kept
+// is a lower bound. `fallback` when no segment was found visible (the hull test must then decide culling).
+SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const Limits& lim, const LodBounds& b,
+                                double radius, WireLod& lod, double& wire_z) {
+    const std::size_t n = curve.segment_count();
+    const ViewTransform tf(view);
+    const PlaneTest planes(view, radius);
+    const double tx = view.tan_half_x, ty = view.tan_half_y;
+    const double sx = std::sqrt(1.0 + tx * tx), sy = std::sqrt(1.0 + ty * ty);
+    const double scale = lim.eps / view.focal_px;
+    lod.required.resize(n);
+    unsigned wire_outside = 63u;
+    wire_z = std::numeric_limits<double>::infinity();
+    uint32_t visible = 0, clamped = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double* nd = b.node_data(0, i);
+        const glm::dvec3 q = tf(glm::dvec3(nd[0], nd[1], nd[2]));
+        const double r0 = nd[3], ri = r0 + radius;
+        const double l = q.x + q.z * tx, rt = q.z * tx - q.x, bt = q.y + q.z * ty, tp = q.z * ty - q.y;
+        const double ne = q.z - view.near_m, fa = view.far_m - q.z;
+        const double rx = ri * sx, ry = ri * sy;
+        const unsigned outside = (l < -rx ? 1u : 0u) | (rt < -rx ? 2u : 0u) | (bt < -ry ? 4u : 0u) |
+                                 (tp < -ry ? 8u : 0u) | (ne < -ri ? 16u : 0u) | (fa < -ri ? 32u : 0u);
+        if (outside != 0) {  // every control point is outside these planes: the hull test says off screen too
+            wire_outside &= outside;
+            lod.required[i] = 1;
+            continue;
+        }
+        const bool inside = l >= rx && rt >= rx && bt >= ry && tp >= ry && ne >= ri && fa >= ri;
+        if (inside) {
+            const double zl = q.z - r0;  // > near: the sphere is in front of the near plane
+            const double a = std::min(tx, (std::abs(q.x) + r0) / zl), c = std::min(ty, (std::abs(q.y) + r0) / zl);
+            const double k = std::sqrt(1.0 + a * a + c * c);
+            wire_outside = 0;
+            ++visible;
+            if (3.0 * b.wang_m(i) <= 4.0 * (scale * zl / k) * (1.0 - 1e-9)) {
+                lod.required[i] = 1;  // the hull's depth is larger and its k smaller: the exact count is 1 too
+                wire_z = std::min(wire_z, zl);
+                continue;
+            }
+            const HullDepth h = hull_depth(tf.hull(curve.segments[i]), view);
+            lod.required[i] = wang_cached(b.wang_m(i), scale * h.z_min / h.k, lim, clamped);
+            wire_z = std::min(wire_z, h.z_min);
+            continue;
+        }
+        const ViewHull hull = tf.hull(curve.segments[i]);
+        const unsigned o = planes.outside(hull);
+        wire_outside &= o;
+        if (o != 0) {
+            lod.required[i] = 1;
+            continue;
+        }
+        ++visible;
+        const HullDepth h = hull_depth(hull, view);
+        lod.required[i] = wang_cached(b.wang_m(i), scale * h.z_min / h.k, lim, clamped);
+        wire_z = std::min(wire_z, h.z_min);
+    }
+    if (wire_outside != 0) return SegmentPass::culled;  // a superset of the hull test's planes: culled as well
+    if (visible == 0) return SegmentPass::fallback;
+    lod.visible_segments = visible;
+    lod.clamped_segments = clamped;
+    return SegmentPass::done;
+}
+
 bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
                      const LodBounds& bounds, bool sphere_cull, bool use_bound) {
     const std::size_t n = curve.segment_count();
@@ -689,6 +768,24 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
                     wire_k = std::max(wire_k, d.k[i]);
                 }
             }
+        }
+    }
+    if (!decided && use_bound && bounds.sphere.radius_m >= 0.0 && !sb.inside && settings.coarse_offscreen_segments &&
+        sides_for_radius(radius, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) == 3) {
+        const SegmentPass pass = per_segment_bounded(curve, view, lim, bounds, radius, lod, wire_z);
+        if (pass == SegmentPass::culled) {
+            bool changed = false;
+            mark_culled(lod, changed);
+            return changed;
+        }
+        if (pass == SegmentPass::done) {
+            decided = true;
+            lod.bounded = true;
+            wire_z = std::max(wire_z, sb.z_lo_m);
+            wire_k = sb.k;  // with wire_z >= the sphere's z_lo: the side count is 3, as the exact one
+        } else {
+            lod.visible_segments = 0;
+            lod.clamped_segments = 0;
         }
     }
     if (!decided && !per_segment_required(curve, view, settings, lim, &bounds, radius, lod, wire_z, wire_k)) {

@@ -536,7 +536,7 @@ TEST(LodCulling, BoundingSphereCullGivesTheSameLodAsTheHullTest) {
 // share of the cases, or the comparison would say little.
 TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
     Rng rng(31);
-    std::size_t updates = 0, bounded = 0, visible = 0, spans = 0;
+    std::size_t updates = 0, bounded = 0, visible = 0, spans = 0, bounded_partly = 0;
     for (int i = 0; i < 240; ++i) {
         const Shape shape = static_cast<Shape>(i % 3);
         const WireNodes nodes = make_wire(shape, rng);
@@ -551,7 +551,18 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
         compute_lod_bounds(curve, bounds);
         const BoundingSphere sphere = curve_bounding_sphere(curve);
         const LodSettings settings{.keep_node_resolution = i % 2 == 1};
-        const LodView start = make_camera(static_cast<CameraKind>((i / 2) % 4), curve, rng);
+        LodView start = make_camera(static_cast<CameraKind>((i / 2) % 4), curve, rng);
+        if (i % 3 == 2) {
+            // Far away, with the wire across the left edge of the view (partly out of view, a few pixels thick).
+            const double d = sphere.radius_m * uniform(rng, 20.0, 400.0);
+            const glm::dvec3 eye = sphere.centre_m + random_unit(rng) * d;
+            const glm::dvec3 fwd = glm::normalize(sphere.centre_m - eye);
+            glm::dvec3 up(0, 1, 0);
+            if (glm::length(glm::cross(fwd, up)) < 1e-3) up = glm::dvec3(1, 0, 0);
+            const glm::dvec3 right = glm::normalize(glm::cross(fwd, up));
+            const double half = d * std::tan(0.5 * kFov) * kWidth / kHeight;
+            start = LodView::perspective(eye, sphere.centre_m + right * half, up, kFov, kWidth, kHeight, 0.05, 1e6);
+        }
         // A walk: the camera recedes (or approaches) and turns a little each frame.
         const glm::dvec3 target = start.eye_m + glm::dvec3(glm::inverse(start.view_from_world)[2]) * -1.0;
         const double step = uniform(rng, -0.05, 0.2);
@@ -580,12 +591,15 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
             }
             EXPECT_FALSE(reference.bounded);
             bounded += cheap.bounded ? 1 : 0;
+            bounded_partly += cheap.bounded && cheap.visible_segments < curve.segment_count() ? 1 : 0;
             visible += cheap.visible ? 1 : 0;
             spans += cheap.spans;
         }
     }
-    std::printf("%zu updates, %zu visible, %zu decided by the per-wire bound, %zu spans\n", updates, visible,
-                bounded, spans);
+    std::printf("%zu updates, %zu visible, %zu decided by the per-wire bound (%zu of them partly out of view), %zu "
+                "spans\n",
+                updates, visible, bounded, bounded_partly, spans);
+    EXPECT_GT(bounded_partly, 20u) << "the per-segment pass of wires partly out of view is exercised";
     EXPECT_GT(bounded, visible / 5);
     EXPECT_GT(visible, updates / 2);
     EXPECT_GT(spans, 0u);
