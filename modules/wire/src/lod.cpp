@@ -457,16 +457,18 @@ void hull_depths(const Curve& curve, const LodView& view) {
     const ViewTransform tf(view);
     const glm::dmat3& m = tf.rotation;
     const glm::dvec3 t = tf.translation;
-    const double* p = &curve.segments[0].b0.x;  // CubicBezier is 4 dvec3: 12 doubles
-    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
     double* xs = sc.x.data();
     double* ys = sc.y.data();
     double* zs = sc.z.data();
-    for (std::size_t i = 0; i < 4 * n; ++i) {
-        const double px = p[3 * i], py = p[3 * i + 1], pz = p[3 * i + 2];
-        xs[i] = (m[0][0] * px + m[1][0] * py + m[2][0] * pz) + t.x;
-        ys[i] = (m[0][1] * px + m[1][1] * py + m[2][1] * pz) + t.y;
-        zs[i] = -((m[0][2] * px + m[1][2] * py + m[2][2] * pz) + t.z);
+    for (std::size_t i = 0; i < n; ++i) {
+        const CubicBezier& seg = curve.segments[i];
+        const glm::dvec3* pts[4] = {&seg.b0, &seg.b1, &seg.b2, &seg.b3};
+        for (std::size_t c = 0; c < 4; ++c) {
+            const glm::dvec3& q = *pts[c];
+            xs[4 * i + c] = (m[0][0] * q.x + m[1][0] * q.y + m[2][0] * q.z) + t.x;
+            ys[4 * i + c] = (m[0][1] * q.x + m[1][1] * q.y + m[2][1] * q.z) + t.y;
+            zs[4 * i + c] = -((m[0][2] * q.x + m[1][2] * q.y + m[2][2] * q.z) + t.z);
+        }
     }
     // Hull depth and off-axis factor per segment (hull_depth() without branches).
     const double near = view.near_m, tx = view.tan_half_x, ty = view.tan_half_y;
