@@ -274,12 +274,13 @@ TEST(WiretoolBench, FarSceneRows) {
     const int raw = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "see " << dir.string() << ".log";
     const Csv csv = read_csv(dir / "bench.csv");
-    ASSERT_EQ(csv.rows.size(), 3u) << "far x {cpu-mesh, gpu-rings, uniform}";
+    ASSERT_EQ(csv.rows.size(), 4u) << "far x {cpu-mesh, gpu-rings, gpu-retained, uniform}";
     const auto* cpu = find(csv.rows, {{"scene", "far"}, {"mode", "cpu-mesh"}});
     const auto* gpu = find(csv.rows, {{"scene", "far"}, {"mode", "gpu-rings"}});
+    const auto* kept = find(csv.rows, {{"scene", "far"}, {"mode", "gpu-retained"}});
     const auto* uni = find(csv.rows, {{"scene", "far"}, {"mode", "uniform"}});
-    ASSERT_TRUE(cpu && gpu && uni);
-    for (const auto* r : {cpu, gpu, uni}) EXPECT_EQ(number(*r, "wires"), 10000.0);
+    ASSERT_TRUE(cpu && gpu && kept && uni);
+    for (const auto* r : {cpu, gpu, kept, uni}) EXPECT_EQ(number(*r, "wires"), 10000.0);
     EXPECT_GT(number(*cpu, "visible_wires"), 1000.0);
     EXPECT_LT(number(*cpu, "visible_wires"), 10000.0) << "some cables are out of view";
     EXPECT_LE(number(*cpu, "max_screen_error_px"), number(*cpu, "tolerance_px"));
