@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -854,7 +855,8 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     for (const float r : curve.radius_m) out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
     out.wang_m_max = 0.0;
     out.levels = 0;
-    ++out.version;
+    static std::atomic<uint64_t> versions{0};  // unique over all curves: a state made for other bounds never matches
+    out.version = versions.fetch_add(1, std::memory_order_relaxed) + 1;
     out.data.clear();
     if (n == 0) return;
     // Level widths and where each level starts (root first).

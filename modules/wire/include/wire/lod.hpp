@@ -39,9 +39,12 @@
 // The cheap pass (DESIGN 4.5, issue 11): a per-wire conservative bound (sphere_screen_bound) decides most wires
 // without per-segment Wang work: when the wire's sphere lies inside the frustum, either the whole wire merges into
 // one span, or every segment needs one ring (max M <= 4/3 eps_world at the sphere's nearest depth); the exact
-// side count then needs the segments' depths only when the conservative one is above 3. Both give exactly what
-// the per-segment evaluation gives (tested); the other wires take the per-segment path, laid out as
-// structure-of-arrays loops. The span walk visits only the hierarchy levels the wire's depth range leaves open.
+// side count then needs the segments' depths only when the conservative one is above 3. A wire partly out of view
+// whose side count the sphere fixes at 3 decides each segment by its own sphere (hull test only where that sphere
+// straddles a plane). The span walk visits only the hierarchy levels the wire's depth range leaves open, and a
+// bounded wire whose decisions cannot have changed for the new camera keeps its state (WireLod::Coherence). All
+// of it gives exactly what the per-segment evaluation gives (tested); the other wires take the per-segment pass,
+// laid out as structure-of-arrays loops.
 #pragma once
 
 #include "wire/curve.hpp"
@@ -177,7 +180,7 @@ struct LodBounds {
     double wang_m_max = 0.0;    ///< max over segments of wang_m()
     std::size_t segments = 0;
     uint32_t levels = 0;                        ///< hierarchy levels (0 for an empty curve)
-    uint64_t version = 0;                       ///< +1 each time compute_lod_bounds() fills it
+    uint64_t version = 0;                       ///< new (unique) each time compute_lod_bounds() fills it
     std::array<uint32_t, 34> level_start{};     ///< index of node 0 of each level (root level first in memory)
     std::vector<double> data;                   ///< per level (min, max) deviation; nodes; Wang's M per segment
 
