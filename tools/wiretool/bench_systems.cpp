@@ -77,8 +77,9 @@ wire::WireNodes hanging_wire(int i) {
 }
 
 // `far`: a 2 km x 2 km landscape (rolling ground) with 10,000 cables of 64 nodes: power lines (three
-// conductors per span, 120-260 m spans between 18-26 m towers, sagging 2-4%) along 12 routes, and rigging (mast
-// stays, crane and ship rigging, 12-45 m, sloped, 1-3% slack) in 60 clusters. Deterministic in i.
+// conductors per span, 120-260 m spans between 18-26 m towers, 2-4% slack) along 12 corridors of parallel lines
+// (wrapped at the landscape's edges), and rigging (mast stays, crane and ship rigging, 12-45 m, sloped, 1-3%
+// slack) in 60 clusters. Deterministic in i.
 double ground_m(double x, double z) { return 12.0 * std::sin(x / 310.0) * std::cos(z / 270.0) + 6.0 * std::sin(z / 130.0); }
 
 struct FarWire {
@@ -104,7 +105,9 @@ FarWire far_wire(int i) {
         const glm::dvec3 start(-900.0 + 150.0 * route, 0.0, -950.0 + 60.0 * route);
         const double s0 = 190.0 * span, s1 = s0 + 120.0 + 140.0 * hash(route, span);
         auto tower = [&](double s) {
-            glm::dvec3 p = start + dir * std::fmod(s, 2400.0) + side * (3.5 * (phase - 1));
+            // A route longer than the landscape folds back as a parallel line 45 m to the side (a corridor).
+            const double lap = std::floor(s / 2400.0);
+            glm::dvec3 p = start + dir * std::fmod(s, 2400.0) + side * (3.5 * (phase - 1) + 45.0 * lap);
             p.x = std::fmod(p.x + 3000.0, 2000.0) - 1000.0;
             p.z = std::fmod(p.z + 3000.0, 2000.0) - 1000.0;
             p.y = ground_m(p.x, p.z) + 18.0 + 8.0 * hash(route, static_cast<int>(s));
