@@ -10,29 +10,24 @@ find_package(CLI11 REQUIRED)
 find_package(TBB REQUIRED)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
 
-# Debian's OpenSubdiv CMake config names static libraries that are not installed: make our own target.
-find_library(OSD_CPU_LIBRARY osdCPU REQUIRED)
-find_path(OSD_INCLUDE_DIR opensubdiv/far/topologyRefiner.h REQUIRED)
-add_library(opensubdiv::cpu UNKNOWN IMPORTED)
-set_target_properties(opensubdiv::cpu PROPERTIES
-  IMPORTED_LOCATION ${OSD_CPU_LIBRARY}
-  INTERFACE_SYSTEM_INCLUDE_DIRECTORIES ${OSD_INCLUDE_DIR})
-
-# stb: Debian's libstb ships the implementations (stb_image, stb_image_write) in libstb.so, so no
-# translation unit of ours defines STB_*_IMPLEMENTATION.
-find_path(STB_INCLUDE_DIR stb_image.h PATHS /usr/include/stb REQUIRED)
-find_library(STB_LIBRARY stb REQUIRED)
-add_library(third_party_stb INTERFACE)
-target_include_directories(third_party_stb SYSTEM INTERFACE ${STB_INCLUDE_DIR})
-target_link_libraries(third_party_stb INTERFACE ${STB_LIBRARY})
-add_library(third_party::stb ALIAS third_party_stb)
+# epoxy, stb and OpenSubdiv have no working CMake package on Debian: wiresDependencies.cmake (installed with our
+# package too) makes imported targets wires_deps::epoxy, wires_deps::stb, wires_deps::opensubdiv.
+include(wiresDependencies)
+if(wires_deps_missing)
+  message(FATAL_ERROR "missing system libraries: ${wires_deps_missing} (run tools/setup.sh)")
+endif()
+# Older names, kept for code that links them. stb: Debian's libstb ships the implementations (stb_image,
+# stb_image_write) in libstb.so, so no translation unit of ours defines STB_*_IMPLEMENTATION.
+add_library(opensubdiv::cpu ALIAS wires_deps::opensubdiv)
+set(STB_INCLUDE_DIR ${WIRES_STB_INCLUDE_DIR})
+add_library(third_party::stb ALIAS wires_deps::stb)
 
 # tinygltf (header-only) includes <stb_image.h> and <nlohmann/json.hpp>. Its implementation is compiled
 # once, in engine/assets.
 find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h REQUIRED)
 add_library(tinygltf_headers INTERFACE)
 target_include_directories(tinygltf_headers SYSTEM INTERFACE ${TINYGLTF_INCLUDE_DIR})
-target_link_libraries(tinygltf_headers INTERFACE nlohmann_json::nlohmann_json third_party::stb)
+target_link_libraries(tinygltf_headers INTERFACE nlohmann_json::nlohmann_json wires_deps::stb)
 add_library(third_party::tinygltf ALIAS tinygltf_headers)
 
 if(WIRE_BUILD_TESTS)

@@ -6,8 +6,10 @@ function(wire_set_warnings target)
   else()
     set(scope PRIVATE)
   endif()
-  target_compile_options(${target} ${scope} -Wall -Wextra -Wpedantic)
+  # BUILD_INTERFACE: our warning flags never reach projects that use the installed package.
+  target_compile_options(${target} ${scope} $<BUILD_INTERFACE:-Wall> $<BUILD_INTERFACE:-Wextra>
+                         $<BUILD_INTERFACE:-Wpedantic>)
   if(WIRE_WERROR)
-    target_compile_options(${target} ${scope} -Werror)
+    target_compile_options(${target} ${scope} $<BUILD_INTERFACE:-Werror>)
   endif()
 endfunction()

@@ -1,0 +1,90 @@
+# ctest package_install: the installed CMake package end to end. Run as
+#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -DCXX_COMPILER=... [-DLAUNCHER=...]
+#         [-DCONFIG=Release] -P run_package_test.cmake
+# 1. cmake --install BUILD_DIR into WORK_DIR/stage, then moves it to WORK_DIR/prefix (the package must be
+#    relocatable); 2. checks the layout (config + version files, no tools or tests installed, no installed file
+#    naming the source or build tree) and the version rule; 3. configures, builds and runs tests/package against
+#    it with nothing but CMAKE_PREFIX_PATH pointing at the prefix.
+foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "run_package_test.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+if(NOT CONFIG)
+  set(CONFIG Release)
+endif()
+
+function(run step)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "package test, ${step} failed (${rc}):\n  ${ARGN}\n${out}")
+  endif()
+  message(STATUS "${step}: ok")
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+
+file(REMOVE_RECURSE "${WORK_DIR}")
+set(stage "${WORK_DIR}/stage")
+set(prefix "${WORK_DIR}/prefix")
+run("install" ${CMAKE_COMMAND} --install "${BUILD_DIR}" --config ${CONFIG} --prefix "${stage}")
+file(RENAME "${stage}" "${prefix}")
+
+# Layout.
+set(pkg "${prefix}/lib/cmake/wires")
+foreach(f wiresConfig.cmake wiresConfigVersion.cmake wiresTargets.cmake wiresDependencies.cmake)
+  if(NOT EXISTS "${pkg}/${f}")
+    message(FATAL_ERROR "package test: ${pkg}/${f} was not installed")
+  endif()
+endforeach()
+foreach(h wire/systems/api.hpp wire/render/wire_renderer.hpp engine/ecs/registry.hpp engine/platform/context.hpp)
+  if(NOT EXISTS "${prefix}/include/${h}")
+    message(FATAL_ERROR "package test: header include/${h} was not installed")
+  endif()
+endforeach()
+file(GLOB top RELATIVE "${prefix}" "${prefix}/*")
+if(NOT top STREQUAL "include;lib")
+  message(FATAL_ERROR "package test: the prefix holds '${top}', expected only include and lib (no tools, tests)")
+endif()
+file(GLOB_RECURSE installed "${prefix}/*")
+foreach(f IN LISTS installed)
+  file(STRINGS "${f}" refs REGEX "${SOURCE_DIR}|${BUILD_DIR}")
+  if(refs)
+    list(GET refs 0 first)
+    message(FATAL_ERROR "package test: ${f} names the source or build tree (not relocatable): ${first}")
+  endif()
+endforeach()
+
+# Version rule: 0.2 accepts 0.2 (and 0.2.x), not 0.1, 0.3 or 1.0.
+foreach(want 0.2:TRUE 0.2.0:TRUE 0.1:FALSE 0.3:FALSE 1.0:FALSE)
+  string(REPLACE ":" ";" want "${want}")
+  list(GET want 0 PACKAGE_FIND_VERSION)
+  list(GET want 1 expected)
+  string(REPLACE "." ";" parts "${PACKAGE_FIND_VERSION}")
+  list(GET parts 0 PACKAGE_FIND_VERSION_MAJOR)
+  list(GET parts 1 PACKAGE_FIND_VERSION_MINOR)
+  set(PACKAGE_FIND_VERSION_RANGE FALSE)
+  unset(PACKAGE_VERSION_COMPATIBLE)
+  set(CMAKE_SIZEOF_VOID_P 8)
+  include("${pkg}/wiresConfigVersion.cmake")
+  if(NOT PACKAGE_VERSION_COMPATIBLE STREQUAL expected AND NOT (expected AND PACKAGE_VERSION_COMPATIBLE))
+    message(FATAL_ERROR "package test: find_package(wires ${PACKAGE_FIND_VERSION}) compatible = "
+                        "'${PACKAGE_VERSION_COMPATIBLE}', expected ${expected} (package ${PACKAGE_VERSION})")
+  endif()
+endforeach()
+message(STATUS "layout and version ${PACKAGE_VERSION}: ok")
+
+# The consumer project, built against the prefix only.
+set(launcher_args "")
+if(LAUNCHER)
+  set(launcher_args "-DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER}")
+endif()
+run("configure tests/package" ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package" -B "${WORK_DIR}/consumer"
+    -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=${CONFIG} "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}" ${launcher_args}
+    "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
+    "-DWIRES_README=${SOURCE_DIR}/README.md")
+run("build tests/package" ${CMAKE_COMMAND} --build "${WORK_DIR}/consumer" --config ${CONFIG})
+find_program(consumer wires_consumer PATHS "${WORK_DIR}/consumer" "${WORK_DIR}/consumer/${CONFIG}" NO_DEFAULT_PATH
+             REQUIRED)
+set(ENV{WIRES_CONSUMER_PNG} "${WORK_DIR}/consumer.png")
+run("run wires_consumer" "${consumer}")
+message(STATUS "${last_output}")
