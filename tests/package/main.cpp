@@ -84,6 +84,8 @@ int main() {
     engine::platform::Context& gl = **context_or;
     auto renderer = wire::render::WireRenderer::create();
     if (!renderer) return fail("WireRenderer::create: " + renderer.error().message);
+    // The README's wire uses material 1 (material 0 is the built-in copper weave): a light blue one.
+    if (renderer->add_material({.tint = {0.4f, 0.7f, 1.0f}}) != 1) return fail("add_material did not return 1");
 
     const wire::WireNodes nodes = hanging_cable(16, 0.2);
     const wire::WireNodes moved_nodes = hanging_cable(16, 0.3);
@@ -95,7 +97,7 @@ int main() {
     const engine::platform::Image image = engine::platform::read_pixels(gl);
     gl.end_frame();
 
-    // Drawn where the nodes project: a non-background pixel within 2 px of every moved node.
+    // Drawn where the nodes project, in material 1: a blue pixel within 2 px of every moved node.
     const glm::mat4 clip_from_world = camera.view_projection();
     int hits = 0;
     for (const glm::dvec3& p : moved_nodes.positions) {
@@ -107,7 +109,9 @@ int main() {
             for (int dx = -2; dx <= 2 && !hit; ++dx) {
                 const int px = x + dx;
                 const int py = y + dy;
-                hit = px >= 0 && py >= 0 && px < width && py < height && !background(image.pixel(px, py), clear);
+                if (px < 0 || py < 0 || px >= width || py >= height) continue;
+                const std::uint8_t* c = image.pixel(px, py);
+                hit = !background(c, clear) && c[2] > c[0] + 20;  // material 1's blue
             }
         }
         hits += hit ? 1 : 0;
