@@ -1,22 +1,25 @@
 #!/usr/bin/env bash
 # Installs every system package the project needs (Debian), then configures and builds.
 # Idempotent: when every package is present it skips apt-get entirely and only builds.
-# Usage: tools/setup.sh [--no-build] [--build-dir DIR] [--type Release|Debug|RelWithDebInfo]
+# Usage: tools/setup.sh [--no-build] [--build-dir DIR] [--type Release|Debug|RelWithDebInfo] [--docs]
+#   --docs also installs Doxygen (for `cmake --build build --target docs`, the API reference).
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="$here/build"
 build_type="Release"
 do_build=1
+do_docs=0
 
 usage() {
-  sed -n '2,4p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,5p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
 }
 while [ $# -gt 0 ]; do
   case "$1" in
     --no-build) do_build=0 ;;
     --build-dir) build_dir="$2"; shift ;;
     --type) build_type="$2"; shift ;;
+    --docs) do_docs=1 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "setup.sh: unknown option '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -30,6 +33,7 @@ packages=(
   cmake
   gnuplot-nox
   libbenchmark-dev
+  libbullet-dev
   libclang-rt-14-dev
   libcli11-dev
   libegl-dev
@@ -49,6 +53,8 @@ packages=(
   nlohmann-json3-dev
   pkg-config
 )
+# Only when asked (--docs): the API reference generator.
+if [ "$do_docs" -eq 1 ]; then packages+=(doxygen); fi
 
 missing=()
 for p in "${packages[@]}"; do

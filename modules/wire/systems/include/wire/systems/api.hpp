@@ -1,10 +1,13 @@
-// Game-side API of wire entities: spawn, update, inspect. Destroy with registry.destroy(entity): every wire
-// component lives on the entity, so nothing else holds on to it.
-//
-//   engine::ecs::Entity w = wire::systems::spawn_wire(registry, nodes, {.radius_m = 0.02f});
-//   wire::systems::set_nodes(registry, w, moved_nodes);                  // or edit_nodes(registry, w).positions[3] = p;
-//   wire::systems::insert_node(registry, w, 4, midpoint);                // a new node with a fresh stable id
-//   registry.destroy(w);
+/// \file
+/// Game-side API of wire entities: spawn, update, inspect. Destroy with registry.destroy(entity): every wire
+/// component lives on the entity, so nothing else holds on to it.
+///
+/// \code
+///   engine::ecs::Entity w = wire::systems::spawn_wire(registry, nodes, {.radius_m = 0.02f});
+///   wire::systems::set_nodes(registry, w, moved_nodes);                  // or edit_nodes(registry, w).positions[3] = p;
+///   wire::systems::insert_node(registry, w, 4, midpoint);                // a new node with a fresh stable id
+///   registry.destroy(w);
+/// \endcode
 #pragma once
 
 #include "wire/systems/components.hpp"
@@ -13,6 +16,8 @@
 
 #include <string>
 
+/// The wire module's ECS side: wire entities (Nodes + Style and the derived components), the game-side API that
+/// spawns and updates them, and the systems that turn them into a DrawList every frame (install()).
 namespace wire::systems {
 
 /// A new wire entity with `nodes` and `style`, plus the systems' derived components (empty until the systems

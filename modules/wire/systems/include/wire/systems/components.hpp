@@ -1,5 +1,6 @@
-// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them as
-// changed); the wire systems own everything else and keep it between frames.
+/// \file
+/// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them as
+/// changed); the wire systems own everything else and keep it between frames.
 #pragma once
 
 #include "wire/curve.hpp"
@@ -33,7 +34,7 @@ struct Style {
 
 /// Curve stage: the rendered curve (pop-free: blended while nodes appear or vanish) and its change counter.
 struct WireCurve {
-    MultiresCurve multires{MultiresSettings{}};
+    MultiresCurve multires{MultiresSettings{}};  ///< pop-free state: blends nodes in and out over frames
     Curve curve;                       ///< what is drawn; empty until the nodes were valid once
     SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
     uint64_t generation = 0;           ///< +1 each time `curve` changes
@@ -45,14 +46,14 @@ struct WireCurve {
     // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
     // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
     // `previous_nodes` (the last valid state) when the ids change.
-    WireNodes previous_nodes;
-    Curve scratch;
-    bool multires_stale = false;
+    WireNodes previous_nodes;          ///< the last valid nodes (re-primes `multires` when ids change)
+    Curve scratch;                     ///< reused storage of the fast path
+    bool multires_stale = false;       ///< `multires` lags behind `curve` (the fast path ran)
 };
 
 /// LOD stage: visibility, per-segment ring counts and sides for the context's camera.
 struct WireLodState {
-    WireLod lod;
+    WireLod lod;                       ///< visibility, per-segment ring counts and sides
     uint64_t generation = 0;           ///< +1 each time counts or visibility change
     uint64_t seen_curve = 0;           ///< WireCurve::generation the LOD was computed for
     uint64_t seen_view = 0;            ///< WireContext view generation the LOD was computed for
@@ -61,20 +62,20 @@ struct WireLodState {
 
 /// Ring stage: ring records along the wire (the gpu_rings path uploads these).
 struct WireRings {
-    std::vector<RingParam> params;
-    RingSet rings;
+    std::vector<RingParam> params;     ///< where the rings sit on the curve (segment, t)
+    RingSet rings;                     ///< ring centres, frames, radii and u
     uint64_t generation = 0;           ///< +1 each time the rings are rebuilt
-    uint64_t seen_curve = 0;
-    uint64_t seen_lod = 0;
+    uint64_t seen_curve = 0;           ///< WireCurve::generation the rings were built from
+    uint64_t seen_lod = 0;             ///< WireLodState::generation the rings were built from
 };
 
 /// Mesh stage (cpu_mesh path only): the tube's vertices and indices.
 struct WireMesh {
-    TubeMesh mesh;
+    TubeMesh mesh;                     ///< vertices (TubeVertex) and triangle indices
     uint64_t generation = 0;           ///< +1 each time the mesh is rebuilt
-    uint64_t seen_rings = 0;
-    uint32_t sides = 0;
-    bool caps = true;
+    uint64_t seen_rings = 0;           ///< WireRings::generation the mesh was built from
+    uint32_t sides = 0;                ///< radial sides the mesh was built with
+    bool caps = true;                  ///< the mesh has end caps
 };
 
 /// A wire whose nodes are invalid (NaN, fewer than 2 distinct nodes, ...): the message names the entity and the
@@ -82,7 +83,7 @@ struct WireMesh {
 /// WireContext::new_errors and through WireContext::on_error) when it appears or its message changes; removed
 /// when the nodes become valid again. While it is present the wire keeps drawing its last valid curve, if any.
 struct WireError {
-    std::string message;
+    std::string message;               ///< names the entity, the node and the problem
     int node = -1;                     ///< offending input node, -1 if no single node
 };
 

@@ -1,5 +1,6 @@
-// What the wire systems share for one scene: the camera and settings the game sets each frame, the frame's
-// DrawList and statistics they produce, and their work lists. One WireContext per registry and schedule.
+/// \file
+/// What the wire systems share for one scene: the camera and settings the game sets each frame, the frame's
+/// DrawList and statistics they produce, and their work lists. One WireContext per registry and schedule.
 #pragma once
 
 #include "wire/draw.hpp"
@@ -21,28 +22,31 @@ struct FrameStats {
     std::size_t wires = 0;             ///< wire entities (with Nodes and Style)
     std::size_t curves_built = 0;      ///< curve stage runs (changed nodes/style, or an ongoing geomorph)
     std::size_t lod_updates = 0;       ///< update_lod runs (hull tests); 0 when nothing moved
-    std::size_t visible_wires = 0;
-    std::size_t culled_wires = 0;
+    std::size_t visible_wires = 0;     ///< wires in the draw list (valid curve, inside the view)
+    std::size_t culled_wires = 0;      ///< wires with a valid curve outside the view
     std::size_t rings_built = 0;       ///< wires whose rings were rebuilt
     std::size_t meshes_built = 0;      ///< wires whose mesh was rebuilt (cpu_mesh path)
     std::size_t rings = 0;             ///< rings of the visible wires
     std::size_t vertices = 0;          ///< mesh vertices of the visible wires (cpu_mesh), or rings * (sides + 1)
     std::size_t indices = 0;           ///< mesh indices of the visible wires (cpu_mesh)
-    std::size_t draw_items = 0;
+    std::size_t draw_items = 0;        ///< items in WireContext::draw_list
     std::size_t errors = 0;            ///< wires with a WireError
 };
 
 /// A wire error as reported once.
 struct ErrorReport {
-    engine::ecs::Entity entity = engine::ecs::null_entity;
-    std::string message;
+    engine::ecs::Entity entity = engine::ecs::null_entity;  ///< the wire
+    std::string message;  ///< WireError::message, e.g. "wire entity 12 (index 12, version 0): node 3: position.y is NaN"
 };
 
+/// What the wire systems share for one scene: the game sets the camera, viewport and settings before
+/// Schedule::run; the systems leave the frame's draw list, statistics and new errors here. One per registry and
+/// schedule; it must outlive the schedule it was installed on (install()).
 struct WireContext {
     // ---- set by the game ----
-    engine::scene::Camera camera{};
-    double viewport_width_px = 1920.0;
-    double viewport_height_px = 1080.0;
+    engine::scene::Camera camera{};              ///< the camera the wires are seen from (LOD and culling)
+    double viewport_width_px = 1920.0;           ///< viewport the frame is drawn into, pixels (LOD screen error)
+    double viewport_height_px = 1080.0;          ///< viewport height, pixels
     LodSettings lod{};                           ///< tolerance (px), max rings per segment, hysteresis
     UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_rings stops at ring records
     bool pop_free = true;                        ///< geomorph when node ids appear or vanish (multires.hpp)
@@ -51,14 +55,14 @@ struct WireContext {
 
     // ---- produced by the systems each frame ----
     DrawList draw_list;                          ///< valid until the systems run again
-    FrameStats stats;
+    FrameStats stats;                            ///< counts of the last Schedule::run
     std::vector<ErrorReport> new_errors;         ///< errors that appeared this frame
 
     // ---- the systems' own bookkeeping ----
     LodView view{};                              ///< the camera as the LOD sees it (double)
     uint64_t view_generation = 0;                ///< +1 whenever `view` or the LOD settings change
-    LodSettings seen_lod{};
-    bool has_view = false;
+    LodSettings seen_lod{};                      ///< the LOD settings `view_generation` was taken with
+    bool has_view = false;                       ///< `view` was computed at least once
     std::vector<engine::ecs::Entity> curve_changed;  ///< wires whose curve changed this frame
     std::vector<engine::ecs::Entity> blending;       ///< wires in a geomorph (their curve changes next frame)
 };

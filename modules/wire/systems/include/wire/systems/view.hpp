@@ -1,4 +1,5 @@
-// The camera as the wire LOD sees it: engine::scene::Camera plus the viewport size -> wire::LodView (double).
+/// \file
+/// The camera as the wire LOD sees it: engine::scene::Camera plus the viewport size -> wire::LodView (double).
 #pragma once
 
 #include "wire/lod.hpp"

@@ -1,0 +1,17 @@
+# ctest api_docs_wire_systems: runs Doxygen with DOXYFILE (WARN_IF_UNDOCUMENTED, WARN_LOGFILE = LOG) and fails,
+# listing them, if it reported any warning (an undocumented public symbol, a broken doc command).
+file(REMOVE "${LOG}")
+execute_process(COMMAND "${DOXYGEN}" "${DOXYFILE}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "doxygen failed (${rc}):\n${out}")
+endif()
+if(NOT EXISTS "${LOG}")
+  message(FATAL_ERROR "doxygen wrote no warning log ${LOG}")
+endif()
+file(STRINGS "${LOG}" warnings)
+list(LENGTH warnings count)
+if(count GREATER 0)
+  string(JOIN "\n" text ${warnings})
+  message(FATAL_ERROR "doxygen: ${count} warnings (undocumented public symbols of the wire systems API):\n${text}")
+endif()
+message(STATUS "doxygen: no undocumented public symbol")
