@@ -1,7 +1,7 @@
 # API reference with Doxygen (Debian's doxygen; tools/setup.sh --docs installs it):
 #   cmake --build build --target docs   -> build/docs/html/index.html (every public header, README as main page)
-# and, when Doxygen is found, ctest api_docs_wire_systems: Doxygen must report no undocumented public symbol of
-# the wire systems API (modules/wire/systems/include; WARN_IF_UNDOCUMENTED, warnings to a file that must be empty).
+# and, when Doxygen is found, the ctest checks below: Doxygen must report no undocumented public symbol
+# (WARN_IF_UNDOCUMENTED, warnings to a file that must be empty).
 find_package(Doxygen QUIET)
 
 # Every installed target's include/ folder (cmake/Install.cmake's list).
@@ -33,16 +33,36 @@ add_custom_target(docs
   COMMENT "Doxygen: API reference"
   VERBATIM)
 
-if(WIRE_BUILD_TESTS)
-  set(DOXY_INPUT "${PROJECT_SOURCE_DIR}/modules/wire/systems/include")
+# ctest checks: Doxygen with WARN_IF_UNDOCUMENTED on a set of headers; any warning fails the test.
+#   api_docs_wire_systems  the wire systems API (modules/wire/systems/include), every header
+#   api_docs_game_api      the other headers a game calls in "Wires from game code" and examples/bullet_ropes:
+#                          wire nodes and draw list, the wire renderer, registry/entity/schedule, context/capture/
+#                          expected, camera
+function(wires_add_doc_check name)
+  set(DOXY_INPUT "${ARGN}")
+  string(REPLACE ";" " " DOXY_INPUT "${DOXY_INPUT}")
   set(DOXY_MAINPAGE "")
-  set(DOXY_OUTPUT "${CMAKE_BINARY_DIR}/docs_check")
+  set(DOXY_OUTPUT "${CMAKE_BINARY_DIR}/${name}")
   set(DOXY_HTML NO)
   set(DOXY_XML YES)  # some output must be generated for Doxygen to report undocumented members
-  set(DOXY_WARN_LOG "${CMAKE_BINARY_DIR}/docs_check/warnings.txt")
-  configure_file(${PROJECT_SOURCE_DIR}/docs/Doxyfile.in ${CMAKE_BINARY_DIR}/docs_check/Doxyfile @ONLY)
-  add_test(NAME api_docs_wire_systems
-    COMMAND ${CMAKE_COMMAND} -DDOXYGEN=$<TARGET_FILE:Doxygen::doxygen> -DDOXYFILE=${CMAKE_BINARY_DIR}/docs_check/Doxyfile
+  set(DOXY_WARN_LOG "${CMAKE_BINARY_DIR}/${name}/warnings.txt")
+  configure_file(${PROJECT_SOURCE_DIR}/docs/Doxyfile.in ${CMAKE_BINARY_DIR}/${name}/Doxyfile @ONLY)
+  add_test(NAME ${name}
+    COMMAND ${CMAKE_COMMAND} -DDOXYGEN=$<TARGET_FILE:Doxygen::doxygen> -DDOXYFILE=${CMAKE_BINARY_DIR}/${name}/Doxyfile
             -DLOG=${DOXY_WARN_LOG} -P ${PROJECT_SOURCE_DIR}/docs/check_doxygen.cmake)
-  set_tests_properties(api_docs_wire_systems PROPERTIES TIMEOUT 60 LABELS docs)
+  set_tests_properties(${name} PROPERTIES TIMEOUT 60 LABELS docs)
+endfunction()
+
+if(WIRE_BUILD_TESTS)
+  wires_add_doc_check(api_docs_wire_systems ${PROJECT_SOURCE_DIR}/modules/wire/systems/include)
+  set(src ${PROJECT_SOURCE_DIR})
+  wires_add_doc_check(api_docs_game_api
+    ${src}/modules/wire/include/wire/nodes.hpp ${src}/modules/wire/include/wire/draw.hpp
+    ${src}/modules/wire/render/include/wire/render/wire_renderer.hpp
+    ${src}/engine/ecs/include/engine/ecs/registry.hpp ${src}/engine/ecs/include/engine/ecs/entity.hpp
+    ${src}/engine/ecs/include/engine/ecs/schedule.hpp
+    ${src}/engine/platform/include/engine/platform/context.hpp
+    ${src}/engine/platform/include/engine/platform/capture.hpp
+    ${src}/engine/platform/include/engine/platform/expected.hpp
+    ${src}/engine/scene/include/engine/scene/camera.hpp)
 endif()

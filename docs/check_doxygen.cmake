@@ -1,4 +1,4 @@
-# ctest api_docs_wire_systems: runs Doxygen with DOXYFILE (WARN_IF_UNDOCUMENTED, WARN_LOGFILE = LOG) and fails,
+# ctest api_docs_*: runs Doxygen with DOXYFILE (WARN_IF_UNDOCUMENTED, WARN_LOGFILE = LOG) and fails,
 # listing them, if it reported any warning (an undocumented public symbol, a broken doc command).
 file(REMOVE "${LOG}")
 execute_process(COMMAND "${DOXYGEN}" "${DOXYFILE}" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
@@ -12,6 +12,6 @@ file(STRINGS "${LOG}" warnings)
 list(LENGTH warnings count)
 if(count GREATER 0)
   string(JOIN "\n" text ${warnings})
-  message(FATAL_ERROR "doxygen: ${count} warnings (undocumented public symbols of the wire systems API):\n${text}")
+  message(FATAL_ERROR "doxygen: ${count} warnings (undocumented public symbols):\n${text}")
 endif()
 message(STATUS "doxygen: no undocumented public symbol")

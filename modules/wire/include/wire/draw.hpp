@@ -1,6 +1,7 @@
-// The interface between the wire systems (CPU: which wires, what geometry) and the wire renderer (GL: upload
-// and draw): one DrawItem per visible wire per frame. Plain data; the arrays are owned by the systems and stay
-// valid until the next frame's systems run.
+/// \file
+/// The interface between the wire systems (CPU: which wires, what geometry) and the wire renderer (GL: upload
+/// and draw): one DrawItem per visible wire per frame. Plain data; the arrays are owned by the systems and stay
+/// valid until the next frame's systems run.
 #pragma once
 
 #include "wire/rings.hpp"
@@ -24,7 +25,7 @@ enum class UploadPath : uint8_t {
 /// One visible wire this frame. Positions inside are relative to origin_m (double, world), so the renderer can
 /// draw camera-relative: offset = origin_m - camera position, computed in double, sent as float.
 struct DrawItem {
-    glm::dvec3 origin_m{};
+    glm::dvec3 origin_m{};   ///< world position the item's geometry is relative to
     uint32_t material = 0;   ///< index into the renderer's material table (texture, colour)
     uint64_t wire_id = 0;    ///< the wire's entity (unique while it lives; the retained ring storage's key)
     /// gpu_rings: changes whenever `rings` change (WireRings::generation). The renderer keeps a wire's ring
@@ -32,21 +33,21 @@ struct DrawItem {
     uint64_t rings_generation = 0;
 
     // cpu_mesh path
-    std::span<const TubeVertex> vertices;
+    std::span<const TubeVertex> vertices;  ///< tube vertices (cpu_mesh path)
     std::span<const uint32_t> indices;  ///< relative to this item's first vertex
 
     // gpu_rings path
-    std::span<const Ring> rings;
+    std::span<const Ring> rings;  ///< ring records (gpu_rings path)
     uint32_t sides = 8;      ///< radial sides, >= 3
-    bool closed = false;
+    bool closed = false;     ///< closed loop (the last ring connects back to the first)
     bool caps = true;        ///< flat end caps on open wires
     float u_close = 0.0f;    ///< closed wires: u where the loop returns to ring 0 (RingSet::u.back())
 };
 
 /// Everything the renderer needs for one frame.
 struct DrawList {
-    UploadPath path = UploadPath::cpu_mesh;
-    std::vector<DrawItem> items;
+    UploadPath path = UploadPath::cpu_mesh;  ///< which of the item's arrays are filled
+    std::vector<DrawItem> items;             ///< the visible wires, in entity order
 };
 
 }  // namespace wire

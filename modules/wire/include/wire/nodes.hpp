@@ -1,4 +1,5 @@
-// Input of the curve stage: a wire's lumped-element nodes (struct of arrays) and the spline settings.
+/// \file
+/// Input of the curve stage: a wire's lumped-element nodes (struct of arrays) and the spline settings.
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -6,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+/// The wire module: curves through lumped-element nodes, rotation-minimizing frames, rings, tube meshes,
+/// tessellation and screen-space LOD on plain arrays (no GL, no ECS); see wire::systems and wire::render.
 namespace wire {
 
 /// One wire's nodes in struct-of-arrays form. Only `positions` is required; every other array is either
@@ -25,13 +28,15 @@ struct WireNodes {
     std::vector<double> area_m2;         ///< cross-section area (> 0)
 
     // Optional per-node Kochanek-Bartels parameters; when present they replace the wire-wide values.
-    std::vector<float> kb_tension;
-    std::vector<float> kb_bias;
-    std::vector<float> kb_continuity;
+    std::vector<float> kb_tension;     ///< per-node Kochanek-Bartels tension
+    std::vector<float> kb_bias;        ///< per-node Kochanek-Bartels bias
+    std::vector<float> kb_continuity;  ///< per-node Kochanek-Bartels continuity
 
+    /// Number of nodes (positions.size()).
     [[nodiscard]] std::size_t size() const { return positions.size(); }
 };
 
+/// The curve through the nodes.
 enum class SplineKind : uint8_t {
     catmull_rom = 0,  ///< local, C1; any alpha; cardinal tension / Kochanek-Bartels / curvature tension apply
     c2,               ///< global C2 interpolating cubic, chordal knots (Thomas / Sherman-Morrison solve)
@@ -42,7 +47,7 @@ enum class SplineKind : uint8_t {
 /// Settings of the curve stage. Default-initialized (`SplineSettings{}` or `{.closed = true}`) is sensible:
 /// centripetal Catmull-Rom, no tension, open wire, radius 1 cm, merge epsilon 1e-9 of the scene scale.
 struct SplineSettings {
-    SplineKind kind = SplineKind::catmull_rom;
+    SplineKind kind = SplineKind::catmull_rom;  ///< curve family
     double alpha = 0.5;       ///< knot exponent: 0 uniform, 0.5 centripetal, 1 chordal; any finite value
     double tension = 0.0;     ///< cardinal / Kochanek-Bartels tension, wire-wide (1 = straight segments)
     double bias = 0.0;        ///< Kochanek-Bartels bias, wire-wide

@@ -1,20 +1,23 @@
-// The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
-// persistently mapped buffers and one multi-draw per material. The only wire code that touches GL.
-//
-// Upload paths: cpu-mesh streams every visible wire's vertices and indices each frame; gpu-rings keeps each
-// wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
-// a frame sends the rings of changed wires plus one draw record and command per visible wire, and expands the
-// tube in the vertex shader over a static index pattern per side count (each vertex shaded once per ring).
-//
-// Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
-// by material, (2) a per-mode "prepare" step that writes each item's draw record and indirect commands (and
-// streams or retains its geometry), (3) one shared submission loop issuing glMultiDrawElementsIndirect per run
-// of equal materials with the mode's program, vertex array and element buffer. A new mode adds a program, a
-// prepare step and its element pattern.
-//
-//   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
-//   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
-//   wire::render::FrameStats stats = renderer->draw(list, camera);  // list.path picks cpu_mesh or gpu_rings
+/// \file
+/// The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
+/// persistently mapped buffers and one multi-draw per material. The only wire code that touches GL.
+///
+/// Upload paths: cpu-mesh streams every visible wire's vertices and indices each frame; gpu-rings keeps each
+/// wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
+/// a frame sends the rings of changed wires plus one draw record and command per visible wire, and expands the
+/// tube in the vertex shader over a static index pattern per side count (each vertex shaded once per ring).
+///
+/// Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
+/// by material, (2) a per-mode "prepare" step that writes each item's draw record and indirect commands (and
+/// streams or retains its geometry), (3) one shared submission loop issuing glMultiDrawElementsIndirect per run
+/// of equal materials with the mode's program, vertex array and element buffer. A new mode adds a program, a
+/// prepare step and its element pattern.
+///
+/// \code
+///   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
+///   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
+///   wire::render::FrameStats stats = renderer->draw(list, camera);  // list.path picks cpu_mesh or gpu_rings
+/// \endcode
 #pragma once
 
 #include "wire/draw.hpp"
@@ -32,6 +35,7 @@
 #include <string_view>
 #include <vector>
 
+/// The wire renderer: the one part of the wire module that makes GL calls.
 namespace wire::render {
 
 using engine::platform::Error;
@@ -47,10 +51,10 @@ struct Material {
 /// blinn^shininess) * light colour, albedo = texture(u, v) * tint. Both upload paths shade identically.
 struct Light {
     glm::vec3 to_light{0.3f, 1.0f, 0.5f};  ///< direction toward the light (normalized by the renderer)
-    glm::vec3 color{1.0f};
-    float ambient = 0.2f;
-    float specular = 0.15f;
-    float shininess = 32.0f;
+    glm::vec3 color{1.0f};     ///< light colour (linear RGB)
+    float ambient = 0.2f;      ///< fraction of the albedo seen on the unlit side
+    float specular = 0.15f;    ///< Blinn-Phong specular strength
+    float shininess = 32.0f;   ///< Blinn-Phong exponent
 };
 
 /// Zero means default.
@@ -77,7 +81,7 @@ struct RendererDesc {
 
 /// Per-frame options.
 struct FrameSettings {
-    Light light{};
+    Light light{};           ///< the frame's directional light
     bool wireframe = false;  ///< glPolygonMode(GL_LINE) for this frame's wires
     /// Camera position in double (world metres); unset: camera.position. Offsets origin_m - eye are computed
     /// in double and sent as float, so wires far from the world origin keep their precision.
@@ -92,14 +96,16 @@ struct FrameStats {
     std::size_t wires_evicted = 0;        ///< gpu-rings retained: ranges freed (wires not drawn for a while)
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
     std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
-    std::size_t triangles = 0;
-    std::size_t indirect_commands = 0;
+    std::size_t triangles = 0;          ///< triangles drawn
+    std::size_t indirect_commands = 0;  ///< indirect draw commands written (one per item drawn)
     std::size_t multi_draw_calls = 0;  ///< one per material in use
-    bool buffer_grew = false;
+    bool buffer_grew = false;  ///< the stream buffer was reallocated larger this frame
     bool waited_for_gpu =
         false;  ///< the region's fence had not signalled (more frames in flight than regions)
 };
 
+/// Draws DrawLists (see the file comment). Owns GL objects: create, use and destroy it with the same context
+/// current. Move-only.
 class WireRenderer {
 public:
     /// Compiles the programs (errors carry the driver's log via engine::gfx::make_program), makes the weave
@@ -107,17 +113,19 @@ public:
     /// context.
     static Expected<WireRenderer> create(const RendererDesc& desc = {});
 
-    WireRenderer();
-    WireRenderer(WireRenderer&&) noexcept;
-    WireRenderer& operator=(WireRenderer&&) noexcept;
-    ~WireRenderer();
+    WireRenderer();                                   ///< empty: use create()
+    WireRenderer(WireRenderer&&) noexcept;            ///< takes over the GL objects
+    WireRenderer& operator=(WireRenderer&&) noexcept;  ///< takes over the GL objects
+    ~WireRenderer();                                  ///< deletes the GL objects (context current)
 
     /// Adds a texture (e.g. engine::gfx::make_texture with Wrap::repeat); returns its index for
     /// Material::texture.
     uint32_t add_texture(engine::gfx::Texture texture);
     /// Adds a material; returns its index for DrawItem::material.
     uint32_t add_material(const Material& material);
+    /// Replaces material `index` (< materials().size()).
     void set_material(uint32_t index, const Material& material);
+    /// The material table; DrawItem::material indexes it.
     [[nodiscard]] const std::vector<Material>& materials() const;
 
     /// Uploads and draws `list` into the bound framebuffer with depth test and back-face culling (it does not
@@ -134,6 +142,7 @@ public:
     [[nodiscard]] std::size_t live_stream_buffers() const;
     /// GL names of every stream buffer allocated so far (the first is the initial one).
     [[nodiscard]] const std::vector<unsigned>& allocated_stream_buffers() const;
+    /// Capacity of one stream-buffer region now, bytes.
     [[nodiscard]] std::size_t region_bytes() const;
     /// Retained ring storage: wires resident, bytes in live ranges, buffer capacity, GL buffers alive, and every
     /// GL buffer it allocated (tests check growth retires the old ones).
