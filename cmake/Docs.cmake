@@ -19,7 +19,7 @@ if(NOT DOXYGEN_FOUND)
 endif()
 
 string(JOIN " " DOXY_INCLUDE_ROOTS ${wires_doc_dirs})
-set(DOXY_INPUT "${DOXY_INCLUDE_ROOTS} ${PROJECT_SOURCE_DIR}/README.md")
+set(DOXY_INPUT "${DOXY_INCLUDE_ROOTS} ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/docs")
 set(DOXY_MAINPAGE "${PROJECT_SOURCE_DIR}/README.md")
 set(DOXY_OUTPUT "${CMAKE_BINARY_DIR}/docs")
 set(DOXY_HTML YES)
@@ -36,8 +36,9 @@ add_custom_target(docs
 # ctest checks: Doxygen with WARN_IF_UNDOCUMENTED on a set of headers; any warning fails the test.
 #   api_docs_wire_systems  the wire systems API (modules/wire/systems/include), every header
 #   api_docs_game_api      the other headers a game calls in "Wires from game code" and examples/bullet_ropes:
-#                          wire nodes and draw list, the wire renderer, registry/entity/schedule, context/capture/
-#                          expected, camera
+#                          wire nodes, draw list, LOD settings and status, the wire renderer, ECS registry/entity/
+#                          schedule/view, platform context/capture/expected/input, camera, frustum, lit renderer
+#                          and meshes
 function(wires_add_doc_check name)
   set(DOXY_INPUT "${ARGN}")
   string(REPLACE ";" " " DOXY_INPUT "${DOXY_INPUT}")
@@ -64,5 +65,9 @@ if(WIRE_BUILD_TESTS)
     ${src}/engine/platform/include/engine/platform/context.hpp
     ${src}/engine/platform/include/engine/platform/capture.hpp
     ${src}/engine/platform/include/engine/platform/expected.hpp
-    ${src}/engine/scene/include/engine/scene/camera.hpp)
+    ${src}/engine/scene/include/engine/scene/camera.hpp
+    ${src}/engine/ecs/include/engine/ecs/view.hpp ${src}/engine/platform/include/engine/platform/input.hpp
+    ${src}/engine/gfx/include/engine/gfx/lit_renderer.hpp ${src}/engine/gfx/include/engine/gfx/mesh.hpp
+    ${src}/engine/scene/include/engine/scene/frustum.hpp ${src}/modules/wire/include/wire/lod.hpp
+    ${src}/modules/wire/include/wire/status.hpp)
 endif()

@@ -39,20 +39,25 @@ std::string frame_name(int frame) {
 
 int main(int argc, char** argv) {
     Options opt;
-    CLI::App app{"bullet_ropes: Bullet soft-body ropes and cables (BulletSoftBody) hanging, swinging and colliding "
-                 "with a floor and a box, their nodes handed to wire entities every frame and drawn by the wire "
-                 "renderer"};
-    app.add_flag("--headless", opt.headless, "Render off-screen with EGL (automatic when there is no display)");
+    CLI::App app{
+        "bullet_ropes: Bullet soft-body ropes and cables (BulletSoftBody) hanging, swinging and colliding "
+        "with a floor and a box, their nodes handed to wire entities every frame and drawn by the wire "
+        "renderer"};
+    app.add_flag("--headless", opt.headless,
+                 "Render off-screen with EGL (automatic when there is no display)");
     app.add_flag("--window", opt.window, "Require a window (fail without a display)")->excludes("--headless");
     app.add_option("--frames", opt.frames, "Frames to run (headless default 240; window: until closed)")
         ->check(CLI::Range(1, 100000000));
-    app.add_option("--capture-every", opt.capture_every,
-                   "Write every K-th frame (and the last) as DIR/frame_NNNN.png; 0: only the last headless, none "
-                   "in a window")
+    app.add_option(
+           "--capture-every", opt.capture_every,
+           "Write every K-th frame (and the last) as DIR/frame_NNNN.png; 0: only the last headless, none "
+           "in a window")
         ->check(CLI::Range(0, 100000000))
         ->capture_default_str();
     app.add_option("--out", opt.out_dir, "Directory for PNG frames")->capture_default_str();
-    app.add_option("--width", opt.width, "Framebuffer width in pixels")->check(CLI::Range(16, 8192))->capture_default_str();
+    app.add_option("--width", opt.width, "Framebuffer width in pixels")
+        ->check(CLI::Range(16, 8192))
+        ->capture_default_str();
     app.add_option("--height", opt.height, "Framebuffer height in pixels")
         ->check(CLI::Range(16, 8192))
         ->capture_default_str();
@@ -75,8 +80,8 @@ int main(int argc, char** argv) {
         return 1;
     }
     platform::Context& ctx = **created;
-    std::printf("bullet_ropes: %s, GL %s on %s\n", ctx.headless() ? "headless" : "window", ctx.gl_version().c_str(),
-                ctx.gl_renderer().c_str());
+    std::printf("bullet_ropes: %s, GL %s on %s\n", ctx.headless() ? "headless" : "window",
+                ctx.gl_version().c_str(), ctx.gl_renderer().c_str());
 
     engine::ecs::Registry registry;
     engine::ecs::Schedule schedule;
@@ -124,7 +129,7 @@ int main(int argc, char** argv) {
         }
         ctx.end_frame();
     }
-    std::printf("bullet_ropes: %d ropes, %.2f s simulated, %d images\n", static_cast<int>(scene.ropes().size()),
-                scene.time_s(), written);
+    std::printf("bullet_ropes: %d ropes, %.2f s simulated, %d images\n",
+                static_cast<int>(scene.ropes().size()), scene.time_s(), written);
     return 0;
 }

@@ -17,9 +17,12 @@
 namespace bullet_ropes {
 namespace {
 
-btVector3 bt(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+btVector3 bt(const glm::vec3& v) {
+    return {v.x, v.y, v.z};
+}
 
-// A soft-body rope through `points` (one node per point, links between neighbours). mass_kg is the whole rope's.
+// A soft-body rope through `points` (one node per point, links between neighbours). mass_kg is the whole
+// rope's.
 btSoftBody* make_rope(btSoftBodyWorldInfo& info, const std::vector<btVector3>& points, float mass_kg,
                       bool fix_first, bool fix_last) {
     const int n = static_cast<int>(points.size());
@@ -34,7 +37,8 @@ btSoftBody* make_rope(btSoftBodyWorldInfo& info, const std::vector<btVector3>& p
 // n points on the straight line a -> b.
 std::vector<btVector3> line(const btVector3& a, const btVector3& b, int n) {
     std::vector<btVector3> p;
-    for (int i = 0; i < n; ++i) p.push_back(a.lerp(b, static_cast<btScalar>(i) / static_cast<btScalar>(n - 1)));
+    for (int i = 0; i < n; ++i)
+        p.push_back(a.lerp(b, static_cast<btScalar>(i) / static_cast<btScalar>(n - 1)));
     return p;
 }
 
@@ -94,14 +98,16 @@ wire::WireNodes wire_nodes(const btSoftBody& body) {
     return nodes;
 }
 
-RopeScene::RopeScene(engine::ecs::Registry& registry) : registry_(registry), world_(std::make_unique<World>()) {
+RopeScene::RopeScene(engine::ecs::Registry& registry)
+    : registry_(registry), world_(std::make_unique<World>()) {
     World& w = *world_;
     w.world.setGravity(btVector3(0.0f, -9.81f, 0.0f));
     w.info.m_gravity = btVector3(0.0f, -9.81f, 0.0f);
     w.info.air_density = 1.2f;
     w.info.m_sparsesdf.Initialize();
-    w.info.m_sparsesdf.setDefaultVoxelsz(0.025f);  // rigid shapes' distance field: 2.5 cm cells (default 25 cm
-    w.info.m_sparsesdf.Reset();                   // rounds the box's edges by centimetres)
+    w.info.m_sparsesdf.setDefaultVoxelsz(
+        0.025f);                 // rigid shapes' distance field: 2.5 cm cells (default 25 cm
+    w.info.m_sparsesdf.Reset();  // rounds the box's edges by centimetres)
 
     w.add_static_box({0.0f, -0.5f, 0.0f}, {8.0f, 0.5f, 8.0f});  // floor, top at y = 0
     box_ = {{0.35f, 0.35f, -0.2f}, {0.35f, 0.35f, 0.35f}};
@@ -118,16 +124,37 @@ RopeScene::RopeScene(engine::ecs::Registry& registry) : registry_(registry), wor
     };
     const std::vector<Spec> specs = {
         // Hangs from (-1.6, 2.2) and starts horizontal: 2.6 m long, swings down and drags over the floor.
-        {"red rope", line({-1.6f, 2.2f, 0.3f}, {1.0f, 2.2f, 0.3f}, 48), 0.5f, true, false, 0.03f,
+        {"red rope",
+         line({-1.6f, 2.2f, 0.3f}, {1.0f, 2.2f, 0.3f}, 48),
+         0.5f,
+         true,
+         false,
+         0.03f,
          {0.95f, 0.12f, 0.08f}},
         // Hangs from (1.8, 2.1) and starts horizontal toward -x: 2.2 m long, swings into the box.
-        {"green rope", line({1.8f, 2.1f, -0.2f}, {-0.4f, 2.1f, -0.2f}, 40), 0.4f, true, false, 0.03f,
+        {"green rope",
+         line({1.8f, 2.1f, -0.2f}, {-0.4f, 2.1f, -0.2f}, 40),
+         0.4f,
+         true,
+         false,
+         0.03f,
          {0.10f, 0.85f, 0.15f}},
-        // A slack cable fixed at both ends, sagging just above the box (released from a shallower sag: it swings).
-        {"blue cable", sagging({-1.8f, 1.5f, -0.45f}, {1.8f, 1.5f, -0.45f}, 0.65f, 48), 0.8f, true, true, 0.035f,
+        // A slack cable fixed at both ends, sagging just above the box (released from a shallower sag: it
+        // swings).
+        {"blue cable",
+         sagging({-1.8f, 1.5f, -0.45f}, {1.8f, 1.5f, -0.45f}, 0.65f, 48),
+         0.8f,
+         true,
+         true,
+         0.035f,
          {0.10f, 0.30f, 1.00f}},
         // A free rope dropped across the box: drapes over its edge onto the floor.
-        {"yellow rope", line({-0.6f, 1.1f, 0.05f}, {0.9f, 1.3f, 0.1f}, 30), 0.3f, false, false, 0.025f,
+        {"yellow rope",
+         line({-0.6f, 1.1f, 0.05f}, {0.9f, 1.3f, 0.1f}, 30),
+         0.3f,
+         false,
+         false,
+         0.025f,
          {1.00f, 0.80f, 0.05f}},
     };
     for (std::size_t i = 0; i < specs.size(); ++i) {
@@ -137,9 +164,9 @@ RopeScene::RopeScene(engine::ecs::Registry& registry) : registry_(registry), wor
         m->m_kLST = 1.0f;                        // inextensible links
         body->generateBendingConstraints(2, m);  // a little bending stiffness
         body->m_cfg.piterations = 16;
-        body->m_cfg.kDF = 0.6f;                  // friction with rigid bodies
-        body->m_cfg.kDP = 0.002f;                // damping
-        body->m_cfg.kCHR = 1.0f;                 // rigid contact hardness
+        body->m_cfg.kDF = 0.6f;    // friction with rigid bodies
+        body->m_cfg.kDP = 0.002f;  // damping
+        body->m_cfg.kCHR = 1.0f;   // rigid contact hardness
         body->getCollisionShape()->setMargin(s.radius_m);
         w.world.addSoftBody(body);
         w.soft.emplace_back(body);

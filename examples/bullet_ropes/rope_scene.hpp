@@ -1,10 +1,10 @@
-// The Bullet rope scene of examples/bullet_ropes: a floor, a box, and soft-body ropes and cables (BulletSoftBody)
-// whose nodes are handed to wire entities every frame; plus the few GL objects that draw it.
+// The Bullet rope scene of examples/bullet_ropes: a floor, a box, and soft-body ropes and cables
+// (BulletSoftBody) whose nodes are handed to wire entities every frame; plus the few GL objects that draw it.
 //
-//   RopeScene scene(registry);                 // Bullet world + one wire entity per rope
-//   scene.step(1.0 / 60.0);                    // Bullet steps, then set_nodes() on every rope's wire
-//   schedule.run(registry, 1.0 / 60.0);        // the wire systems (wire::systems::install) build the DrawList
-//   view.draw(scene, context.draw_list, camera);   // floor and box (lit), then the wires
+//   RopeScene scene(registry);                    // Bullet world + one wire entity per rope
+//   scene.step(1.0 / 60.0);                       // Bullet steps, then set_nodes() on every rope's wire
+//   schedule.run(registry, 1.0 / 60.0);           // the wire systems build the DrawList
+//   view.draw(scene, context.draw_list, camera);  // floor and box (lit), then the wires
 #pragma once
 
 #include <engine/ecs/entity.hpp>
@@ -37,20 +37,20 @@ struct Box {
 /// One rope or cable: Bullet soft body -> wire entity.
 struct Rope {
     std::string name;
-    btSoftBody* body = nullptr;        ///< owned by the scene's Bullet world
+    btSoftBody* body = nullptr;  ///< owned by the scene's Bullet world
     engine::ecs::Entity wire = engine::ecs::null_entity;
     float radius_m = 0.03f;
-    uint32_t material = 0;             ///< renderer material (RopeView adds one per rope colour)
-    glm::vec3 colour{1.0f};            ///< tint of that material (linear RGB)
+    uint32_t material = 0;   ///< renderer material (RopeView adds one per rope colour)
+    glm::vec3 colour{1.0f};  ///< tint of that material (linear RGB)
 };
 
 /// The wire nodes of a Bullet soft body: node positions in order, ids = node index (Bullet never inserts or
 /// removes rope nodes, so the index is a stable id).
 [[nodiscard]] wire::WireNodes wire_nodes(const btSoftBody& body);
 
-/// Bullet world (soft + rigid), a static floor (top at y = 0) and box, four ropes: two hanging from one end that
-/// start horizontal and swing down (one into the box), a slack cable fixed at both ends sagging over the box, and
-/// a free rope dropped onto the box's edge. Deterministic: the same steps give the same nodes.
+/// Bullet world (soft + rigid), a static floor (top at y = 0) and box, four ropes: two hanging from one end
+/// that start horizontal and swing down (one into the box), a slack cable fixed at both ends sagging over the
+/// box, and a free rope dropped onto the box's edge. Deterministic: the same steps give the same nodes.
 class RopeScene {
 public:
     explicit RopeScene(engine::ecs::Registry& registry);

@@ -1,6 +1,6 @@
 // Consumer of the installed wires package: runs README.md's "Wires from game code" example unchanged in a
-// headless GL context, then checks that the wire was drawn where its nodes project. Exit 0 on success, 1 with a
-// message on failure.
+// headless GL context, then checks that the wire was drawn where its nodes project. Exit 0 on success, 1 with
+// a message on failure.
 #include <wire/render/wire_renderer.hpp>
 #include <wire/systems/api.hpp>
 #include <wire/systems/systems.hpp>
@@ -68,7 +68,8 @@ int main() {
     engine::assets::MeshData fine;
     if (engine::assets::subdivide(coarse, 1, fine).ok()) return fail("subdivide accepted an empty mesh");
     std::vector<curved_space::Segment> segments;
-    if (!curved_space::parse_segments_json(R"({"segments": [{"length": 2.0, "angle": 0.5}]})", "segs", segments) ||
+    if (!curved_space::parse_segments_json(R"({"segments": [{"length": 2.0, "angle": 0.5}]})", "segs",
+                                           segments) ||
         segments.size() != 1) {
         return fail("parse_segments_json failed");
     }
@@ -85,7 +86,8 @@ int main() {
     auto renderer = wire::render::WireRenderer::create();
     if (!renderer) return fail("WireRenderer::create: " + renderer.error().message);
     // The README's wire uses material 1 (material 0 is the built-in copper weave): a light blue one.
-    if (renderer->add_material({.tint = {0.4f, 0.7f, 1.0f}}) != 1) return fail("add_material did not return 1");
+    if (renderer->add_material({.tint = {0.4f, 0.7f, 1.0f}}) != 1)
+        return fail("add_material did not return 1");
 
     const wire::WireNodes nodes = hanging_cable(16, 0.2);
     const wire::WireNodes moved_nodes = hanging_cable(16, 0.3);
@@ -116,7 +118,8 @@ int main() {
         }
         hits += hit ? 1 : 0;
     }
-    // And nowhere else: the wire spans x in [-1.5, 1.5], y in [-0.3, 0.3]; the top and bottom fifth stay empty.
+    // And nowhere else: the wire spans x in [-1.5, 1.5], y in [-0.3, 0.3]; the top and bottom fifth stay
+    // empty.
     long stray = 0;
     long drawn = 0;
     for (int y = 0; y < height; ++y) {
@@ -126,9 +129,10 @@ int main() {
             if (y < height / 5 || y >= height - height / 5) ++stray;
         }
     }
-    std::printf("wires_consumer: %s; %d/%zu nodes drawn, %ld wire pixels, %ld stray\n", gl.gl_renderer().c_str(),
-                hits, moved_nodes.positions.size(), drawn, stray);
-    if (hits != static_cast<int>(moved_nodes.positions.size())) return fail("the wire is not drawn at its nodes");
+    std::printf("wires_consumer: %s; %d/%zu nodes drawn, %ld wire pixels, %ld stray\n",
+                gl.gl_renderer().c_str(), hits, moved_nodes.positions.size(), drawn, stray);
+    if (hits != static_cast<int>(moved_nodes.positions.size()))
+        return fail("the wire is not drawn at its nodes");
     if (stray != 0) return fail("pixels drawn away from the wire");
     if (const char* out = std::getenv("WIRES_CONSUMER_PNG")) {
         if (!engine::platform::write_png(out, image)) return fail(std::string("could not write ") + out);

@@ -64,8 +64,8 @@ bool hidden_by(const bullet_ropes::Box& box, const glm::dvec3& eye, const glm::d
     return true;
 }
 
-// The pixel's colour direction matches the tint's (the weave texture and the lighting scale it, the background,
-// floor and box are greys far from every rope colour).
+// The pixel's colour direction matches the tint's (the weave texture and the lighting scale it, the
+// background, floor and box are greys far from every rope colour).
 bool matches(const std::uint8_t* px, const glm::vec3& tint) {
     const glm::vec3 c(px[0], px[1], px[2]);
     if (std::max({c.r, c.g, c.b}) < 30.0f) return false;
@@ -84,7 +84,8 @@ bool rope_pixel_near(const engine::platform::Image& image, const Projected& p, c
 class BulletRopes : public ::testing::Test {
 protected:
     void SetUp() override {
-        auto ctx = engine::platform::create_headless_context({.width = kWidth, .height = kHeight, .quiet = true});
+        auto ctx =
+            engine::platform::create_headless_context({.width = kWidth, .height = kHeight, .quiet = true});
         ASSERT_TRUE(ctx) << ctx.error().message;
         ctx_ = std::move(*ctx);
         wire::systems::install(schedule_, wires_);
@@ -121,7 +122,8 @@ protected:
 
 TEST_F(BulletRopes, RopesAreDrawnWhereBulletPutsThem) {
     std::vector<wire::WireNodes> start;
-    for (const bullet_ropes::Rope& rope : scene_->ropes()) start.push_back(bullet_ropes::wire_nodes(*rope.body));
+    for (const bullet_ropes::Rope& rope : scene_->ropes())
+        start.push_back(bullet_ropes::wire_nodes(*rope.body));
 
     const engine::platform::Image image = run(90);  // 1.5 s: the hanging ropes have swung down
     if (const char* dir = std::getenv("BULLET_ROPES_TEST_PNG")) {
@@ -152,10 +154,12 @@ TEST_F(BulletRopes, RopesAreDrawnWhereBulletPutsThem) {
         checked_all += checked;
         hits_all += hits;
         std::printf("%s: %d of %d visible nodes show its colour\n", rope.name.c_str(), hits, checked);
-        EXPECT_GE(checked, static_cast<int>(now.size()) / 3) << rope.name << ": too few nodes visible to check";
+        EXPECT_GE(checked, static_cast<int>(now.size()) / 3)
+            << rope.name << ": too few nodes visible to check";
         EXPECT_GE(hits, checked * 9 / 10) << rope.name << ": not drawn where Bullet put its nodes";
 
-        // The picture follows the simulation: where the swinging ropes started (horizontal), their colour is gone.
+        // The picture follows the simulation: where the swinging ropes started (horizontal), their colour is
+        // gone.
         if (rope.name == "red rope" || rope.name == "green rope") {
             int old_checked = 0;
             int old_hits = 0;
@@ -175,8 +179,8 @@ TEST_F(BulletRopes, RopesAreDrawnWhereBulletPutsThem) {
 }
 
 TEST_F(BulletRopes, RopesRestOnTheFloorAndTheBox) {
-    // Gaps between the tube surface (node centre +- radius) and the floor / the box, worst over every frame of
-    // 4 s (swinging into the box, falling onto it, lying still): negative = sunk in.
+    // Gaps between the tube surface (node centre +- radius) and the floor / the box, worst over every frame
+    // of 4 s (swinging into the box, falling onto it, lying still): negative = sunk in.
     const bullet_ropes::Box& box = scene_->box();
     double floor_gap = std::numeric_limits<double>::infinity();
     double box_gap = std::numeric_limits<double>::infinity();
@@ -191,14 +195,16 @@ TEST_F(BulletRopes, RopesRestOnTheFloorAndTheBox) {
                 floor_gap = std::min(floor_gap, p.y - rope.radius_m);
                 if (p.y - rope.radius_m < 0.01) ++on_floor;
                 const glm::dvec3 d = glm::abs(p - glm::dvec3(box.centre_m)) - glm::dvec3(box.half_m);
-                const double distance = glm::length(glm::max(d, 0.0)) + std::min(std::max({d.x, d.y, d.z}), 0.0);
+                const double distance =
+                    glm::length(glm::max(d, 0.0)) + std::min(std::max({d.x, d.y, d.z}), 0.0);
                 box_gap = std::min(box_gap, distance - rope.radius_m);
                 if (d.x < 0.0 && d.z < 0.0 && std::abs(d.y - rope.radius_m) < 0.01) ++on_box;
             }
         }
     }
-    std::printf("worst gap to the floor %.4f m, to the box %.4f m; at 4 s %d nodes on the floor, %d on the box top\n",
-                floor_gap, box_gap, on_floor, on_box);
+    std::printf(
+        "worst gap to the floor %.4f m, to the box %.4f m; at 4 s %d nodes on the floor, %d on the box top\n",
+        floor_gap, box_gap, on_floor, on_box);
     EXPECT_GE(floor_gap, -0.01) << "a rope sank more than 1 cm into the floor";
     EXPECT_GE(box_gap, -0.01) << "a rope sank more than 1 cm into the box";
     EXPECT_GE(on_floor, 5) << "no rope lies on the floor";

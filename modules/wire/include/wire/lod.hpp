@@ -66,17 +66,17 @@ namespace wire {
 /// A perspective camera as the LOD sees it, in double: GL conventions (right-handed view space looking down -z).
 /// Build it with LodView::perspective(); the fields are derived and compared as a whole to detect camera motion.
 struct LodView {
-    glm::dvec3 eye_m{};
-    glm::dmat4 view_from_world{1.0};
-    glm::dmat4 clip_from_world{1.0};
+    glm::dvec3 eye_m{};                  ///< camera position, world metres
+    glm::dmat4 view_from_world{1.0};     ///< view matrix (glm::lookAt)
+    glm::dmat4 clip_from_world{1.0};     ///< projection * view
     std::array<glm::dvec4, 6> planes{};  ///< world-space frustum planes (xyz unit normal, w offset): inside >= 0
     double focal_px = 1.0;               ///< (H/2) / tan(fovY/2)
     double tan_half_x = 1.0;             ///< tan of half the horizontal field of view
-    double tan_half_y = 1.0;
-    double near_m = 0.1;
-    double far_m = 1000.0;
-    double width_px = 1920.0;
-    double height_px = 1080.0;
+    double tan_half_y = 1.0;             ///< tan of half the vertical field of view
+    double near_m = 0.1;                 ///< near plane distance
+    double far_m = 1000.0;               ///< far plane distance
+    double width_px = 1920.0;            ///< viewport width
+    double height_px = 1080.0;           ///< viewport height
 
     /// A look-at camera (glm::lookAt) with vertical field of view fov_y_rad over a width_px x height_px viewport.
     [[nodiscard]] static LodView perspective(const glm::dvec3& eye_m, const glm::dvec3& target_m, const glm::dvec3& up,
@@ -88,6 +88,7 @@ struct LodView {
     /// Pixel position (x right, y down, origin at the top-left corner) of a view-space point with z > 0.
     [[nodiscard]] glm::dvec2 view_to_px(const glm::dvec3& view) const;
 
+    /// Every field equal (camera motion is detected by comparing views).
     friend bool operator==(const LodView&, const LodView&) = default;
 };
 
@@ -118,7 +119,7 @@ struct WireLod {
     std::vector<uint32_t> counts;    ///< per segment: rings used (after hysteresis; >= required[i]); empty if culled
     std::vector<uint32_t> required;  ///< per segment: rings the tolerance needs now (Wang count, or the spans)
     uint32_t sides = 0;              ///< radial sides used (>= required_sides); 0 if culled
-    uint32_t required_sides = 0;
+    uint32_t required_sides = 0;     ///< radial sides the tolerance needs now
     bool visible = false;            ///< the wire's control hull, inflated by its radius, meets the frustum
     uint32_t visible_segments = 0;   ///< segments whose inflated hull meets the frustum
     uint32_t clamped_segments = 0;   ///< segments whose required count hit max_rings_per_segment (bound not met)
@@ -152,7 +153,7 @@ struct WireLod {
 /// A sphere enclosing a wire's tube: every control point of the curve, inflated by its largest radius. Computed
 /// once when the curve changes (O(control points)); tested against the frustum in O(1) every frame.
 struct BoundingSphere {
-    glm::dvec3 centre_m{};
+    glm::dvec3 centre_m{};   ///< world metres
     double radius_m = -1.0;  ///< < 0: unknown (update_lod then skips the quick test)
 };
 
@@ -260,7 +261,7 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
 struct ScreenError {
     double max_px = 0.0;        ///< largest distance of a reference point to the drawn centre polyline, pixels
     uint32_t worst_segment = 0; ///< segment of that reference point
-    double worst_t = 0.0;
+    double worst_t = 0.0;       ///< parameter in [0, 1] of that reference point inside its segment
     std::size_t samples = 0;    ///< reference points that were on screen (the others carry no guarantee)
 };
 

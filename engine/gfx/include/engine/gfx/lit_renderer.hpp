@@ -1,6 +1,7 @@
-// A minimal forward renderer for opaque meshes: Lambert diffuse from one directional light plus ambient.
-// Used by the demo and the headless system test; the shading is documented so tests can predict it:
-//   color = albedo * (ambient + (1 - ambient) * max(0, dot(n, to_light))) * light_color
+/// \file
+/// A minimal forward renderer for opaque meshes: Lambert diffuse from one directional light plus ambient.
+/// Used by the demo and the headless system test; the shading is documented so tests can predict it:
+///   color = albedo * (ambient + (1 - ambient) * max(0, dot(n, to_light))) * light_color
 #pragma once
 
 #include <glm/mat4x4.hpp>
@@ -11,26 +12,29 @@
 
 namespace engine::gfx {
 
+/// The light of LitRenderer (see the shading formula in the file comment).
 struct DirectionalLight {
-    glm::vec3 to_light{0.3f, 1.0f, 0.5f};  // direction toward the light (normalized by the renderer)
-    glm::vec3 color{1.0f};
-    float ambient = 0.15f;  // fraction of albedo seen on the unlit side
+    glm::vec3 to_light{0.3f, 1.0f, 0.5f};  ///< direction toward the light (normalized by the renderer)
+    glm::vec3 color{1.0f};                 ///< light colour (linear RGB)
+    float ambient = 0.15f;  ///< fraction of albedo seen on the unlit side
 };
 
+/// Draws opaque GpuMeshes with one directional light (create, then begin() once per frame, draw() per mesh).
 class LitRenderer {
 public:
-    // Compiles the shaders; errors carry the driver's log.
+    /// Compiles the shaders; errors carry the driver's log.
     static Expected<LitRenderer> create();
 
-    // Sets the per-frame state: depth test on, back faces culled, program bound.
+    /// Sets the per-frame state: depth test on, back faces culled, program bound.
     void begin(const glm::mat4& clip_from_world, const DirectionalLight& light) const;
+    /// Draws `mesh` placed by `world_from_model` in colour `albedo` (linear RGB). Call after begin().
     void draw(const GpuMesh& mesh, const glm::mat4& world_from_model, const glm::vec3& albedo) const;
 
 private:
     Program program_;
 };
 
-// Clears color (RGBA in [0, 1]) and depth of the bound framebuffer.
+/// Clears color (RGBA in [0, 1]) and depth of the bound framebuffer.
 void clear(const glm::vec4& color);
 
 }  // namespace engine::gfx

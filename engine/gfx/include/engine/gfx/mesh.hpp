@@ -1,5 +1,6 @@
-// Simple indexed triangle meshes (position + normal): CPU generators for primitives and their GPU upload.
-// The generators are plain math (no GL); upload_mesh needs a current context.
+/// \file
+/// Simple indexed triangle meshes (position + normal): CPU generators for primitives and their GPU upload.
+/// The generators are plain math (no GL); upload_mesh needs a current context.
 #pragma once
 
 #include <cstdint>
@@ -9,50 +10,53 @@
 
 #include "engine/gfx/resources.hpp"
 
+/// GL object handles, primitive meshes, a minimal lit forward renderer and GL debug output.
 namespace engine::gfx {
 
+/// A mesh vertex.
 struct Vertex {
-    glm::vec3 position{0.0f};
-    glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    glm::vec3 position{0.0f};            ///< metres, model space
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};  ///< unit normal
 };
 
-// Counter-clockwise front faces, outward normals.
+/// Counter-clockwise front faces, outward normals.
 struct MeshData {
-    std::vector<Vertex> vertices{};
-    std::vector<std::uint32_t> indices{};
+    std::vector<Vertex> vertices{};        ///< the vertices
+    std::vector<std::uint32_t> indices{};  ///< three per triangle, into vertices
 };
 
-// Closed cylinder along +y centered on the origin; sides and caps have separate vertices (flat cap normals).
-// The side is the polygon with `sides` corners inscribed in the circle of radius radius_m.
+/// Closed cylinder along +y centered on the origin; sides and caps have separate vertices (flat cap normals).
+/// The side is the polygon with `sides` corners inscribed in the circle of radius radius_m.
 struct CylinderDesc {
-    float radius_m = 0.5f;
-    float half_height_m = 0.5f;
-    int sides = 32;  // >= 3
-    bool caps = true;
+    float radius_m = 0.5f;       ///< circumradius of the side polygon
+    float half_height_m = 0.5f;  ///< the cylinder spans y in [-half_height_m, half_height_m]
+    int sides = 32;  ///< >= 3
+    bool caps = true;            ///< close both ends
 };
+/// The cylinder described by `desc`.
 MeshData make_cylinder_mesh(const CylinderDesc& desc = {});
 
-// Axis-aligned box centered on the origin, flat normals.
+/// Axis-aligned box centered on the origin, flat normals.
 MeshData make_box_mesh(glm::vec3 half_extents_m = glm::vec3(0.5f));
 
-// Square in the y = 0 plane facing +y, centered on the origin.
+/// Square in the y = 0 plane facing +y, centered on the origin.
 MeshData make_plane_mesh(float half_size_m = 1.0f);
 
-// UV sphere centered on the origin.
+/// UV sphere centered on the origin.
 MeshData make_sphere_mesh(float radius_m = 0.5f, int slices = 32, int stacks = 16);
 
-// A mesh on the GPU: vertex buffer (Vertex layout: location 0 position, 1 normal), index buffer and VAO.
+/// A mesh on the GPU: vertex buffer (Vertex layout: location 0 position, 1 normal), index buffer and VAO.
 struct GpuMesh {
-    Buffer vertices;
-    Buffer indices;
-    VertexArray vertex_array;
-    int index_count = 0;
+    Buffer vertices;           ///< vertex buffer (Vertex layout)
+    Buffer indices;            ///< uint32 index buffer
+    VertexArray vertex_array;  ///< VAO binding both
+    int index_count = 0;       ///< indices to draw
 };
 
-// Errors: empty mesh, or buffer allocation failed.
+/// Errors: empty mesh, or buffer allocation failed.
 Expected<GpuMesh> upload_mesh(const MeshData& mesh, std::string_view label = {});
 
-// Draws all triangles with whatever program is in use.
+/// Draws all triangles with whatever program is in use.
 void draw(const GpuMesh& mesh);
 
 }  // namespace engine::gfx
