@@ -189,8 +189,8 @@ public:
         ENGINE_ECS_ASSERT(valid(e), "mark_changed: stale or null entity handle");
         storage<T>().mark_changed(e);
     }
-    /// The shared change clock: every stamp so far, of any type, has a tick <= tick(), later ones are greater.
-    /// A system remembers tick() after it runs and passes it as `since` next time.
+    /// The shared change clock: every stamp so far, of any type, has a tick <= tick(), later ones are
+    /// greater. A system remembers tick() after it runs and passes it as `since` next time.
     [[nodiscard]] std::uint64_t tick() const noexcept { return *clock_; }
     /// Entities whose T was emplaced/replaced/patched/marked after tick `since` (each once, in stamp order);
     /// entities that have since lost T are not listed. Cost follows the number of stamps since `since`.

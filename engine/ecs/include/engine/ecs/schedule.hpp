@@ -30,10 +30,10 @@ struct FrameContext {
 
 /// Wall time of one system, in milliseconds.
 struct SystemStats {
-    std::string name;      ///< the name given to Schedule::add
-    double last_ms = 0.0;  ///< last frame it ran
-    double mean_ms = 0.0;  ///< mean over all frames it ran
-    double max_ms = 0.0;   ///< longest frame it ran
+    std::string name;        ///< the name given to Schedule::add
+    double last_ms = 0.0;    ///< last frame it ran
+    double mean_ms = 0.0;    ///< mean over all frames it ran
+    double max_ms = 0.0;     ///< longest frame it ran
     std::uint64_t runs = 0;  ///< frames it ran
 };
 

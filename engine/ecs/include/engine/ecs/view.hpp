@@ -23,7 +23,7 @@ using StorageFor = std::conditional_t<std::is_const_v<C>, const Storage<std::rem
 /// A view over the entities that have every one of Cs (a const C gives read-only access).
 ///
 /// Iteration rules (the same for each(), range-for and each() ranges):
-/// - The lead (smallest) storage is chosen when iteration starts and walked from its last member to its first.
+/// - The lead (smallest) storage is chosen when iteration starts and walked from last member to first.
 /// - Inside the loop, removing components of the current entity, or destroying it, is safe: the member
 ///   swapped into its place has already been visited. Removing components of other entities is not
 ///   (an unvisited entity can be skipped or an entity visited twice).
@@ -57,10 +57,10 @@ public:
     /// Forward iterator over matching entities (a range-for yields Entity).
     class Iterator {
     public:
-        using value_type = Entity;                ///< what *it yields
+        using value_type = Entity;               ///< what *it yields
         using difference_type = std::ptrdiff_t;  ///< for std::forward_iterator
-        Iterator() = default;                     ///< the end iterator
-        /// Starts below lead position `next` of `lead`, at the first matching entity (View::begin() makes it).
+        Iterator() = default;                    ///< the end iterator
+        /// Starts below lead position `next` of `lead`, at the first matching entity (see View::begin()).
         Iterator(const View* v, const SparseSet* lead, std::size_t next) : v_{v}, lead_{lead}, next_{next} {
             settle();
         }
@@ -120,7 +120,7 @@ public:
         class Iterator {
         public:
             using value_type = std::tuple<Entity, Cs&...>;  ///< what *it yields
-            using difference_type = std::ptrdiff_t;        ///< for std::forward_iterator
+            using difference_type = std::ptrdiff_t;         ///< for std::forward_iterator
             Iterator() = default;                           ///< the end iterator
             /// Wraps an entity iterator of the view.
             explicit Iterator(typename View::Iterator it) : it_{it} {}
@@ -139,7 +139,7 @@ public:
         private:
             typename View::Iterator it_;
         };
-        explicit EachRange(const View& v) : v_{&v} {}                        ///< the range of `v`
+        explicit EachRange(const View& v) : v_{&v} {}                           ///< the range of `v`
         [[nodiscard]] Iterator begin() const { return Iterator{v_->begin()}; }  ///< first match
         [[nodiscard]] Iterator end() const { return Iterator{}; }               ///< end
 

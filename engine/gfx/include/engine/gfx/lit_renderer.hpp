@@ -16,7 +16,7 @@ namespace engine::gfx {
 struct DirectionalLight {
     glm::vec3 to_light{0.3f, 1.0f, 0.5f};  ///< direction toward the light (normalized by the renderer)
     glm::vec3 color{1.0f};                 ///< light colour (linear RGB)
-    float ambient = 0.15f;  ///< fraction of albedo seen on the unlit side
+    float ambient = 0.15f;                 ///< fraction of albedo seen on the unlit side
 };
 
 /// Draws opaque GpuMeshes with one directional light (create, then begin() once per frame, draw() per mesh).

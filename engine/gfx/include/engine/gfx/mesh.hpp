@@ -30,7 +30,7 @@ struct MeshData {
 struct CylinderDesc {
     float radius_m = 0.5f;       ///< circumradius of the side polygon
     float half_height_m = 0.5f;  ///< the cylinder spans y in [-half_height_m, half_height_m]
-    int sides = 32;  ///< >= 3
+    int sides = 32;              ///< >= 3
     bool caps = true;            ///< close both ends
 };
 /// The cylinder described by `desc`.

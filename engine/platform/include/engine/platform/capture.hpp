@@ -13,8 +13,8 @@ namespace engine::platform {
 
 /// RGBA8 pixels, rows top to bottom (image order, not GL order).
 struct Image {
-    int width = 0;   ///< pixels
-    int height = 0;  ///< pixels
+    int width = 0;                   ///< pixels
+    int height = 0;                  ///< pixels
     std::vector<std::uint8_t> rgba;  ///< width * height * 4 bytes
 
     /// The 4 bytes (R, G, B, A) of pixel (x, y), y = 0 the top row. No bounds check.

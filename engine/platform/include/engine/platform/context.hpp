@@ -93,7 +93,7 @@ bool display_available();
 /// Creates a context per desc.backend and makes it current. Errors name what failed (e.g. "EGL: no
 /// surfaceless Mesa platform", "GLFW: could not create a 4.5 core window").
 Expected<std::unique_ptr<Context>> create_context(const ContextDesc& desc = {});
-/// create_context() with Backend::headless: EGL surfaceless, rendering into an off-screen RGBA8 + depth24 FBO.
+/// create_context() with Backend::headless: EGL surfaceless, rendering into an RGBA8 + depth24 FBO.
 Expected<std::unique_ptr<Context>> create_headless_context(const ContextDesc& desc = {});
 /// The EGL display the headless backend chose, e.g. "hardware EGL device 1 (/dev/dri/renderD128)" or "Mesa
 /// surfaceless (EGL device 0: software, skipped; )"; empty before the first headless context. A hardware EGL

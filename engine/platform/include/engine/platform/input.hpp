@@ -38,14 +38,14 @@ struct Input {
     static constexpr int key_count = 512;   ///< size of the key arrays (GLFW key codes are below it)
     static constexpr int button_count = 8;  ///< size of the button array
 
-    std::array<bool, key_count> keys_down{};     ///< held now
-    std::array<bool, key_count> keys_pressed{};  ///< went down since the previous poll_events()
+    std::array<bool, key_count> keys_down{};        ///< held now
+    std::array<bool, key_count> keys_pressed{};     ///< went down since the previous poll_events()
     std::array<bool, button_count> buttons_down{};  ///< held now
-    double mouse_x_px = 0.0;  ///< cursor x in window pixels, from the left
-    double mouse_y_px = 0.0;  ///< cursor y in window pixels, from the top
-    double mouse_dx_px = 0.0;  ///< motion since the previous poll_events()
-    double mouse_dy_px = 0.0;  ///< vertical motion since the previous poll_events()
-    double scroll_y = 0.0;  ///< scroll since the previous poll_events()
+    double mouse_x_px = 0.0;                        ///< cursor x in window pixels, from the left
+    double mouse_y_px = 0.0;                        ///< cursor y in window pixels, from the top
+    double mouse_dx_px = 0.0;                       ///< motion since the previous poll_events()
+    double mouse_dy_px = 0.0;                       ///< vertical motion since the previous poll_events()
+    double scroll_y = 0.0;                          ///< scroll since the previous poll_events()
 
     /// Key `k` is held.
     bool down(Key k) const { return keys_down[static_cast<std::size_t>(k)]; }

@@ -16,13 +16,13 @@ namespace engine::scene {
 
 /// A perspective camera looking from `position` at `target` (see the file comment for the conventions).
 struct Camera {
-    glm::vec3 position{0.0f, 0.0f, 5.0f};  ///< eye, world metres
-    glm::vec3 target{0.0f};                ///< the point looked at, world metres
-    glm::vec3 up{0.0f, 1.0f, 0.0f};        ///< world up (not parallel to target - position)
+    glm::vec3 position{0.0f, 0.0f, 5.0f};   ///< eye, world metres
+    glm::vec3 target{0.0f};                 ///< the point looked at, world metres
+    glm::vec3 up{0.0f, 1.0f, 0.0f};         ///< world up (not parallel to target - position)
     float fov_y_rad = glm::radians(60.0f);  ///< vertical field of view, radians
-    float aspect = 16.0f / 9.0f;  ///< width / height
-    float near_m = 0.1f;          ///< near clip distance, metres
-    float far_m = 1000.0f;        ///< far clip distance, metres
+    float aspect = 16.0f / 9.0f;            ///< width / height
+    float near_m = 0.1f;                    ///< near clip distance, metres
+    float far_m = 1000.0f;                  ///< far clip distance, metres
 
     /// View matrix (world -> view space), glm::lookAt.
     glm::mat4 view() const { return glm::lookAt(position, target, up); }
@@ -33,8 +33,8 @@ struct Camera {
     /// Unit vector from position toward target.
     glm::vec3 forward() const { return glm::normalize(target - position); }
 
-    /// Focal length in pixels for a viewport `height_px` tall: (H/2) / tan(fovY/2). A length L at view depth z
-    /// covers L * focal_px / z pixels.
+    /// Focal length in pixels for a viewport `height_px` tall: (H/2) / tan(fovY/2). A length L at view depth
+    /// z covers L * focal_px / z pixels.
     float focal_px(float height_px) const { return 0.5f * height_px / std::tan(0.5f * fov_y_rad); }
 };
 

@@ -51,10 +51,10 @@ struct Material {
 /// blinn^shininess) * light colour, albedo = texture(u, v) * tint. Both upload paths shade identically.
 struct Light {
     glm::vec3 to_light{0.3f, 1.0f, 0.5f};  ///< direction toward the light (normalized by the renderer)
-    glm::vec3 color{1.0f};     ///< light colour (linear RGB)
-    float ambient = 0.2f;      ///< fraction of the albedo seen on the unlit side
-    float specular = 0.15f;    ///< Blinn-Phong specular strength
-    float shininess = 32.0f;   ///< Blinn-Phong exponent
+    glm::vec3 color{1.0f};                 ///< light colour (linear RGB)
+    float ambient = 0.2f;                  ///< fraction of the albedo seen on the unlit side
+    float specular = 0.15f;                ///< Blinn-Phong specular strength
+    float shininess = 32.0f;               ///< Blinn-Phong exponent
 };
 
 /// Zero means default.
@@ -99,7 +99,7 @@ struct FrameStats {
     std::size_t triangles = 0;          ///< triangles drawn
     std::size_t indirect_commands = 0;  ///< indirect draw commands written (one per item drawn)
     std::size_t multi_draw_calls = 0;  ///< one per material in use
-    bool buffer_grew = false;  ///< the stream buffer was reallocated larger this frame
+    bool buffer_grew = false;          ///< the stream buffer was reallocated larger this frame
     bool waited_for_gpu =
         false;  ///< the region's fence had not signalled (more frames in flight than regions)
 };
@@ -113,10 +113,10 @@ public:
     /// context.
     static Expected<WireRenderer> create(const RendererDesc& desc = {});
 
-    WireRenderer();                                   ///< empty: use create()
-    WireRenderer(WireRenderer&&) noexcept;            ///< takes over the GL objects
+    WireRenderer();                                    ///< empty: use create()
+    WireRenderer(WireRenderer&&) noexcept;             ///< takes over the GL objects
     WireRenderer& operator=(WireRenderer&&) noexcept;  ///< takes over the GL objects
-    ~WireRenderer();                                  ///< deletes the GL objects (context current)
+    ~WireRenderer();                                   ///< deletes the GL objects (context current)
 
     /// Adds a texture (e.g. engine::gfx::make_texture with Wrap::repeat); returns its index for
     /// Material::texture.

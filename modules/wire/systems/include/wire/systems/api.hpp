@@ -4,8 +4,8 @@
 ///
 /// \code
 ///   engine::ecs::Entity w = wire::systems::spawn_wire(registry, nodes, {.radius_m = 0.02f});
-///   wire::systems::set_nodes(registry, w, moved_nodes);                  // or edit_nodes(registry, w).positions[3] = p;
-///   wire::systems::insert_node(registry, w, 4, midpoint);                // a new node with a fresh stable id
+///   wire::systems::set_nodes(registry, w, moved_nodes);    // or edit_nodes(registry, w).positions[3] = p;
+///   wire::systems::insert_node(registry, w, 4, midpoint);  // a new node with a fresh stable id
 ///   registry.destroy(w);
 /// \endcode
 #pragma once
@@ -16,8 +16,8 @@
 
 #include <string>
 
-/// The wire module's ECS side: wire entities (Nodes + Style and the derived components), the game-side API that
-/// spawns and updates them, and the systems that turn them into a DrawList every frame (install()).
+/// The wire module's ECS side: wire entities (Nodes + Style and the derived components), the game-side API
+/// that spawns and updates them, and the systems that turn them into a DrawList every frame (install()).
 namespace wire::systems {
 
 /// A new wire entity with `nodes` and `style`, plus the systems' derived components (empty until the systems

@@ -1,6 +1,6 @@
 /// \file
-/// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them as
-/// changed); the wire systems own everything else and keep it between frames.
+/// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them
+/// as changed); the wire systems own everything else and keep it between frames.
 #pragma once
 
 #include "wire/curve.hpp"
@@ -46,9 +46,9 @@ struct WireCurve {
     // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
     // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
     // `previous_nodes` (the last valid state) when the ids change.
-    WireNodes previous_nodes;          ///< the last valid nodes (re-primes `multires` when ids change)
-    Curve scratch;                     ///< reused storage of the fast path
-    bool multires_stale = false;       ///< `multires` lags behind `curve` (the fast path ran)
+    WireNodes previous_nodes;     ///< the last valid nodes (re-primes `multires` when ids change)
+    Curve scratch;                ///< reused storage of the fast path
+    bool multires_stale = false;  ///< `multires` lags behind `curve` (the fast path ran)
 };
 
 /// LOD stage: visibility, per-segment ring counts and sides for the context's camera.

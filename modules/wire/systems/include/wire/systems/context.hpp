@@ -36,17 +36,18 @@ struct FrameStats {
 /// A wire error as reported once.
 struct ErrorReport {
     engine::ecs::Entity entity = engine::ecs::null_entity;  ///< the wire
-    std::string message;  ///< WireError::message, e.g. "wire entity 12 (index 12, version 0): node 3: position.y is NaN"
+    std::string message;  ///< WireError::message, e.g. "wire entity 12 (index 12, version 0): node 3:
+                          ///< position.y is NaN"
 };
 
 /// What the wire systems share for one scene: the game sets the camera, viewport and settings before
-/// Schedule::run; the systems leave the frame's draw list, statistics and new errors here. One per registry and
-/// schedule; it must outlive the schedule it was installed on (install()).
+/// Schedule::run; the systems leave the frame's draw list, statistics and new errors here. One per registry
+/// and schedule; it must outlive the schedule it was installed on (install()).
 struct WireContext {
     // ---- set by the game ----
-    engine::scene::Camera camera{};              ///< the camera the wires are seen from (LOD and culling)
-    double viewport_width_px = 1920.0;           ///< viewport the frame is drawn into, pixels (LOD screen error)
-    double viewport_height_px = 1080.0;          ///< viewport height, pixels
+    engine::scene::Camera camera{};      ///< the camera the wires are seen from (LOD and culling)
+    double viewport_width_px = 1920.0;   ///< viewport the frame is drawn into, pixels (LOD screen error)
+    double viewport_height_px = 1080.0;  ///< viewport height, pixels
     LodSettings lod{};                           ///< tolerance (px), max rings per segment, hysteresis
     UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_rings stops at ring records
     bool pop_free = true;                        ///< geomorph when node ids appear or vanish (multires.hpp)

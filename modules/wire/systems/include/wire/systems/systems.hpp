@@ -1,18 +1,20 @@
 /// \file
 /// The wire systems and their order. install() registers, in this order, on a schedule:
 /// \verbatim
-///   wire.curve      wires whose Nodes or Style changed since it last ran (change tracking), plus wires in a
-///                   geomorph: pop-free curve (multires.hpp); bad nodes -> WireError, reported once, wire skipped
-///   wire.lod        if the camera (or LOD settings) changed: every wire; otherwise only wires whose curve changed:
-///                   hull culling, per-segment ring counts, sides, hysteresis (lod.hpp)
+///   wire.curve      wires whose Nodes or Style changed since it last ran (change tracking), plus wires in
+///                   a geomorph: pop-free curve (multires.hpp); bad nodes -> WireError, reported once,
+///                   wire skipped
+///   wire.lod        if the camera (or LOD settings) changed: every wire; otherwise only wires whose curve
+///                   changed: hull culling, per-segment ring counts, sides, hysteresis (lod.hpp)
 ///   wire.rings      visible wires whose curve or counts changed: ring records, first normal carried over
 ///   wire.mesh       cpu_mesh path: visible wires whose rings or sides changed: TubeVertex + indices;
 ///                   gpu_rings path: nothing
 ///   wire.draw_list  the frame's DrawList: visible wires in entity order, spans into the per-wire arrays
 /// \endverbatim
 /// The renderer adds its upload/render systems after these, reading WireContext::draw_list.
-/// Per-wire work runs with tbb::parallel_for over a dense array of the wires to process; each wire writes only
-/// its own components, and lists are ordered by entity, so the output does not depend on the thread count.
+/// Per-wire work runs with tbb::parallel_for over a dense array of the wires to process; each wire writes
+/// only its own components, and lists are ordered by entity, so the output does not depend on the thread
+/// count.
 #pragma once
 
 #include "wire/systems/context.hpp"
@@ -26,18 +28,19 @@ namespace wire::systems {
 
 /// Names of the systems install() adds, in run order (as engine::ecs::Schedule::stats() reports them).
 inline constexpr const char* kCurveSystem = "wire.curve";
-inline constexpr const char* kLodSystem = "wire.lod";            ///< second system, after kCurveSystem
-inline constexpr const char* kRingsSystem = "wire.rings";        ///< third system
-inline constexpr const char* kMeshSystem = "wire.mesh";          ///< fourth system
-inline constexpr const char* kDrawListSystem = "wire.draw_list";  ///< last system: fills WireContext::draw_list
+inline constexpr const char* kLodSystem = "wire.lod";      ///< second system, after kCurveSystem
+inline constexpr const char* kRingsSystem = "wire.rings";  ///< third system
+inline constexpr const char* kMeshSystem = "wire.mesh";    ///< fourth system
+inline constexpr const char* kDrawListSystem =
+    "wire.draw_list";  ///< last system: fills WireContext::draw_list
 
 /// Adds the five wire systems to `schedule` in the order above. `context` must outlive the schedule.
 void install(engine::ecs::Schedule& schedule, WireContext& context);
 
 // The systems one by one (install() calls these; tests and tools may too).
 
-/// Curve stage (wire.curve): rebuilds the curve of wires whose Nodes or Style changed since registry tick `since`
-/// (the curve system's previous run, FrameContext::last_run_tick) and of wires in a geomorph; resets
+/// Curve stage (wire.curve): rebuilds the curve of wires whose Nodes or Style changed since registry tick
+/// `since` (the curve system's previous run, FrameContext::last_run_tick) and of wires in a geomorph; resets
 /// WireContext::stats; reports new WireErrors.
 void curve_system(engine::ecs::Registry& registry, WireContext& context, uint64_t since);
 /// LOD stage (wire.lod): visibility and per-segment ring counts for the context's camera (every wire when the
@@ -45,8 +48,8 @@ void curve_system(engine::ecs::Registry& registry, WireContext& context, uint64_
 void lod_system(engine::ecs::Registry& registry, WireContext& context);
 /// Ring stage (wire.rings): ring records of visible wires whose curve or LOD changed.
 void rings_system(engine::ecs::Registry& registry, WireContext& context);
-/// Mesh stage (wire.mesh, UploadPath::cpu_mesh only): tube vertices and indices of visible wires whose rings or
-/// sides changed.
+/// Mesh stage (wire.mesh, UploadPath::cpu_mesh only): tube vertices and indices of visible wires whose rings
+/// or sides changed.
 void mesh_system(engine::ecs::Registry& registry, WireContext& context);
 /// Draw-list stage (wire.draw_list): fills WireContext::draw_list with the visible wires, in entity order.
 void draw_list_system(engine::ecs::Registry& registry, WireContext& context);
