@@ -4,7 +4,8 @@
 # 1. cmake --install BUILD_DIR into WORK_DIR/stage, then moves it to WORK_DIR/prefix (the package must be
 #    relocatable); 2. checks the layout (config + version files, no tools or tests installed, no installed file
 #    naming the source or build tree) and the version rule; 3. configures, builds and runs tests/package against
-#    it with nothing but CMAKE_PREFIX_PATH pointing at the prefix.
+#    it with nothing but CMAKE_PREFIX_PATH pointing at the prefix: the README example (wires_consumer) and the
+#    repository's modules/wire/systems/examples/spawn_wires.cpp linking only wires::wire_systems.
 foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_package_test.cmake: -D${var}=... is required")
@@ -83,10 +84,17 @@ endif()
 run("configure tests/package" ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package" -B "${WORK_DIR}/consumer"
     -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=${CONFIG} "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}" ${launcher_args}
     "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
-    "-DWIRES_README=${SOURCE_DIR}/README.md")
+    "-DWIRES_README=${SOURCE_DIR}/README.md"
+    "-DWIRES_SPAWN_EXAMPLE=${SOURCE_DIR}/modules/wire/systems/examples/spawn_wires.cpp")
 run("build tests/package" ${CMAKE_COMMAND} --build "${WORK_DIR}/consumer" --config ${CONFIG})
 find_program(consumer wires_consumer PATHS "${WORK_DIR}/consumer" "${WORK_DIR}/consumer/${CONFIG}" NO_DEFAULT_PATH
              REQUIRED)
 set(ENV{WIRES_CONSUMER_PNG} "${WORK_DIR}/consumer.png")
 run("run wires_consumer" "${consumer}")
 message(STATUS "${last_output}")
+find_program(spawn spawn_wires_example PATHS "${WORK_DIR}/consumer" "${WORK_DIR}/consumer/${CONFIG}"
+             NO_DEFAULT_PATH REQUIRED)
+run("run spawn_wires_example (wires::wire_systems only)" "${spawn}")
+if(NOT last_output MATCHES "frame 5: 2 wires, 1 visible")
+  message(FATAL_ERROR "spawn_wires_example: unexpected output:\n${last_output}")
+endif()
