@@ -93,12 +93,12 @@ bool display_available();
 /// Creates a context per desc.backend and makes it current. Errors name what failed (e.g. "EGL: no
 /// surfaceless Mesa platform", "GLFW: could not create a 4.5 core window").
 Expected<std::unique_ptr<Context>> create_context(const ContextDesc& desc = {});
-/// create_context() with Backend::headless: EGL surfaceless, rendering into an RGBA8 + depth24 FBO.
+/// create_context() with Backend::headless: EGL (see headless_display()), rendering into an off-screen FBO.
 Expected<std::unique_ptr<Context>> create_headless_context(const ContextDesc& desc = {});
 /// The EGL display the headless backend chose, e.g. "hardware EGL device 1 (/dev/dri/renderD128)" or "Mesa
 /// surfaceless (EGL device 0: software, skipped; )"; empty before the first headless context. A hardware EGL
-/// device is preferred when one exists; WIRE_EGL_PLATFORM=surfaceless|device forces one (device: fail if none).
-/// Logged to stderr once per process unless ContextDesc::quiet.
+/// device is preferred when one exists; WIRE_EGL_PLATFORM=surfaceless|device forces one (device: fail if
+/// none). Logged to stderr once per process unless ContextDesc::quiet.
 std::string headless_display();
 /// create_context() with Backend::window: a GLFW window; fails without a display.
 Expected<std::unique_ptr<Context>> create_window_context(const ContextDesc& desc = {});

@@ -147,9 +147,13 @@ public:
     /// Retained ring storage: wires resident, bytes in live ranges, buffer capacity, GL buffers alive, and every
     /// GL buffer it allocated (tests check growth retires the old ones).
     [[nodiscard]] std::size_t resident_wires() const;
+    /// Retained ring storage: bytes in live ranges.
     [[nodiscard]] std::size_t ring_storage_live_bytes() const;
+    /// Retained ring storage: capacity of its buffer, bytes.
     [[nodiscard]] std::size_t ring_storage_capacity() const;
+    /// Retained ring storage: GL buffers alive now (1 plus retired ones still waiting for their fences).
     [[nodiscard]] std::size_t live_ring_buffers() const;
+    /// Retained ring storage: GL names of every buffer it allocated so far (the first is the initial one).
     [[nodiscard]] const std::vector<unsigned>& allocated_ring_buffers() const;
 
 private:
