@@ -36,7 +36,7 @@ add_custom_target(docs
 # ctest checks: Doxygen with WARN_IF_UNDOCUMENTED on a set of headers; any warning fails the test.
 #   api_docs_wire_systems  the wire systems API (modules/wire/systems/include), every header
 #   api_docs_game_api      the other headers a game calls in "Wires from game code" and examples/bullet_ropes:
-#                          wire nodes, draw list, LOD settings and status, the wire renderer, ECS registry/entity/
+#                          wire nodes, draw list and status, the wire renderer, ECS registry/entity/
 #                          schedule/view, platform context/capture/expected/input, camera, frustum, lit renderer
 #                          and meshes
 function(wires_add_doc_check name)
@@ -68,6 +68,5 @@ if(WIRE_BUILD_TESTS)
     ${src}/engine/scene/include/engine/scene/camera.hpp
     ${src}/engine/ecs/include/engine/ecs/view.hpp ${src}/engine/platform/include/engine/platform/input.hpp
     ${src}/engine/gfx/include/engine/gfx/lit_renderer.hpp ${src}/engine/gfx/include/engine/gfx/mesh.hpp
-    ${src}/engine/scene/include/engine/scene/frustum.hpp ${src}/modules/wire/include/wire/lod.hpp
-    ${src}/modules/wire/include/wire/status.hpp)
+    ${src}/engine/scene/include/engine/scene/frustum.hpp ${src}/modules/wire/include/wire/status.hpp)
 endif()
