@@ -226,7 +226,9 @@ TEST_F(GlBuffersTest, GpuTimerMeasuresWithoutStalling) {
     for (std::size_t i = 0; i < got.size(); ++i) {
         std::printf(" %.4f", got[i].ms);
         EXPECT_GE(got[i].ms, 0.0);
-        if (i > 0) EXPECT_GT(got[i].frame, got[i - 1].frame) << "results in order";
+        if (i > 0) {
+            EXPECT_GT(got[i].frame, got[i - 1].frame) << "results in order";
+        }
     }
     std::printf(" ms\n");
     ASSERT_GE(got.size(), 2u);

@@ -73,7 +73,9 @@ TEST_F(GfxTest, HeadlessDisplayChoiceIsReported) {
     const bool hardware = chosen.rfind("hardware EGL device", 0) == 0;
     const bool surfaceless = chosen.rfind("Mesa surfaceless", 0) == 0;
     EXPECT_TRUE(hardware || surfaceless) << chosen;
-    if (hardware) EXPECT_EQ(context->gl_renderer().find("llvmpipe"), std::string::npos);
+    if (hardware) {
+        EXPECT_EQ(context->gl_renderer().find("llvmpipe"), std::string::npos);
+    }
 }
 
 // WIRE_EGL_PLATFORM forces the choice; a bad value is an error naming it. The display is chosen when the first
