@@ -223,7 +223,28 @@ std::vector<Case> wrapped(uint64_t seed, int count) {
     return out;
 }
 
+namespace {
+double segment_distance(const dvec3& p, const dvec3& a, const dvec3& b) {
+    const dvec3 d = b - a;
+    const double t = std::clamp(glm::dot(p - a, d) / std::max(glm::dot(d, d), 1e-300), 0.0, 1.0);
+    return glm::length(p - (a + t * d));
+}
+}  // namespace
+
 double max_deviation_m(const Case& c, const Curve& curve, int samples_per_segment) {
+    if (!c.corner.empty()) {  // zigzag: the truth is the node polyline (exact distance to its nearby pieces)
+        const std::vector<dvec3>& x = c.nodes.positions;
+        double worst = 0.0;
+        for (std::size_t k = 0; k < curve.segment_count() && k + 1 < x.size(); ++k) {
+            for (int s = 0; s <= samples_per_segment; ++s) {
+                const dvec3 p = position(curve.segments[k], static_cast<double>(s) / samples_per_segment);
+                double d = HUGE_VAL;
+                for (std::size_t j = k > 0 ? k - 1 : 0; j <= std::min(k + 1, x.size() - 2); ++j) d = std::min(d, segment_distance(p, x[j], x[j + 1]));
+                worst = std::max(worst, d);
+            }
+        }
+        return worst;
+    }
     // Per segment: bracket the foot point on a table of the truth over the segment's parameter interval
     // (widened by half a neighbour interval), then golden-section search on the exact function.
     constexpr int kTable = 48;
