@@ -28,11 +28,13 @@
 //              turning pattern: the curvature vector k_i = (e_out - e_in) / mean element is compared with
 //              the neighbours' (carried to node i's tangent, interpolated in arc length):
 //                d = |k_i - k~_i| / (|k_i| + |k~_i|),  share = |k_i| / (|k_i| + |k~_i|),
-//                g = smoothstep(0.55, 0.85, d) * smoothstep(0.3, 0.45, share),  w_i = (1 + 1e4)^g - 1.
+//                g = smoothstep(0.55, 0.85, d) * smoothstep(0.3, 0.45, share),  w_i = (1 + 3e4)^g - 1,
+//              plus (1 + 30)^g' - 1 with g' = smoothstep(0.55, 0.85, d) * (1 - smoothstep(0, 0.1, share)) at a
+//              straight node next to a turn (the end of a load-free span: damps c2's ringing into it).
 //              Spread-out turning (sag, drums, sheaves, helices: d small) -> g = 0: the accurate C2 spline,
 //              whatever the stretch. A turn the neighbours do not share (a corner between straight runs, an
-//              alternating zig-zag) -> g = 1: straight runs and a rounding of ~1e-4 of the element at the turn
-//              (the tangent shrinks to ~3/(2 + 1e4) of c2's, never 0: G1 everywhere). Open ends blend from
+//              alternating zig-zag) -> g = 1: straight runs and a rounding of ~3e-5 of the element at the turn
+//              (the tangent shrinks to ~3/(2 + 3e4) of c2's, never 0: G1 everywhere). Open ends blend from
 //              not-a-knot to free as node 1 or 2 (n-2 or n-3) gets tensed. Continuous in the nodes (g and w
 //              are smooth functions of them). Stretch is not used: the turning pattern, not the stretch,
 //              shows where a distributed load acts. Why, and where it stops holding: modules/wire/DESIGN.md.
