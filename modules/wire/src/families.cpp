@@ -283,11 +283,6 @@ double max_deviation_m(const Case& c, const Curve& curve, int samples_per_segmen
 }
 
 namespace {
-double distance_to_line(const dvec3& p, const dvec3& a, const dvec3& b) {
-    const dvec3 d = b - a;
-    const double l = glm::length(d);
-    return l > 0.0 ? glm::length(glm::cross(p - a, d)) / l : glm::length(p - a);
-}
 double distance_to_segment(const dvec3& p, const dvec3& a, const dvec3& b) {
     const dvec3 d = b - a;
     const double t = std::clamp(glm::dot(p - a, d) / std::max(glm::dot(d, d), 1e-300), 0.0, 1.0);
@@ -315,7 +310,8 @@ TautNumbers taut_numbers(const Case& c, const Curve& curve, int samples_per_segm
                 const dvec3 p = position(curve.segments[k], static_cast<double>(s) / samples_per_segment);
                 const double from_corner = std::min(c.corner[a] ? glm::length(p - x[a]) : HUGE_VAL,
                                                     c.corner[b] ? glm::length(p - x[b]) : HUGE_VAL);
-                if (from_corner > 0.05 * h) t.straight_rel = std::max(t.straight_rel, distance_to_line(p, x[a], x[b]) / run);
+                // Distance to the run's segment (not its infinite line): overshooting an end along the line counts.
+                if (from_corner > 0.05 * h) t.straight_rel = std::max(t.straight_rel, distance_to_segment(p, x[a], x[b]) / run);
                 if (near_corner) {
                     double poly = HUGE_VAL;
                     for (std::size_t j = (k > 0 ? k - 1 : 0); j <= std::min(k + 1, n - 2); ++j)

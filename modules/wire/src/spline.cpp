@@ -340,7 +340,8 @@ void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>
         const dvec3 rln = (s[segs - 1] * (hP * (3.0 * hL + 2.0 * hP)) + (hL * hL) * s[segs - 2]) / ((hP + hL) * (hP + hL));
         // The not-a-knot end makes the first (last) two segments one cubic, which overshoots when either
         // node it spans is tensed (its tangent nearly vanishes): then the end becomes free.
-        const double g0 = std::max(g[1], n > 3 ? g[2] : 0.0), gl = std::max(g[n - 2], n > 3 ? g[n - 3] : 0.0);
+        const auto tensed = [&](std::size_t i) { return std::max(g[i], gs[i]); };
+        const double g0 = std::max(tensed(1), n > 3 ? tensed(2) : 0.0), gl = std::max(tensed(n - 2), n > 3 ? tensed(n - 3) : 0.0);
         const double beta0 = (1.0 - g0) * h1 / (h0 + h1) + 2.0 * g0, betal = (1.0 - gl) * hP / (hP + hL) + 2.0 * gl;
         const dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s[0], rl = (1.0 - gl) * rln + (3.0 * gl) * s[segs - 1];
         const std::size_t m = n - 2;
