@@ -96,7 +96,7 @@ std::string write_family_outputs(const Options& o, const FamilyResults& r) {
     md += "\n" + csv.markdown() + "\n";
     for (const auto& [family, ratio] : r.auto_vs_chordal) {
         char buf[160];
-        std::snprintf(buf, sizeof buf, "- `%s`: auto / chordal, worst case %.3f\n", family.c_str(), ratio);
+        std::snprintf(buf, sizeof buf, "- `%s`: auto / chordal, worst case %.3g\n", family.c_str(), ratio);
         md += buf;
     }
     if (!write_text(o.out_dir / "families.md", "# wiretool bench: random families\n\n" + md)) return "";
@@ -132,7 +132,7 @@ std::string family_plot_panel(const std::filesystem::path& dat, const FamilyResu
     for (std::size_t i = 0; i < fams.size(); ++i) xtics += (i ? ", \"" : "\"") + fams[i] + "\" " + std::to_string(i);
     xtics += ")\n";
     return "set title \"random families: max deviation per case (dot median, x p90, bar to max; floor 1e-7 m)\"\n"
-           "unset logscale x\nset logscale y\nset yrange [1e-7:*]\nset xrange [-0.6:" + std::to_string(fams.size() - 1) + ".6]\n" + xtics +
+           "unset logscale x\nset logscale y\nset format y \"%g\"\nset yrange [1e-7:*]\nset xrange [-0.6:" + std::to_string(fams.size() - 1) + ".6]\n" + xtics +
            "set xlabel \"family\"\nset ylabel \"max deviation from the exact curve (m)\"\n" + plots + "\n";
 }
 
