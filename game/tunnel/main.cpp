@@ -37,7 +37,7 @@ struct Args {
     int pieces = 16;
     uint32_t seed = 1;
     std::string path = "cpu";
-    std::string spline = "catmull-rom";
+    std::string spline = "automatic";
     double lod_tolerance_px = 0.5;
     bool wireframe = false;
     bool frames_given = false;  // window: close after `frames` frames

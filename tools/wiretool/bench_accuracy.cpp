@@ -3,6 +3,7 @@
 // three frame methods and five LOD tolerances; per row time, size, world/screen/twist error and pops. Writes
 // accuracy.csv, accuracy.md, stability.md and speed_vs_error.png (gnuplot, when installed).
 #include "bench_common.hpp"
+#include "bench_families.hpp"
 #include "commands.hpp"
 
 #include <wire/bezier.hpp>
@@ -613,7 +614,7 @@ const Row* find_row(const std::vector<Row>& rows, const std::string& scene, cons
 }
 
 /// Writes the data and script and runs gnuplot. Returns a sentence for accuracy.md.
-std::string plot(const Options& o, const std::vector<Row>& rows) {
+std::string plot(const Options& o, const std::vector<Row>& rows, const FamilyResults& families) {
     const std::filesystem::path dat = o.out_dir / "speed_vs_error.dat";
     const std::filesystem::path gp = o.out_dir / "speed_vs_error.gp";
     const std::filesystem::path png = o.out_dir / "speed_vs_error.png";
@@ -636,10 +637,12 @@ std::string plot(const Options& o, const std::vector<Row>& rows) {
          {"centripetal", "centripetal+rotation", "centripetal+projection"}},
     };
     std::string data, script;
-    script += "set terminal png size 1800,620 font \",11\" noenhanced\n";
+    const std::string family_panel = family_plot_panel(o.out_dir / "families.dat", families);
+    script += family_panel.empty() ? "set terminal png size 1800,620 font \",11\" noenhanced\n"
+                                   : "set terminal png size 1800,1240 font \",11\" noenhanced\n";
     script +=
         "set output '" + png.string() +
-        "'\nset multiplot layout 1,3 title \"wiretool bench: time per wire "
+        "'\nset multiplot layout " + (family_panel.empty() ? "1,3" : "2,2") + " title \"wiretool bench: time per wire "
         "against error, one marker per LOD tolerance (0.1, 0.25, 0.5, 1, 2 px; larger tolerance = fewer rings"
         " = less time)\"\n";
     script +=
@@ -673,6 +676,8 @@ std::string plot(const Options& o, const std::vector<Row>& rows) {
         any = true;
         script += "set title \"" + p.title + "\"\nset xlabel \"" + p.xlabel + "\"\n" + plots + "\n";
     }
+    script += family_panel;
+    any = any || !family_panel.empty();
     script += "unset multiplot\n";
     if (!any) return "Plot skipped: none of its scenes (catenary, random_walk, helix) was run.";
     if (!write_text(dat, data) || !write_text(gp, script)) return "Plot skipped: cannot write its data.";
@@ -690,6 +695,7 @@ std::string plot(const Options& o, const std::vector<Row>& rows) {
 }  // namespace
 
 int run_accuracy_bench(const Options& o) {
+    const FamilyResults families = run_family_accuracy(o);
     std::vector<Scene> scenes;
     auto want = [&](const std::string& n) { return selected(o, n); };
     if (want("catenary")) scenes.push_back(catenary_scene("catenary"));
@@ -754,7 +760,7 @@ int run_accuracy_bench(const Options& o) {
         return exit_failure;
     }
 
-    const std::string plot_note = plot(o, rows);
+    const std::string plot_note = plot(o, rows, families);
     std::string md = "# wiretool bench: speed against error\n\n";
     md +=
         "One wire per scene, seen whole by a 1920x1080, 60-degree camera; every spline method (frames by "
@@ -820,6 +826,7 @@ int run_accuracy_bench(const Options& o) {
         }
         md += "\n";
     }
+    md += "\n" + write_family_outputs(o, families);
     md += "\n## All rows\n\n" + csv.markdown();
     md += "\nThe DESIGN §5 hard cases: see stability.md.\n";
     if (!write_text(o.out_dir / "accuracy.md", md)) {

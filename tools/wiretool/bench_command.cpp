@@ -45,7 +45,7 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_option("--scenes", o->scenes, "Only these scenes, comma-separated")
         ->delimiter(',')
         ->check(CLI::IsMember({"standard", "offscreen", "swaying", "far", "catenary", "helix", "stretched_bend",
-                               "hairpin", "random_walk", "churn"}));
+                               "hairpin", "random_walk", "churn", "families"}));
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
     cmd->add_flag(
         "--gl", o->gl,

@@ -160,7 +160,7 @@ Action add_mesh_command(CLI::App& app) {
     cmd->add_option("input", o->input, "Wire JSON file")->required();
     cmd->add_option("-o,--output", o->glb_out, "Write binary glTF: one mesh per wire (the last frame)");
     cmd->add_option("--csv", o->csv_out, "Write one row per ring (every frame)");
-    cmd->add_option("--spline", o->overrides.spline_type, "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear)")
+    cmd->add_option("--spline", o->overrides.spline_type, "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear); default auto")
         ->check(CLI::IsMember({"uniform", "centripetal", "chordal", "c2", "auto", "automatic", "catmull-rom", "linear"}));
     cmd->add_option("--alpha", o->overrides.alpha, "Catmull-Rom knot exponent (0 uniform, 0.5 centripetal, 1 chordal)")
         ->check(CLI::Range(0.0, 1.0));

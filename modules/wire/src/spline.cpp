@@ -25,11 +25,6 @@ std::string describe(double v) {
 
 std::string node_prefix(std::size_t i) { return "node " + std::to_string(i) + ": "; }
 
-// Automatic mode at a sharp node: both tangents' magnitude -> kHug * the shorter neighbour chord. The bend
-// then rounds off inside the short element with an overshoot of ~(4/27) kHug l_min past the node (Hermite
-// basis maximum); 0.5 halves the overshoot of a uniform-like 1.0 while keeping the corner visibly round.
-constexpr double kHug = 0.5;
-
 // Largest accepted |coordinate| (metres): the tube's float vertices (relative to ring 0) and squared chord
 // lengths must stay finite; 1e12 m is far beyond any scene (DESIGN §5 asks for 1e6 m from the origin).
 constexpr double kMaxCoordinate_m = 1e12;
@@ -242,6 +237,151 @@ void c2_tangents(const Chords& ch, bool closed, Tangents& tg) {
     }
 }
 
+// ---- automatic: the nu-spline under tension read from the nodes' turning pattern (DESIGN §4.1,
+// modules/wire/DESIGN.md "Automatic spline").
+
+// Largest per-node tension w (added to the C2 row's diagonal 2): the tangent at a fully tensed node shrinks to
+// ~3/(2+W) of the C2 one, a rounding of ~3e-5 of the element at a concentrated corner (the bending length
+// sqrt(EI/T) ~ h/(2 sqrt(W)) = h/350), yet never 0, so the curve stays G1.
+constexpr double kMaxNodeTension = 3e4;
+// Turning-pattern thresholds: a node's curvature vector is "unsupported" by its neighbours when
+// d = |k - k~| / (|k| + |k~|) exceeds kSpreadHi (1 = nothing in common: a corner between straight runs, an
+// alternating zig-zag); smooth sag, drums and helices with >= 5 nodes per turn stay below kSpreadLo.
+constexpr double kSpreadLo = 0.55, kSpreadHi = 0.85;
+// ... and the node must carry at least its share of the turning (c = |k| / (|k| + |k~|)): a straight node next
+// to a corner (c = 0) is not tensed (it stays on its line anyway; tensing it would only add rings).
+constexpr double kShareLo = 0.3, kShareHi = 0.45;
+// A node that stays straight while a neighbour turns (share below kStraightHi, fully at 0) ends a load-free
+// span: a moderate tension there (w up to kStraightTension) damps the C2 spline's ringing into the straight run
+// (wrapped-cable family: mean deviation 0.74x -> 0.61x chordal Catmull-Rom's, worst case 1.06x -> 1.03x). A
+// larger band (up to share 0.3) tenses nodes whose element is partly curved and loses on the worst case (1.6x).
+constexpr double kStraightLo = 0.0, kStraightHi = 0.1;
+constexpr double kStraightTension = 30.0;
+
+/// Per-node tension weight g in [0, 1] from the turning pattern (see the constants above).
+std::vector<double> concentrated_turns(const Chords& ch, bool closed, std::vector<double>* straight = nullptr) {
+    const std::size_t segs = ch.d.size();
+    const std::size_t n = closed ? segs : segs + 1;
+    std::vector<double> g(n, 0.0);
+    if (straight) straight->assign(n, 0.0);
+    if (n < 3) return g;
+    // Curvature vectors k_i = (e_out - e_in) / (mean of the two elements): |k| ~ 2 sin(phi/2) / h.
+    std::vector<dvec3> k(n, dvec3(0.0));
+    auto interior = [&](std::size_t i) { return closed || (i > 0 && i + 1 < n); };
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!interior(i)) continue;
+        const std::size_t kin = (i + segs - 1) % segs, kout = i % segs;
+        k[i] = (ch.d[kout] / ch.len[kout] - ch.d[kin] / ch.len[kin]) * (2.0 / (ch.len[kin] + ch.len[kout]));
+    }
+    // Node tangents (chord bisectors), to carry a neighbour's curvature vector to node i by the rotation that
+    // takes its tangent to node i's (on a circle this maps one curvature vector exactly onto the next).
+    std::vector<dvec3> t(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool in = closed || i > 0, out = closed || i + 1 < n;
+        const dvec3 e_in = in ? ch.d[(i + segs - 1) % segs] / ch.len[(i + segs - 1) % segs] : dvec3(0.0);
+        const dvec3 e_out = out ? ch.d[i % segs] / ch.len[i % segs] : dvec3(0.0);
+        const dvec3 b = e_in + e_out;
+        const double lb = glm::length(b);
+        t[i] = lb > 1e-12 ? b / lb : (out ? e_out : e_in);
+    }
+    if (!closed) k[0] = k[1], k[n - 1] = k[n - 2], t[0] = t[1], t[n - 1] = t[n - 2];  // constant extrapolation
+    const auto carry = [&](std::size_t from, std::size_t to) {  // Rodrigues rotation t[from] -> t[to] applied to k
+        const dvec3 axis = glm::cross(t[from], t[to]);
+        const double c = glm::dot(t[from], t[to]);
+        if (c <= -1.0 + 1e-12) return -k[from];  // reversal: any perpendicular axis; the sign is what matters
+        return k[from] * c + glm::cross(axis, k[from]) + axis * (glm::dot(axis, k[from]) / (1.0 + c));
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!interior(i)) continue;
+        const std::size_t kin = (i + segs - 1) % segs, kout = i % segs;
+        const double hin = ch.len[kin], hout = ch.len[kout];
+        // What the neighbours predict at node i: their curvature vectors, carried to node i's tangent,
+        // interpolated linearly in arc length.
+        const dvec3 pred = (hout * carry((i + n - 1) % n, i) + hin * carry((i + 1) % n, i)) / (hin + hout);
+        const double lk = glm::length(k[i]), lp = glm::length(pred), sum = lk + lp;
+        if (!(sum > 0.0) || !std::isfinite(sum)) continue;  // straight here and around: nothing to decide
+        const double d = glm::length(k[i] - pred) / sum;
+        // Turning below ~1e-6 rad is rounding noise of collinear nodes (and invisible): nothing to decide.
+        const double turn = 0.5 * sum * (hin + hout);
+        const double unshared = smoothstep(kSpreadLo, kSpreadHi, d) * smoothstep(1e-8, 1e-6, turn);
+        g[i] = unshared * smoothstep(kShareLo, kShareHi, lk / sum);
+        if (straight) (*straight)[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, lk / sum));
+    }
+    return g;
+}
+
+/// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
+/// proportional to the tangent (tension). Rows as c2_tangents' with w_i added to the diagonal; open ends
+/// not-a-knot, blending to free ends (zero curvature) as the neighbouring node gets tensed.
+void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>& g, const std::vector<double>& gs, Tangents& tg) {
+    const std::size_t segs = ch.d.size();
+    const std::size_t n = closed ? segs : segs + 1;
+    std::vector<dvec3> s(segs);
+    for (std::size_t k = 0; k < segs; ++k) s[k] = ch.d[k] / ch.len[k];
+    std::vector<double> w(n);
+    for (std::size_t i = 0; i < n; ++i)  // log-uniform in g
+        w[i] = std::expm1(g[i] * std::log1p(kMaxNodeTension)) + std::expm1(gs[i] * std::log1p(kStraightTension));
+    std::vector<dvec3> D(n);
+    if (closed) {
+        std::vector<double> a(n), b(n), c(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t kin = (i + segs - 1) % segs, kout = i;
+            const double hin = ch.len[kin], hout = ch.len[kout], sum = hin + hout;
+            a[i] = hout / sum, c[i] = hin / sum, b[i] = 2.0 + w[i];
+            D[i] = 3.0 * (a[i] * s[kin] + c[i] * s[kout]);
+        }
+        thomas_cyclic(a, b, c, D);
+    } else if (n == 2) {
+        D[0] = D[1] = s[0];
+    } else {
+        // End rows beta D0 + D1 = r: not-a-knot (beta = h1/(h0+h1)) blending to free (beta = 2, r = 3 s0).
+        const double h0 = ch.len[0], h1 = ch.len[1], hL = ch.len[segs - 1], hP = ch.len[segs - 2];
+        const dvec3 r0n = (s[0] * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s[1]) / ((h0 + h1) * (h0 + h1));
+        const dvec3 rln = (s[segs - 1] * (hP * (3.0 * hL + 2.0 * hP)) + (hL * hL) * s[segs - 2]) / ((hP + hL) * (hP + hL));
+        // The not-a-knot end makes the first (last) two segments one cubic, which overshoots when either
+        // node it spans is tensed (its tangent nearly vanishes): then the end becomes free.
+        const auto tensed = [&](std::size_t i) { return std::max(g[i], gs[i]); };
+        const double g0 = std::max(tensed(1), n > 3 ? tensed(2) : 0.0), gl = std::max(tensed(n - 2), n > 3 ? tensed(n - 3) : 0.0);
+        const double beta0 = (1.0 - g0) * h1 / (h0 + h1) + 2.0 * g0, betal = (1.0 - gl) * hP / (hP + hL) + 2.0 * gl;
+        const dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s[0], rl = (1.0 - gl) * rln + (3.0 * gl) * s[segs - 1];
+        const std::size_t m = n - 2;
+        std::vector<double> a(m), b(m), c(m);
+        std::vector<dvec3> r(m);
+        for (std::size_t j = 0; j < m; ++j) {
+            const std::size_t i = j + 1;
+            const double hin = ch.len[i - 1], hout = ch.len[i], sum = hin + hout;
+            a[j] = hout / sum, c[j] = hin / sum, b[j] = 2.0 + w[i];
+            r[j] = 3.0 * (a[j] * s[i - 1] + c[j] * s[i]);
+        }
+        if (m == 1) {
+            // 3 nodes: not-a-knot at both ends is the interpolating parabola (one cubic through 3 points is
+            // not determined: the elimination below would be singular); it blends with the tensed solution
+            // with free ends as the middle node gets tensed.
+            const double g1 = g[1];
+            const dvec3 p0 = s[0] - h0 * (s[1] - s[0]) / (h0 + h1), p1 = (h1 * s[0] + h0 * s[1]) / (h0 + h1);
+            const dvec3 p2 = s[1] + h1 * (s[1] - s[0]) / (h0 + h1);
+            // Free ends: 2 D0 + D1 = 3 s0, 2 D2 + D1 = 3 s1, middle row a D0 + (2 + w) D1 + c D2 = r.
+            const dvec3 t1 = (r[0] - 1.5 * (a[0] * s[0] + c[0] * s[1])) / (b[0] - 0.5 * (a[0] + c[0]));
+            const dvec3 t0 = 0.5 * (3.0 * s[0] - t1), t2 = 0.5 * (3.0 * s[1] - t1);
+            D[0] = (1.0 - g1) * p0 + g1 * t0;
+            D[1] = (1.0 - g1) * p1 + g1 * t1;
+            D[2] = (1.0 - g1) * p2 + g1 * t2;
+        } else {
+            // Eliminate D0 and D[n-1] (pivots stay >= 1: a/beta <= 1).
+            r[0] -= (a[0] / beta0) * r0, b[0] -= a[0] / beta0, a[0] = 0.0;
+            r[m - 1] -= (c[m - 1] / betal) * rl, b[m - 1] -= c[m - 1] / betal, c[m - 1] = 0.0;
+            thomas(a, b, c, r);
+            for (std::size_t j = 0; j < m; ++j) D[j + 1] = r[j];
+            D[0] = (r0 - D[1]) / beta0;
+            D[n - 1] = (rl - D[n - 2]) / betal;
+        }
+    }
+    for (std::size_t k = 0; k < segs; ++k) {
+        tg.t0[k] = D[k] * ch.len[k];
+        tg.t1[k] = D[(k + 1) % n] * ch.len[k];
+    }
+}
+
 }  // namespace
 
 double curvature_tension(double theta_rad, double iz_m4, double length_m, double delta_length_m, double area_m2) {
@@ -292,10 +432,25 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         for (std::size_t k = 0; k < segs; ++k) tg.t0[k] = tg.t1[k] = ch.d[k];
     } else if (kind == SplineKind::c2) {
         c2_tangents(ch, closed, tg);
+    } else if (kind == SplineKind::automatic) {
+        std::vector<double> gs;
+        const std::vector<double> g = concentrated_turns(ch, closed, &gs);
+        automatic_tangents(ch, closed, g, gs, tg);
+        // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
+        // C2 only where it is 0).
+        for (std::size_t j = 0; j < n; ++j) {
+            const uint32_t src = m.first[j];
+            const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
+            const double t_curv = physics ? curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
+                                                              nodes.delta_length_m[src], nodes.area_m2[src])
+                                          : 0.0;
+            const double keep = (1.0 - t_user) * (1.0 - t_curv);
+            if (keep == 1.0) continue;
+            if (closed || j + 1 < n) tg.t0[j % segs] *= keep;
+            if (closed || j > 0) tg.t1[(j + segs - 1) % segs] *= keep;
+        }
     } else {
-        const bool automatic = kind == SplineKind::automatic;
-        const double alpha = automatic ? 1.0 : settings.alpha;
-        std::vector<double> sharp(n, 0.0);
+        const double alpha = settings.alpha;
         for (std::size_t j = 0; j < n; ++j) {
             const uint32_t src = m.first[j];
             const bool has_in = closed || j > 0, has_out = closed || j + 1 < n;
@@ -307,9 +462,9 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
             const double lin = has_in ? ch.len[kin] : ch.len[kout];
             const double lout = has_out ? ch.len[kout] : ch.len[kin];
 
-            double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
-            const double b = automatic ? 0.0 : (nodes.kb_bias.empty() ? settings.bias : nodes.kb_bias[src]);
-            const double c = automatic ? 0.0 : (nodes.kb_continuity.empty() ? settings.continuity : nodes.kb_continuity[src]);
+            const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
+            const double b = nodes.kb_bias.empty() ? settings.bias : nodes.kb_bias[src];
+            const double c = nodes.kb_continuity.empty() ? settings.continuity : nodes.kb_continuity[src];
             double t_curv = 0.0;
             if (physics) {
                 t_curv = curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
@@ -322,52 +477,10 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
             const double lr = alpha == 0.0 ? 0.0 : std::clamp(alpha * (std::log(lout) - std::log(lin)), -300.0, 300.0);
             const double rho = std::exp(lr);
             const double w = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);  // w + iw = 1
-            dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
-            dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
-
-            if (automatic && has_in && has_out) {
-                const double phi = std::atan2(glm::length(glm::cross(din, dout)), glm::dot(din, dout));
-                const double q = std::max(lin, lout) / std::min(lin, lout);
-                const double st = std::max(seg_stretch[kin], seg_stretch[kout]);
-                const double s_angle = smoothstep(0.35, 1.2, phi * (1.0 + std::log(q)));
-                const double s_stretch = smoothstep(1.0, 1.02, st);
-                const double s = 1.0 - (1.0 - s_angle) * (1.0 - s_stretch);
-                sharp[j] = s;
-                if (s > 0.0) {
-                    const double ls = glm::length(start);
-                    const dvec3 dir_c = ls > 0.0 ? start / ls : dvec3(0.0);
-                    const dvec3 hug = lin * din + lout * dout;  // l_in^2 e_in + l_out^2 e_out
-                    const double lh = glm::length(hug);
-                    const dvec3 dir_s = lh > 0.0 ? hug / lh : dir_c;
-                    const dvec3 mix = (1.0 - s) * dir_c + s * dir_s;
-                    const double lm = glm::length(mix);
-                    const dvec3 dir = lm > 0.0 ? mix / lm : dir_c;
-                    // A taut wire runs straight between its nodes: from 1% to 5% stretch the rounding shrinks
-                    // to a tenth (still G1: the tangent never vanishes, unlike tension 1).
-                    const double h = kHug * (1.0 - 0.9 * smoothstep(1.01, 1.05, st)) * std::min(lin, lout);
-                    start = ((1.0 - s) * ls + s * keep * h) * dir;
-                    end = ((1.0 - s) * glm::length(end) + s * keep * h) * dir;
-                }
-            }
+            const dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
+            const dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
             if (has_out) tg.t0[kout] = start;
             if (has_in) tg.t1[kin] = end;
-        }
-        if (automatic && !closed && n >= 3) {
-            // Quadratic (Bessel) end tangents instead of the phantom node's chord: O(h^2) on smooth sag; they
-            // blend back to the chord as the neighbouring node gets sharp.
-            auto end_tangent = [&](std::size_t k_end, std::size_t k_next, std::size_t node_next, bool at_start) {
-                const double h0 = ch.len[k_end], h1 = ch.len[k_next];
-                const dvec3 s0 = ch.d[k_end] / h0, s1 = ch.d[k_next] / h1;
-                const dvec3 bessel = at_start ? s0 - (h0 / (h0 + h1)) * (s1 - s0) : s0 + (h0 / (h0 + h1)) * (s0 - s1);
-                const double s = sharp[node_next];
-                const dvec3 tan = ((1.0 - s) * h0) * bessel + s * ch.d[k_end];
-                const double len_now = glm::length(at_start ? tg.t0[k_end] : tg.t1[k_end]);
-                const double len_chord = h0;
-                // keep the node's tension scaling (len_now / chord for the reflected tangent)
-                return tan * (len_now / len_chord);
-            };
-            tg.t0[0] = end_tangent(0, 1, 1, true);
-            tg.t1[segs - 1] = end_tangent(segs - 1, segs - 2, n - 2, false);
         }
     }
 

@@ -5,7 +5,10 @@ namespace wire::io {
 
 Status resolve_settings(const WireSpec& spec, const SettingsOverrides& o, PipelineSettings& out) {
     PipelineSettings s;  // defaults
-    const std::string type = o.spline_type ? *o.spline_type : spec.spline_type.value_or("centripetal");
+    // Default: the automatic spline (the best measured method, docs/speed_vs_error.md); an alpha given without
+    // a type means Catmull-Rom with that alpha.
+    const char* fallback = (o.alpha || spec.alpha) ? "catmull-rom" : "auto";
+    const std::string type = o.spline_type ? *o.spline_type : spec.spline_type.value_or(fallback);
     if (type == "uniform" || type == "centripetal" || type == "chordal" || type == "catmull-rom") {
         s.spline.kind = SplineKind::catmull_rom;
         const double implied = type == "uniform" ? 0.0 : type == "chordal" ? 1.0 : 0.5;

@@ -89,8 +89,8 @@ inline BendNumbers measure_bend(const Curve& curve) {
         if (k > 0) {
             const glm::dvec3 t0 = derivative(curve.segments[k - 1], 1.0), t1 = derivative(curve.segments[k], 0.0);
             const double l0 = glm::length(t0), l1 = glm::length(t1);
-            double deg = 180.0;
-            if (l0 > 0.0 && l1 > 0.0) deg = std::acos(std::clamp(glm::dot(t0, t1) / (l0 * l1), -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
+            double deg = 180.0;  // atan2, not acos: acos cannot resolve angles below ~1e-6 deg (1 - cos rounds)
+            if (l0 > 0.0 && l1 > 0.0) deg = std::atan2(glm::length(glm::cross(t0, t1)), glm::dot(t0, t1)) * 180.0 / 3.14159265358979323846;
             b.kink_deg = std::max(b.kink_deg, deg);
         }
     }

@@ -124,3 +124,22 @@ TEST(WireJson, FrameCameraIsReadAndChecked) {
     EXPECT_EQ(parse_error(R"({)" + wires + R"(, "camera": {"eye": [0,0,5], "target": [0,0,0]}})"),
               "in.json: unknown key 'camera' in the top level");
 }
+
+TEST(WireJson, DefaultSplineIsAutomaticAndAnAlphaAloneMeansCatmullRom) {
+    // Issue 17: the default spline is the best measured one (automatic); a file or override that gives only an
+    // alpha still gets Catmull-Rom with that alpha, as before.
+    wire::PipelineSettings p;
+    SceneSpec s = parse_ok(R"({"nodes": [[0,0,0],[1,0,0],[2,1,0]]})");
+    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], {}, p).ok);
+    EXPECT_EQ(p.spline.kind, wire::SplineKind::automatic);
+    s = parse_ok(R"({"spline": {"alpha": 0.7}, "nodes": [[0,0,0],[1,0,0],[2,1,0]]})");
+    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], {}, p).ok);
+    EXPECT_EQ(p.spline.kind, wire::SplineKind::catmull_rom);
+    EXPECT_EQ(p.spline.alpha, 0.7);
+    s = parse_ok(R"({"nodes": [[0,0,0],[1,0,0],[2,1,0]]})");
+    wire::io::SettingsOverrides o;
+    o.alpha = 0.25;
+    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], o, p).ok);
+    EXPECT_EQ(p.spline.kind, wire::SplineKind::catmull_rom);
+    EXPECT_EQ(p.spline.alpha, 0.25);
+}

@@ -40,7 +40,7 @@ struct WireNodes {
 enum class SplineKind : uint8_t {
     catmull_rom = 0,  ///< local, C1; any alpha; cardinal tension / Kochanek-Bartels / curvature tension apply
     c2,               ///< global C2 interpolating cubic, chordal knots (Thomas / Sherman-Morrison solve)
-    automatic,        ///< chordal Catmull-Rom on gentle sag, blending smoothly to a bend-hugging G1 form (see spline.hpp)
+    automatic,        ///< nu-spline under tension: c2 where turning is spread out, straight runs at concentrated turns (spline.hpp)
     linear,           ///< straight segments (degenerate cubics), for baselines
 };
 

@@ -21,18 +21,25 @@
 //              Thomas algorithm O(n)); open ends not-a-knot (O(h^4) on smooth sag, where natural ends force
 //              zero curvature that a hanging cable does not have); 3 nodes: the interpolating parabola;
 //              closed: cyclic system by Sherman-Morrison. Tension, bias, continuity are ignored (they break C2).
-// automatic    Per node a sharpness s in [0,1] (smoothstep, so it moves continuously with the nodes) from the
-//              turning angle phi, the neighbour length ratio q >= 1 and the stretch:
-//                s = 1 - (1 - smoothstep(0.35, 1.2, phi (1 + ln q))) (1 - smoothstep(1.0, 1.02, stretch)).
-//              s = 0: chordal Catmull-Rom (with a quadratic "Bessel" end tangent instead of the phantom node).
-//              s > 0: the node tangent's direction blends toward (l_in^2 e_in + l_out^2 e_out) (the longer
-//              neighbour dominates, so a long straight run stays on its line) and both sides' magnitudes blend
-//              toward h = 0.5 min(l_in, l_out) (a bend rounds within the short segment, overshooting the node by
-//              at most (4/27) h), and h shrinks to a tenth between 1% and 5% stretch (a taut wire runs straight
-//              between its nodes). Both sides keep one direction: G1 everywhere (no tangent vanishes unless
-//              tension reaches 1), C1 where s = 0. Tension (wire, node, curvature) applies as for catmull_rom;
-//              bias and continuity do not.
-//              The thresholds (0.35..1.2 rad, 1..2% and 1..5% stretch, 0.5) are tunable constants in spline.cpp.
+// automatic    The spline under tension a cable obeys (EI w'''' - T w'' = q), as Nielson's nu-spline: chordal
+//              knots, C1, one cubic per segment, and at node i the jump of the second derivative equals
+//              nu_i times the tangent; in the normalized C2 rows (see c2) that adds w_i to the diagonal 2.
+//              w_i = 0 gives exactly c2 (not-a-knot ends); w_i -> inf a corner. w_i is read from the nodes'
+//              turning pattern: the curvature vector k_i = (e_out - e_in) / mean element is compared with
+//              the neighbours' (carried to node i's tangent, interpolated in arc length):
+//                d = |k_i - k~_i| / (|k_i| + |k~_i|),  share = |k_i| / (|k_i| + |k~_i|),
+//                g = smoothstep(0.55, 0.85, d) * smoothstep(0.3, 0.45, share),  w_i = (1 + 3e4)^g - 1,
+//              plus (1 + 30)^g' - 1 with g' = smoothstep(0.55, 0.85, d) * (1 - smoothstep(0, 0.1, share)) at a
+//              straight node next to a turn (the end of a load-free span: damps c2's ringing into it).
+//              Spread-out turning (sag, drums, sheaves, helices: d small) -> g = 0: the accurate C2 spline,
+//              whatever the stretch. A turn the neighbours do not share (a corner between straight runs, an
+//              alternating zig-zag) -> g = 1: straight runs and a rounding of ~3e-5 of the element at the turn
+//              (the tangent shrinks to ~3/(2 + 3e4) of c2's, never 0: G1 everywhere). Open ends blend from
+//              not-a-knot to free as node 1 or 2 (n-2 or n-3) gets tensed. Continuous in the nodes (g and w
+//              are smooth functions of them). Stretch is not used: the turning pattern, not the stretch,
+//              shows where a distributed load acts. Why, and where it stops holding: modules/wire/DESIGN.md.
+//              Tension (wire, node, curvature) scales both tangents at a node as for catmull_rom; bias and
+//              continuity do not apply. Cost O(n) (one tridiagonal solve, as c2).
 // linear       b1, b2 at 1/3 and 2/3 of the chord.
 #pragma once
 

@@ -24,7 +24,8 @@ struct Nodes : WireNodes {};
 struct Style {
     float radius_m = 0.01f;       ///< tube radius where a node's radius is 0; 0 -> 1 cm
     uint32_t max_sides = 0;       ///< upper clamp of the LOD's radial sides; 0 -> 16
-    SplineSettings spline{};      ///< curve settings (spline.closed and spline.radius_m are taken from this Style)
+    SplineSettings spline{.kind = SplineKind::automatic};  ///< curve settings (default: automatic, the best measured;
+                                                           ///< spline.closed and spline.radius_m come from this Style)
     uint32_t material = 0;        ///< renderer material index
     bool caps = true;             ///< flat end caps on open wires
     bool closed = false;          ///< closed loop
