@@ -21,13 +21,18 @@
 //   * lag: |rendered - T| <= (1 - w) max|D|; at the switch it is the instant pop itself (P drawn exactly);
 //   * settles: after N frames the event's offset is gone; with no event running the curve drawn is T, bit for
 //     bit (to far better than 1e-6 m).
-// Length of an event: N = blend_s / frame_s (0.25 s: 15 frames at 60 Hz) so that the jump is at most 1.5/15 =
-// 1/10 of max|D| (close to the instant pop: D is measured point to corresponding point), lengthened to
-// 1.5 max|D| / max_step_m frames when that is longer, so that the jump stays under max_step_m (1 mm), and at most
-// max_blend_s (2 s: a wire drawn away from its physics for longer than that is no longer "smoothing"). The
-// bound: an event with max|D| above 1.5 mm * (2 s / 1/60 s) / 1.5 = 80 mm... precisely max_step_m * N_max / 1.5
-// = 80 mm by default, still takes 2 s and its frames jump by max|D| / 80 (1.25% of it, e.g. 2.5 mm for a 20 cm
-// change).
+// Length of an event: N = blend_s / frame_s (0.25 s: 15 frames at 60 Hz), so that each frame moves the curve by
+// at most 1.5/15 = 1/10 of max|D| (which is the instant pop where D runs point to nearest point), lengthened to
+// 1.5 max|D| / max_step_m frames when that is longer, so that each frame stays under max_step_m (1 mm), and
+// at most max_blend_s (4 s). The bound and its reason: a change of size P cannot move by at most s per frame
+// in fewer than 1.5 P / s frames (smoothstep's peak speed is 1.5x its mean), so "<= 2 mm a frame" and "done in
+// bounded time" meet only up to a size; with the defaults, 1 mm a frame holds up to max|D| = 16 cm, 2 mm up
+// to 32 cm (events in flight add up, hence 1 mm for one event), and a larger change takes 4 s at max|D|/160
+// a frame. A wire held more than 4 s away from its physics is no longer a smoothing.
+// Events overlap: each keeps its own bound, so the frame's jump is at most the sum over running events.
+// Known limit: between junctions D pairs points by parameter; where the two curves' parameter speeds differ
+// strongly (uniform Catmull-Rom across very unequal elements) D slides along the curve, max|D| can exceed the
+// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md).
 // Not remedied (the new curve is shown at once, counted in unremedied()): a node count change when
 // WireNodes::ids is empty (nodes are then named by index), or a change between open and closed.
 // A duplicate id in one state is an error (Status naming the node and the id); the previous curve stays.
