@@ -36,29 +36,6 @@ struct Rng {
     }
 };
 
-// Parameter of the point of c nearest to p: a 16-point scan, then Newton inside the best cell.
-double foot_parameter(const CubicBezier& c, const dvec3& p) {
-    constexpr int kScan = 16;
-    double best_t = 0.0, best_d2 = std::numeric_limits<double>::infinity();
-    for (int i = 0; i <= kScan; ++i) {
-        const double t = static_cast<double>(i) / kScan;
-        const dvec3 d = position(c, t) - p;
-        if (glm::dot(d, d) < best_d2) best_d2 = glm::dot(d, d), best_t = t;
-    }
-    const double lo = std::max(0.0, best_t - 1.0 / kScan), hi = std::min(1.0, best_t + 1.0 / kScan);
-    double t = best_t;
-    for (int it = 0; it < 12; ++it) {
-        const dvec3 d = position(c, t) - p, d1 = derivative(c, t), d2 = second_derivative(c, t);
-        const double f = glm::dot(d, d1), fp = glm::dot(d1, d1) + glm::dot(d, d2);
-        if (!(fp > 0.0)) break;
-        const double next = std::clamp(t - f / fp, lo, hi);
-        if (std::abs(next - t) < 1e-14) break;
-        t = next;
-    }
-    const dvec3 dn = position(c, t) - p;
-    return glm::dot(dn, dn) <= best_d2 ? t : best_t;
-}
-
 // Foot points on one curve: per-segment bounding spheres of the control points for pruning, and a warm start
 // (the previous query's foot) for the usual case of queries that walk along the curve.
 class FootFinder {

@@ -804,8 +804,12 @@ TEST(WireMultires, SettlesOnTheFreshCurveWithinTheBlendTime) {
             for (int f = 0; f <= std::max(60, frames); ++f) {
                 const double lag = curve_distance_m(cur, m.target());
                 EXPECT_LE(lag, pop * (1.0 + 1e-9) + 1e-12) << v.name << " frame " << f;
-                if (f >= frames) EXPECT_EQ(lag, 0.0) << v.name << " frame " << f;  // exactly the fresh curve
-                if (f > 0) EXPECT_LE(curve_distance_m(prev, cur), 0.2 * pop + 1e-12) << v.name << " frame " << f;
+                if (f >= frames) {
+                    EXPECT_EQ(lag, 0.0) << v.name << " frame " << f;  // exactly the fresh curve
+                }
+                if (f > 0) {
+                    EXPECT_LE(curve_distance_m(prev, cur), 0.2 * pop + 1e-12) << v.name << " frame " << f;
+                }
                 prev = cur;
                 ASSERT_TRUE(m.update(*state, cur).ok);
             }
@@ -846,7 +850,9 @@ TEST(WireMultires, ClosedLoopsAndTheSeamNodeAreRemedied) {
                 worst = std::max(worst, curve_distance_m(prev, cur));
                 EXPECT_EQ(cur.segments.back().b3, cur.segments.front().b0) << int(kind);
             }
-            if (kind != SplineKind::linear || state == &seamless) EXPECT_GT(pop, 1e-4) << int(kind);
+            if (kind != SplineKind::linear || state == &seamless) {
+                EXPECT_GT(pop, 1e-4) << int(kind);
+            }
             EXPECT_LE(worst, 0.2 * pop + 1e-12) << int(kind);
             EXPECT_FALSE(m.blending());
             EXPECT_EQ(curve_distance_m(cur, m.target()), 0.0);
