@@ -52,9 +52,9 @@ wire::PipelineSettings read_settings(FuzzedDataProvider& in) {
     s.frame_method = static_cast<wire::FrameMethod>(in.ConsumeIntegralInRange<int>(0, 2));
     s.pop_free = in.ConsumeBool();
     if (in.ConsumeBool()) {
-        s.multires.blend_frames = in.ConsumeIntegralInRange<int>(-2, 12);
+        s.multires.blend_s = special_or_raw(in);
         s.multires.max_step_m = special_or_raw(in);
-        s.multires.max_blend_frames = in.ConsumeIntegralInRange<int>(-2, 300);
+        s.multires.max_blend_s = special_or_raw(in);
     }
     return s;
 }
@@ -116,13 +116,13 @@ void dump(const wire::PipelineSettings& s, const wire::WireNodes& n, int state) 
     std::fprintf(stderr,
                  "state %d: kind %d alpha %.17g tension %.17g bias %.17g continuity %.17g curvature_tension %d closed %d "
                  "radius %.9g merge %.17g rings %u tolerance %.17g max_rings %u sides %u caps %d tilt %d frames %d "
-                 "pop_free %d blend %d step %.17g max_blend %d\n",
+                 "pop_free %d blend %.17g s step %.17g max_blend %.17g s\n",
                  state, int(s.spline.kind), s.spline.alpha, s.spline.tension, s.spline.bias, s.spline.continuity,
                  int(s.spline.curvature_tension), int(s.spline.closed), double(s.spline.radius_m),
                  s.spline.merge_epsilon_rel, s.tessellate.rings_per_segment, s.tessellate.tolerance_m,
                  s.tessellate.max_rings_per_segment, s.tube.sides, int(s.tube.caps), int(s.tube.tilt_normals),
-                 int(s.frame_method), int(s.pop_free), s.multires.blend_frames, s.multires.max_step_m,
-                 s.multires.max_blend_frames);
+                 int(s.frame_method), int(s.pop_free), s.multires.blend_s, s.multires.max_step_m,
+                 s.multires.max_blend_s);
     for (std::size_t i = 0; i < n.size(); ++i) {
         std::fprintf(stderr, "  node %zu: %.17g %.17g %.17g", i, n.positions[i].x, n.positions[i].y, n.positions[i].z);
         if (!n.ids.empty()) std::fprintf(stderr, " id %u", n.ids[i]);

@@ -64,6 +64,7 @@ std::string num(std::size_t v);
 // (exit_ok, or exit_failure when a file could not be written).
 int run_systems_bench(const Options& o);   ///< bench.csv, bench.md
 int run_accuracy_bench(const Options& o);  ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
+int run_remedy_bench(const Options& o);    ///< remedy_families.csv, remedy_families.md (bench_remedy.cpp)
 /// The DESIGN §5 hard cases as a Markdown section (case, result, max error).
 std::string stability_report();
 

@@ -6,6 +6,7 @@
 #include "wire/curve.hpp"
 #include "wire/nodes.hpp"
 #include "wire/reference.hpp"
+#include "wire/remedy_family.hpp"
 #include "wire/spline.hpp"
 #include "wire/status.hpp"
 
@@ -756,7 +757,7 @@ TEST(WireMultires, MovingWireFollowsTheNodesWhileMorphing) {
     EXPECT_LT(curve_jump_m(cur, m.target()), 1e-12);
 }
 
-TEST(WireMultires, UnremediedCasesShowTheTarget) {
+TEST(WireMultires, BadStatesKeepThePreviousCurve) {
     const WireNodes loop = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0), dvec3(-1.0, 0.0, 0.5)});
     MultiresCurve m({.spline = {.closed = true}});
     Curve c;
@@ -768,10 +769,133 @@ TEST(WireMultires, UnremediedCasesShowTheTarget) {
     const Status st = m.update(bad, c);
     EXPECT_EQ(st.message, "node 1: position.x is NaN");
     EXPECT_EQ(c.segment_count(), 4u);  // the previous frame's curve stays
+    // A duplicate id is an error naming the node and the id (the caller prefixes the wire), in the first state too.
     WireNodes dup = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0)});
-    dup.ids = {5, 5, 6};
+    dup.ids = {5, 6, 5};
     MultiresCurve d;
+    const Status first = d.update(dup, c);
+    EXPECT_FALSE(first.ok);
+    EXPECT_EQ(first.message, "node 2: id 5 is used twice (also node 0)");
+    EXPECT_EQ(first.node, 2);
+    dup.ids = {5, 6, 7};
     ASSERT_TRUE(d.update(dup, c).ok);
-    ASSERT_TRUE(d.update(dup, c).ok);
-    EXPECT_FALSE(d.blending());
+    dup.ids = {5, 7, 7};
+    EXPECT_EQ(d.update(dup, c).message, "node 2: id 7 is used twice (also node 1)");
+    EXPECT_EQ(c.segment_count(), 2u);
+    // Without ids a node count change renames the nodes: shown at once and counted.
+    WireNodes plain = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0)});
+    MultiresCurve p;
+    ASSERT_TRUE(p.update(plain, c).ok);
+    plain.positions.push_back(dvec3(3.0, 1.0, 0.0));
+    ASSERT_TRUE(p.update(plain, c).ok);
+    EXPECT_FALSE(p.blending());
+    EXPECT_EQ(p.unremedied(), 1u);
+}
+
+// Issue 17's two-event case: a node inserted on the curve of the 16-node cable, then another node removed, each
+// held for at least 60 frames. Every kind ends exactly on the fresh curve within the blend time (at most
+// max_blend_frames) and never lags more than the instant pop of the event.
+TEST(WireMultires, SettlesOnTheFreshCurveWithinTheBlendTime) {
+    const Catenary cable = hanging_cable();
+    for (const NamedSettings& v : spline_variants()) {
+        const WireNodes base = cable_nodes(cable, 16);
+        const WireNodes inserted = cable_with_inserted_node(cable, v.settings);
+        WireNodes removed = inserted;
+        removed.positions.erase(removed.positions.begin() + 4), removed.ids.erase(removed.ids.begin() + 4);
+        MultiresCurve m({.spline = v.settings});
+        Curve prev, cur;
+        ASSERT_TRUE(m.update(base, prev).ok);
+        for (const WireNodes* state : {&inserted, static_cast<const WireNodes*>(&removed)}) {
+            const Curve before = m.target();
+            ASSERT_TRUE(m.update(*state, cur).ok);
+            const double pop = curve_distance_m(before, m.target());
+            const int frames = m.last_blend_frames();
+            EXPECT_LE(frames, m.max_blend_frames()) << v.name;
+            for (int f = 0; f <= std::max(60, frames); ++f) {
+                const double lag = curve_distance_m(cur, m.target());
+                EXPECT_LE(lag, pop * (1.0 + 1e-9) + 1e-12) << v.name << " frame " << f;
+                if (f >= frames) {
+                    EXPECT_EQ(lag, 0.0) << v.name << " frame " << f;  // exactly the fresh curve
+                }
+                if (f > 0) {
+                    EXPECT_LE(curve_distance_m(prev, cur), 0.2 * pop + 1e-12) << v.name << " frame " << f;
+                }
+                prev = cur;
+                ASSERT_TRUE(m.update(*state, cur).ok);
+            }
+        }
+        EXPECT_FALSE(m.blending()) << v.name;
+    }
+}
+
+// A closed loop (a coil of 3 m radius, 12 nodes): a node inserted on its curve in the last segment (across the
+// seam), then the seam node itself removed. Both are geomorphed, not popped.
+TEST(WireMultires, ClosedLoopsAndTheSeamNodeAreRemedied) {
+    for (SplineKind kind : {SplineKind::catmull_rom, SplineKind::c2, SplineKind::automatic, SplineKind::linear}) {
+        WireNodes loop;
+        for (int i = 0; i < 12; ++i) {
+            const double th = 2.0 * kPi * i / 12.0;
+            loop.positions.emplace_back(3.0 * std::cos(th), 0.4 * std::sin(3.0 * th), 3.0 * std::sin(th));
+            loop.ids.push_back(static_cast<uint32_t>(10 + i));
+        }
+        MultiresCurve m({.spline = {.kind = kind, .closed = true}});
+        Curve prev, cur;
+        ASSERT_TRUE(m.update(loop, prev).ok);
+        WireNodes inserted = loop;
+        inserted.positions.push_back(position(m.target().segments[11], 0.4));
+        inserted.ids.push_back(99);
+        WireNodes seamless = inserted;
+        seamless.positions.erase(seamless.positions.begin()), seamless.ids.erase(seamless.ids.begin());
+        for (const WireNodes* state : {static_cast<const WireNodes*>(&inserted), static_cast<const WireNodes*>(&seamless)}) {
+            const Curve before = m.target();
+            ASSERT_TRUE(m.update(*state, cur).ok);
+            const double pop = curve_distance_m(before, m.target());
+            EXPECT_LT(curve_distance_m(prev, cur), 1e-12) << int(kind);  // the switch frame shows the old loop
+            EXPECT_TRUE(cur.closed);
+            EXPECT_EQ(cur.segments.back().b3, cur.segments.front().b0) << int(kind);
+            double worst = 0.0;
+            for (int f = 0; f <= m.max_blend_frames() && m.blending(); ++f) {
+                prev = cur;
+                ASSERT_TRUE(m.update(*state, cur).ok);
+                worst = std::max(worst, curve_distance_m(prev, cur));
+                EXPECT_EQ(cur.segments.back().b3, cur.segments.front().b0) << int(kind);
+            }
+            if (kind != SplineKind::linear || state == &seamless) {
+                EXPECT_GT(pop, 1e-4) << int(kind);
+            }
+            EXPECT_LE(worst, 0.2 * pop + 1e-12) << int(kind);
+            EXPECT_FALSE(m.blending());
+            EXPECT_EQ(curve_distance_m(cur, m.target()), 0.0);
+            prev = cur;
+        }
+        EXPECT_EQ(m.unremedied(), 0u);
+    }
+}
+
+// The physics re-creates an end node under a new id (1 cm from the old one): the wire's ends still correspond,
+// so the change is blended like any other.
+TEST(WireMultires, ReplacedEndNodesAreRemedied) {
+    const Catenary cable = hanging_cable();
+    for (const NamedSettings& v : spline_variants()) {
+        const WireNodes base = cable_nodes(cable, 16);
+        WireNodes replaced = base;
+        replaced.ids.back() = 4242, replaced.positions.back() += dvec3(0.0, 0.01, 0.0);
+        replaced.ids.front() = 4243;
+        MultiresCurve m({.spline = v.settings});
+        Curve prev, cur;
+        ASSERT_TRUE(m.update(base, prev).ok);
+        ASSERT_TRUE(m.update(replaced, cur).ok);
+        EXPECT_LT(curve_distance_m(prev, cur), 1e-12) << v.name;
+        EXPECT_TRUE(m.blending()) << v.name;
+        double worst = 0.0;
+        while (m.blending()) {
+            prev = cur;
+            ASSERT_TRUE(m.update(replaced, cur).ok);
+            worst = std::max(worst, curve_distance_m(prev, cur));
+        }
+        EXPECT_LE(worst, 0.2 * 0.01 + 1e-12) << v.name;
+        EXPECT_GT(worst, 0.0) << v.name;
+        EXPECT_EQ(curve_distance_m(cur, m.target()), 0.0) << v.name;
+        EXPECT_EQ(m.unremedied(), 0u);
+    }
 }

@@ -363,6 +363,52 @@ TEST(WireSystems, InsertedNodeIsBlendedInWithoutAPop) {
     EXPECT_GT(rendered_jump_m(raw_before, raw.registry.get<WireCurve>(r).curve), 2.0 * worst_jump);
 }
 
+// A state with a node id used twice is an error naming the wire entity, the node and the id, with or without the
+// pop-free remedy; the wire keeps drawing its last valid curve.
+TEST(WireSystems, DuplicateNodeIdIsAnErrorNamingWireAndId) {
+    for (bool pop_free : {true, false}) {
+        World w;
+        w.ctx.pop_free = pop_free;
+        std::vector<ErrorReport> reported;
+        w.ctx.on_error = [&](const ErrorReport& r) { reported.push_back(r); };
+        WireNodes nodes = cable(8, {-2, 0, 0}, 4.0, 0.5);
+        nodes.ids = {10, 11, 12, 13, 14, 15, 16, 17};
+        const Entity e = spawn_wire(w.registry, nodes);
+        w.run();
+        const Curve good = w.registry.get<WireCurve>(e).curve;
+        WireNodes dup = w.registry.get<Nodes>(e);
+        dup.ids[5] = dup.ids[2];
+        set_nodes(w.registry, e, dup);
+        w.run();
+        ASSERT_EQ(reported.size(), 1u) << pop_free;
+        EXPECT_EQ(reported[0].message, describe_entity(e) + ": node 5: id " + std::to_string(dup.ids[2]) +
+                                           " is used twice (also node 2)");
+        EXPECT_EQ(wire_error(w.registry, e)->node, 5);
+        EXPECT_EQ(w.registry.get<WireCurve>(e).curve.segments.size(), good.segments.size());
+    }
+}
+
+// Style::blend_s sets the geomorph length per wire: a small change on a wire with 1 s blends for 60 frames,
+// the same change on a default wire for 15 (0.25 s at the 60 Hz frame).
+TEST(WireSystems, BlendTimeIsSetPerWire) {
+    World w;
+    const Entity quick = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.6));
+    const Entity slow = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.6), {.blend_s = 1.0f});
+    w.run();
+    for (const Entity e : {quick, slow}) {
+        const auto& p = w.registry.get<Nodes>(e).positions;
+        insert_node(w.registry, e, 6, 0.5 * (p[5] + p[6]) + glm::dvec3(0, 0.002, 0));
+    }
+    int frames[2] = {0, 0};
+    for (int frame = 0; frame < 200; ++frame) {
+        w.run();
+        if (w.registry.get<WireCurve>(quick).blending) ++frames[0];
+        if (w.registry.get<WireCurve>(slow).blending) ++frames[1];
+    }
+    EXPECT_EQ(frames[0], 15);
+    EXPECT_EQ(frames[1], 60);
+}
+
 TEST(WireSystems, InsertAndRemoveNodeKeepArraysAndIds) {
     World w;
     WireNodes n = cable(6, {-1, 0, 0}, 2.0, 0.2);

@@ -1,29 +1,43 @@
 // Pop-free multiresolution: a small per-wire object that turns successive node states (with stable ids) into
-// the curve to render, geomorphing the segments around nodes that appear or vanish.
+// the curve to render, geomorphing the change when nodes appear or vanish.
 //
-// Remedy (open wires): each state's exact curve T is built with build_curve. The previous state's target and
-// the new one share "common" node ids; between two consecutive common nodes A, B lies a span. A span whose
-// interior ids changed (a node inserted or removed), its `support` neighbours (whose tangents changed with it:
-// 1 for the local splines, 3 for c2, 0 for linear) and any blend they touch start a geomorph:
-//   * the span is rendered in the UNION topology: old-only nodes (removed) stay as ghost nodes, new-only nodes
-//     (inserted) are cut into the old curve at their closest point. Old and new chains are both subdivided
-//     (de Casteljau, exact) at all union points, so each side is represented exactly;
-//   * per sub-segment, the control-point offset D = old - new is frozen (0 at the anchors A, B, which are never
-//     mid-morph, so neighbouring spans stay joined), and the rendered control points are new(now) + keep * D;
-//   * keep falls linearly from 1 to 0 at a constant rate: frame 0 renders the old curve exactly (no pop at the
-//     switch), the last frame renders T exactly. A constant rate (not a smoothstep) because a later event
-//     restarts the morph from what is on screen: an ease-in restarted every few frames would stall.
-// Consecutive affected spans form one run (one blend): inner common nodes that are still mid-morph become
-// union points, so nothing snaps. Ghosts whose two pieces are again one cubic within max_step_m/10 are pruned
-// when a run restarts.
-// With the target at rest, the point at parameter t moves in one frame by rate * |D(t)| (D(t) the Bezier
-// combination of the offsets, at most the largest control-point offset); every rendered point is that close
-// to a point of the previous frame, which bounds the measured jump. rate = max_step_m / max_t |D(t)|, clamped
-// to [1/max_blend_frames, 1/blend_frames], keeps every frame's jump under max_step_m unless the morph would
-// take longer than max_blend_frames. |D(t)| includes sliding along the curve, so the bound is conservative.
-// Not remedied (the new curve is shown at once): closed loops, a wire's end node replaced (nothing to anchor
-// on beyond it), duplicate ids, ids that change order, and a node count change when WireNodes::ids is empty
-// (nodes are then named by index). Cost per state: O(n) plus, per restarted run, O(run nodes^2) projections.
+// Remedy. Let P be the exact curve of the previous state and T the exact curve (build_curve) of the current
+// one. When the ids change, P is mapped onto T's parameterisation: nodes present in both are matched exactly;
+// an open wire's two ends always correspond (so a replaced end node, an end re-created by the physics under a
+// new id, is covered); a closed loop is cut at a common node (the seam node is a node like any other). Between
+// two consecutive matched nodes, a node only in P (removed) is placed on T at its closest point and a node only
+// in T (inserted) on P at its closest point; if those disagree on the order, the stretch is cut at arc-length
+// fractions instead. Both curves are subdivided at all these points (de Casteljau, exact), so the event's
+// offset D = P - T is one cubic per sub-piece, continuous along the wire, and zero wherever P and T agree.
+// The curve drawn is
+//     rendered = T + sum over running events e of (1 - w(k_e / N_e)) * D_e,     w(s) = 3s^2 - 2s^3,
+// k_e the frames since event e, N_e its length in frames. Each event decays on its own clock; a later event
+// carries the earlier offsets over onto the new parameterisation (exactly, by sub-division), so overlapping
+// events compose and none of them restarts or stalls another. Properties, for the target at rest:
+//   * no step: at an event's frame w = 0, so the switch shows the previous curve exactly; w is C1 with w' = 0
+//     at both ends, and when an event ends its offset is exactly 0, so the end and the dropping of the ghost
+//     junctions (sub-pieces of T that rejoin) change nothing;
+//   * per-frame jump <= max over the frame of |w(k/N) - w((k-1)/N)| * max_t |D(t)| <= 1.5 max|D| / N;
+//   * lag: |rendered - T| <= (1 - w) max|D|; at the switch it is the instant pop itself (P drawn exactly);
+//   * settles: after N frames the event's offset is gone; with no event running the curve drawn is T, bit for
+//     bit (to far better than 1e-6 m).
+// Length of an event: N = blend_s / frame_s (0.25 s: 15 frames at 60 Hz), so that each frame moves the curve by
+// at most 1.5/15 = 1/10 of max|D| (which is the instant pop where D runs point to nearest point), lengthened to
+// 1.5 max|D| / max_step_m frames when that is longer, so that each frame stays under max_step_m (1 mm), and
+// at most max_blend_s (4 s). The bound and its reason: a change of size P cannot move by at most s per frame
+// in fewer than 1.5 P / s frames (smoothstep's peak speed is 1.5x its mean), so "<= 2 mm a frame" and "done in
+// bounded time" meet only up to a size; with the defaults, 1 mm a frame holds up to max|D| = 16 cm, 2 mm up
+// to 32 cm (events in flight add up, hence 1 mm for one event), and a larger change takes 4 s at max|D|/160
+// a frame. A wire held more than 4 s away from its physics is no longer a smoothing.
+// Events overlap: each keeps its own bound, so the frame's jump is at most the sum over running events.
+// Known limit: between junctions D pairs points by parameter; where the two curves' parameter speeds differ
+// strongly (uniform Catmull-Rom across very unequal elements) D slides along the curve, max|D| can exceed the
+// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md).
+// Not remedied (the new curve is shown at once, counted in unremedied()): a node count change when
+// WireNodes::ids is empty (nodes are then named by index), or a change between open and closed.
+// A duplicate id in one state is an error (Status naming the node and the id); the previous curve stays.
+// Cost per state: O(n) plus O(pieces * running events) while blending; at an event, projections of the
+// changed nodes onto the stretch between their matched neighbours.
 #pragma once
 
 #include "wire/curve.hpp"
@@ -37,56 +51,73 @@ namespace wire {
 
 struct MultiresSettings {
     SplineSettings spline{};
-    bool geomorph = true;        ///< false: render each state's exact curve (the "no remedy" baseline)
-    int blend_frames = 8;        ///< minimum frames of a geomorph (<= 0: 8)
-    double max_step_m = 0.5e-3;  ///< per-frame displacement bound that lengthens a geomorph (<= 0: 0.5 mm)
-    int max_blend_frames = 240;  ///< cap on a geomorph's length (<= 0: 240)
+    bool geomorph = true;          ///< false: render each state's exact curve (the "no remedy" baseline)
+    double blend_s = 0.25;         ///< shortest geomorph, seconds (<= 0 or not finite: 0.25 s)
+    double frame_s = 1.0 / 60.0;   ///< time one update() stands for, seconds (<= 0 or not finite: 1/60 s)
+    double max_step_m = 1e-3;      ///< per-frame jump bound that lengthens a large event (<= 0 or not finite: 1 mm)
+    double max_blend_s = 4.0;      ///< longest geomorph, seconds (<= 0 or not finite: 4 s; at least blend_s)
 };
 
 /// The pop metric (same as curve_jump_m in bezier.hpp): the symmetric Hausdorff distance between the dense
 /// samples of two consecutive rendered curves, metres.
 [[nodiscard]] double rendered_jump_m(const Curve& before, const Curve& after, int per_segment = 64);
 
+/// Ok, or "node j: id X is used twice (also node i)" for the first repeated id of `nodes` (empty ids: ok).
+[[nodiscard]] Status check_unique_ids(const WireNodes& nodes);
+
 class MultiresCurve {
 public:
     explicit MultiresCurve(const MultiresSettings& settings = {});
 
-    /// Takes the next state. On success `rendered` is the curve to draw this frame (its nodes: the union of
-    /// current nodes and ghosts of removed ones while they morph away; `source_node` of a ghost is the current
-    /// node before it). On failure (build_curve's Status) `rendered` is left as the previous frame's curve.
+    /// Takes the next state (one frame, frame_s seconds after the previous one). On success `rendered` is the
+    /// curve to draw this frame (its nodes: the current nodes plus the junctions of pieces still morphing;
+    /// `source_node` of a junction is the current node before it). On failure (build_curve's Status, or a
+    /// duplicate id) `rendered` is left as the previous frame's curve and the state is unchanged.
     [[nodiscard]] Status update(const WireNodes& nodes, Curve& rendered);
 
     void reset();
-    [[nodiscard]] const Curve& target() const { return target_; }      ///< the exact curve of the last state
-    [[nodiscard]] bool blending() const { return !blends_.empty(); }
-    [[nodiscard]] std::size_t active_blends() const { return blends_.size(); }
-    /// States that changed topology but were shown without a geomorph (closed loop, replaced end node,
-    /// duplicate ids, ...), and the code of the last such case (for diagnostics).
+    [[nodiscard]] const Curve& target() const { return target_; }  ///< the exact curve of the last state
+    [[nodiscard]] bool blending() const { return !events_.empty(); }
+    [[nodiscard]] std::size_t active_blends() const { return events_.size(); }  ///< events still morphing
+    /// Length in frames of the newest event's geomorph (0 before any); the event has settled that many
+    /// frames after the frame that showed it.
+    [[nodiscard]] int last_blend_frames() const { return last_frames_; }
+    /// The longest geomorph these settings allow, frames.
+    [[nodiscard]] int max_blend_frames() const { return max_frames_; }
+    /// max over the wire of |D| of the newest event, metres (its frames move the curve by at most
+    /// 1.5 * that / last_blend_frames()).
+    [[nodiscard]] double last_max_offset_m() const { return events_.empty() ? 0.0 : events_.back().max_d; }
+    /// Geomorphs started so far (an id change that moved nothing starts none).
+    [[nodiscard]] std::size_t events_started() const { return started_; }
+    /// States that changed topology but were shown without a geomorph (see above), and the code of the last.
     [[nodiscard]] std::size_t unremedied() const { return unremedied_; }
     [[nodiscard]] int last_unremedied_reason() const { return last_reason_; }
 
-    struct Point {  // a union point inside a span, in the new chain's coordinates
-        uint32_t segment;  // offset from the span's first segment
-        double u;
-        uint32_t id;
-        bool ghost;  // an old-only node (removed) rather than a current node
+    struct Event {
+        int elapsed = 0;     ///< frames since the event's switch frame
+        int frames = 1;      ///< its length N
+        double max_d = 0.0;  ///< max over the wire of |D|, metres
     };
-    struct Blend {
-        uint32_t anchor_a = 0, anchor_b = 0;  // ids of the common nodes bounding the span
-        double keep = 1.0;                    // share of the start offset still shown (1 -> 0)
-        double rate = 0.125;                  // decrease of keep per frame
-        std::vector<Point> points;            // interior union points, in order
-        std::vector<CubicBezier> offset;      // per sub-segment D = old - new at the start
+    struct Piece {           ///< a part [u0, u1] of target segment `segment` carrying offsets
+        uint32_t segment = 0;
+        double u0 = 0.0, u1 = 1.0;
+        std::vector<CubicBezier> offset;  ///< one per running event, in events_ order
     };
 
 private:
+    void remap(const Curve& T, const std::vector<uint32_t>& tid);
+    void assemble(const Curve& T, Curve& out) const;
+
     MultiresSettings settings_;
+    int min_frames_ = 15, max_frames_ = 120;
     bool has_state_ = false;
-    Curve target_;                     // exact curve of the last state
-    std::vector<uint32_t> target_ids_; // per target node
-    Curve rendered_;                   // what was drawn last
-    std::vector<uint32_t> rendered_ids_;
-    std::vector<Blend> blends_;
+    Curve target_;                      // exact curve of the last state
+    std::vector<uint32_t> target_ids_;  // per target node
+    Curve rendered_;                    // what was drawn last
+    std::vector<Event> events_;
+    std::vector<Piece> pieces_;         // sorted by (segment, u0); segments without pieces are drawn as T
+    int last_frames_ = 0;
+    std::size_t started_ = 0;
     std::size_t unremedied_ = 0;
     int last_reason_ = 0;
 };

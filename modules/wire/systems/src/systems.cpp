@@ -119,10 +119,11 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         CurveJob& job = jobs[i];
         WireCurve& c = *job.curve;
         const SplineSettings spline = spline_of(*job.style);
-        if (c.builds == 0 || !same_spline(spline, c.spline) || c.geomorph != pop_free) {
-            c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free});
+        if (c.builds == 0 || !same_spline(spline, c.spline) || c.geomorph != pop_free || c.blend_s != job.style->blend_s) {
+            c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
             c.spline = spline;
             c.geomorph = pop_free;
+            c.blend_s = job.style->blend_s;
         }
         const WireNodes& nodes = *job.nodes;
         const WireNodes& prev = c.previous_nodes;
@@ -131,6 +132,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         if (!pop_free || same_ids) {
             // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
             job.status = build_curve(nodes, spline, c.scratch);
+            if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
             if (job.status.ok) std::swap(c.curve, c.scratch);
             c.multires_stale = true;
         } else {

@@ -29,6 +29,7 @@ struct Style {
     uint32_t material = 0;        ///< renderer material index
     bool caps = true;             ///< flat end caps on open wires
     bool closed = false;          ///< closed loop
+    float blend_s = 0.0f;         ///< pop-free geomorph length for small changes, seconds (multires.hpp); 0 -> 0.25 s
 };
 
 // ---- derived state, owned by the systems (read them, do not write them) ----
@@ -44,6 +45,7 @@ struct WireCurve {
     uint64_t builds = 0;               ///< times the curve stage ran for this wire (test/statistics counter)
     bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
     bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
+    float blend_s = 0.0f;              ///< Style::blend_s the multires state was made with
     // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
     // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
     // `previous_nodes` (the last valid state) when the ids change.
