@@ -37,7 +37,12 @@ nlohmann::json frame_record(const LevelFrameStats& s, std::span<const engine::ec
             {"nodes_removed", s.nodes_removed},
             {"curves_built", s.curves_built},
             {"rings", s.rings},
-            {"piece_levels", levels}};
+            {"piece_levels", levels},
+            {"rope_max_turn_deg", finite(s.rope_max_turn_deg)},
+            {"rope_penetration_m", finite(s.rope_penetration_m)},
+            {"piece_max_error_px", finite(s.piece_max_error_px)},
+            {"camera_rope_m", finite(s.camera_rope_m)},
+            {"camera_cable_m", finite(s.camera_cable_m)}};
 }
 
 bool all_finite(const nlohmann::json& doc) {
