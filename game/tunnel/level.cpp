@@ -644,7 +644,7 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
     }
 
     // Settle the ropes (fixed step, so every run starts from the same state).
-    const double prewarm_dt = 1.0 / 60.0;
+    const double prewarm_dt = 1.0 / 30.0;
     level->options_.gusts = false;
     for (double t = 0.0; t < settings.prewarm_s; t += prewarm_dt) level->update_ropes(prewarm_dt);
     level->options_.gusts = true;

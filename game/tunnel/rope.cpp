@@ -138,8 +138,9 @@ void Rope::solve(int it, const Collider& collider) {
             if (collider(x_[e], x_[e + 1], s_.radius_m, c) && c.depth_m > 0.0)
                 push_element(e, c.t, c.normal, c.depth_m);
     }
-    // Bending last: the largest turn holds at the end of every pass (contacts pull it back next pass).
-    bend(s_.bend_stiffness, it % 2 == 1);
+    // Bending last, on the passes with contacts: the largest turn holds at the end of them (contacts pull it
+    // back next time); twice the stiffness on half the passes.
+    if (it % 2 == 1 || it + 1 == s_.iterations) bend(2.0 * s_.bend_stiffness, it % 4 == 1);
 }
 
 void Rope::bend(double stiffness, bool backward) {
