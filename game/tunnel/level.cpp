@@ -40,7 +40,8 @@ constexpr double kPieceLength = 4.0;  // the assets' length along +z
 constexpr double kWallRadius = 2.5;
 constexpr int kLevelSlots = 8;
 constexpr std::size_t kGroups = 5;  // wall, ribs, walkway, hooks, clips
-constexpr glm::dvec2 kCloseUpEye{1.70, -0.20};  // unbent (x, y) of the eye at the closest point of the close-up
+constexpr glm::dvec2 kCloseUpEye{1.70,
+                                 -0.20};  // unbent (x, y) of the eye at the closest point of the close-up
 
 // Wire materials (indices into the WireRenderer's table; 0 is its copper weave).
 enum WireMaterial : uint32_t { copper = 0, rubber, orange, yellow, blue, red };
@@ -81,8 +82,8 @@ void add_quad(engine::assets::MeshData& m, const std::array<glm::dvec3, 4>& p, c
         m.positions.insert(m.positions.end(), {static_cast<float>(p[static_cast<std::size_t>(i)].x),
                                                static_cast<float>(p[static_cast<std::size_t>(i)].y),
                                                static_cast<float>(p[static_cast<std::size_t>(i)].z)});
-        m.normals.insert(m.normals.end(),
-                         {static_cast<float>(normal.x), static_cast<float>(normal.y), static_cast<float>(normal.z)});
+        m.normals.insert(m.normals.end(), {static_cast<float>(normal.x), static_cast<float>(normal.y),
+                                           static_cast<float>(normal.z)});
         m.uvs.insert(m.uvs.end(), {uv[i].x, uv[i].y});
     }
     m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
@@ -267,8 +268,9 @@ bool element_contact(const LevelShapes& g, double total_z, const glm::dvec3& a, 
     // Walkway corners and cable axes in (x, y): the element projects to a straight segment there.
     const glm::dvec2 a2(a.x, a.y), b2(b.x, b.y);
     if (near.walkway)
-        for (const glm::dvec2& c : {g.walkway_min_m, g.walkway_max_m, glm::dvec2(g.walkway_min_m.x, g.walkway_max_m.y),
-                                    glm::dvec2(g.walkway_max_m.x, g.walkway_min_m.y)})
+        for (const glm::dvec2& c :
+             {g.walkway_min_m, g.walkway_max_m, glm::dvec2(g.walkway_min_m.x, g.walkway_max_m.y),
+              glm::dvec2(g.walkway_max_m.x, g.walkway_min_m.y)})
             ts[nt++] = closest_t_2d(a2, b2, c);
     for (std::size_t i = 0; i < g.cables.size(); ++i)
         if ((near.cables & (1u << i)) != 0 && nt < 32) ts[nt++] = closest_t_2d(a2, b2, g.cables[i].section_m);
@@ -279,7 +281,8 @@ bool element_contact(const LevelShapes& g, double total_z, const glm::dvec3& a, 
              base += kPieceLength)
             for (const glm::dvec2& z : g.rib_z_m)
                 for (double zc : {base + z.x, base + z.y})
-                    if (zc > lo.z && zc < hi.z && nt < 32) ts[nt++] = closest_t_2d(ra, rb, {g.rib_inner_radius_m, zc});
+                    if (zc > lo.z && zc < hi.z && nt < 32)
+                        ts[nt++] = closest_t_2d(ra, rb, {g.rib_inner_radius_m, zc});
     }
     bool found = false;
     for (int i = 0; i < nt; ++i) {
@@ -478,7 +481,8 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
                 g.inner_radius_m = 1e30;
                 for (std::size_t v = 0; v < combined.vertex_count(); ++v)
                     g.inner_radius_m = std::min<double>(
-                        g.inner_radius_m, std::hypot(combined.positions[3 * v], combined.positions[3 * v + 1]));
+                        g.inner_radius_m,
+                        std::hypot(combined.positions[3 * v], combined.positions[3 * v + 1]));
                 g.top = std::move(combined);
             }
         }
@@ -725,7 +729,8 @@ void Level::animate(double dt_s) {
         };
         const double u = options_.close_up ? smooth(7.5, 9.5, z) * (1.0 - smooth(12.5, 14.0, z)) : 0.0;
         const glm::dvec3 eye_unbent(kCloseUpEye.x * u, 0.35 + (kCloseUpEye.y - 0.35) * u, z);
-        const glm::dvec3 look = glm::mix(glm::dvec3(0.0, 0.05, z + 7.0), glm::dvec3(2.2, -0.45, z + 2.0), 0.8 * u);
+        const glm::dvec3 look =
+            glm::mix(glm::dvec3(0.0, 0.05, z + 7.0), glm::dvec3(2.2, -0.45, z + 2.0), 0.8 * u);
         const curved_space::BentVertex eye = chain_.transform(eye_unbent, {0.0, 1.0, 0.0});
         camera_.position = glm::vec3(eye.position);
         camera_.target = glm::vec3(chain_.transform_point(look));
@@ -776,9 +781,10 @@ void Level::update_ropes(double dt_s) {
         for (const glm::dvec2& q : {glm::dvec2(2.4, 0.0), {-2.4, 0.0}, {0.0, 2.4}, {0.0, -2.4}})
             for (double z : {kPieceLength * e.piece_a, zc, kPieceLength * (e.piece_a + 1)}) {
                 const glm::dvec3 p(q, z);
-                e.z_scale = std::min(e.z_scale, glm::length(chain_.transform_point(p + glm::dvec3(0, 0, kEps)) -
-                                                            chain_.transform_point(p)) /
-                                                    kEps);
+                e.z_scale =
+                    std::min(e.z_scale, glm::length(chain_.transform_point(p + glm::dvec3(0, 0, kEps)) -
+                                                    chain_.transform_point(p)) /
+                                            kEps);
             }
         // Gravity (world -y) seen in the unbent space at the rope's piece, minus the -y the rope applies.
         const double g = ropes_[r].settings().gravity_mps2;
@@ -788,8 +794,8 @@ void Level::update_ropes(double dt_s) {
         if (gusting && std::abs(z0 + 2.0 - gust_z) < 2.0 + 4.0 * kGustWidth) {
             const glm::dvec3 anchor = s.anchors[e.anchor_a];
             const bool across = e.anchor_b >= 4 && e.anchor_a < 4;  // from one wall to the other
-            const glm::dvec3 dir = glm::normalize(
-                across ? glm::dvec3(0.0, 0.25, 1.0) : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
+            const glm::dvec3 dir = glm::normalize(across ? glm::dvec3(0.0, 0.25, 1.0)
+                                                         : glm::dvec3(anchor.x < 0.0 ? 1.0 : -1.0, 0.6, 0.0));
             fields[r] = [dir, gust_z, correction](const glm::dvec3& p) {
                 const double u = (p.z - gust_z) / kGustWidth;
                 return correction + dir * (kGustAccel * std::exp(-u * u));
@@ -842,7 +848,8 @@ void Level::update_ropes(double dt_s) {
                         for (std::size_t j = 0; j + 1 < pb.size(); ++j) {
                             const glm::dvec3 bl = glm::min(pb[j], pb[j + 1]);
                             const glm::dvec3 bh = glm::max(pb[j], pb[j + 1]);
-                            if (glm::any(glm::greaterThan(al, bh)) || glm::any(glm::greaterThan(bl, ah))) continue;
+                            if (glm::any(glm::greaterThan(al, bh)) || glm::any(glm::greaterThan(bl, ah)))
+                                continue;
                             pairs.push_back({a, b, i, j});
                         }
                     }
@@ -862,7 +869,8 @@ void Level::update_ropes(double dt_s) {
                     const double clear =
                         (ropes_[q.a].settings().radius_m + ropes_[q.b].settings().radius_m) /
                         bent_metric(nrm, std::min(s.rope_ends[q.a].z_scale, s.rope_ends[q.b].z_scale));
-                    if (len < clear) Rope::separate(ropes_[q.a], q.ea, sa, ropes_[q.b], q.eb, sb, nrm, clear - len);
+                    if (len < clear)
+                        Rope::separate(ropes_[q.a], q.ea, sa, ropes_[q.b], q.eb, sb, nrm, clear - len);
                 }
             }
             for (std::size_t r = 0; r < n; ++r) ropes_[r].end_substep();
@@ -946,18 +954,21 @@ void Level::measure_ropes() {
             const auto& pb = samples[b];
             if (pa.size() < 2 || pb.size() < 2) continue;
             const double clear = ropes_[a].settings().radius_m + ropes_[b].settings().radius_m;
-            if (glm::any(glm::greaterThan(lo[a] - clear, hi[b])) || glm::any(glm::greaterThan(lo[b] - clear, hi[a])))
+            if (glm::any(glm::greaterThan(lo[a] - clear, hi[b])) ||
+                glm::any(glm::greaterThan(lo[b] - clear, hi[a])))
                 continue;
             for (std::size_t i = 0; i + 1 < pa.size(); ++i)
                 for (std::size_t j = 0; j + 1 < pb.size(); ++j) {
-                    const glm::dvec3 al = glm::min(pa[i], pa[i + 1]) - clear, ah = glm::max(pa[i], pa[i + 1]) + clear;
+                    const glm::dvec3 al = glm::min(pa[i], pa[i + 1]) - clear,
+                                     ah = glm::max(pa[i], pa[i + 1]) + clear;
                     const glm::dvec3 bl = glm::min(pb[j], pb[j + 1]), bh = glm::max(pb[j], pb[j + 1]);
                     if (glm::any(glm::greaterThan(al, bh)) || glm::any(glm::greaterThan(bl, ah))) continue;
                     double sa = 0.0, sb = 0.0;
                     closest_segments(pa[i], pa[i + 1], pb[j], pb[j + 1], sa, sb);
                     const glm::dvec3 p = pa[i] + sa * (pa[i + 1] - pa[i]);
                     const glm::dvec3 q = pb[j] + sb * (pb[j + 1] - pb[j]);
-                    const double pen = clear - glm::length(chain_.transform_point(p) - chain_.transform_point(q));
+                    const double pen =
+                        clear - glm::length(chain_.transform_point(p) - chain_.transform_point(q));
                     deepest = std::max(deepest, pen);
                 }
         }
@@ -967,7 +978,8 @@ void Level::measure_ropes() {
     stats_.camera_rope_m = 1e30;
     for (std::size_t r = 0; r < ropes_.size(); ++r)
         for (const glm::dvec3& p : samples[r])
-            stats_.camera_rope_m = std::min(stats_.camera_rope_m, glm::length(chain_.transform_point(p) - eye));
+            stats_.camera_rope_m =
+                std::min(stats_.camera_rope_m, glm::length(chain_.transform_point(p) - eye));
     stats_.camera_cable_m = 1e30;
     const double z_eye = s.flight_z_m;
     for (const FixedCable& f : s.fixed)
@@ -1009,7 +1021,8 @@ void Level::choose_piece_levels() {
                 distance[g] = std::min(distance[g], std::sqrt(along * along + gap * gap));
             }
         }
-        const double curvature = std::abs(chain_.segment(static_cast<std::size_t>(k)).angle_rad) / kPieceLength;
+        const double curvature =
+            std::abs(chain_.segment(static_cast<std::size_t>(k)).angle_rad) / kPieceLength;
         for (std::size_t g = 0; g < kGroups; ++g) {
             const int level = engine::assets::choose_subdivision_level(
                 s.groups[g].model, {.curvature_per_m = curvature,
@@ -1088,8 +1101,10 @@ void Level::draw_wires() {
         }
     }
     // GPU ms of both passes: the newest frame whose two results are available, never waited for.
-    for (const auto& m : s.pieces_timer.poll()) s.gpu_results.try_emplace(m.frame, -1.0, -1.0).first->second.first = m.ms;
-    for (const auto& m : s.wires_timer.poll()) s.gpu_results.try_emplace(m.frame, -1.0, -1.0).first->second.second = m.ms;
+    for (const auto& m : s.pieces_timer.poll())
+        s.gpu_results.try_emplace(m.frame, -1.0, -1.0).first->second.first = m.ms;
+    for (const auto& m : s.wires_timer.poll())
+        s.gpu_results.try_emplace(m.frame, -1.0, -1.0).first->second.second = m.ms;
     for (auto it = s.gpu_results.rbegin(); it != s.gpu_results.rend(); ++it) {
         if (it->second.first < 0.0 || it->second.second < 0.0) continue;
         stats_.gpu_ms_frame = static_cast<int64_t>(it->first);

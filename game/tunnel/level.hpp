@@ -4,7 +4,8 @@
 // themselves, and a camera flying along the bent centre line. Everything runs as named systems of one
 // engine::ecs::Schedule (timed per system):
 //   tunnel.animate  segment angles at time t -> Chain; fly camera; wire context camera/viewport
-//   tunnel.ropes    ropes simulated in the UNBENT tunnel space (where walkway, ribs, walls and wall cables are
+//   tunnel.ropes    ropes simulated in the UNBENT tunnel space (where walkway, ribs, walls and wall cables
+//   are
 //                   simple shapes): Verlet/PBD step with bending, contacts and friction, rope-rope contacts,
 //                   node insertion/removal
 //   tunnel.cables   wall cables and rope nodes bent by the CPU transform -> wire entities; rope metrics
@@ -17,6 +18,7 @@
 #include "tunnel/rope.hpp"
 
 #include <curved_space/chain.hpp>
+#include <engine/assets/mesh_data.hpp>
 #include <engine/ecs/entity.hpp>
 #include <engine/ecs/schedule.hpp>
 #include <engine/platform/expected.hpp>
@@ -24,7 +26,6 @@
 #include <wire/curve.hpp>
 #include <wire/draw.hpp>
 #include <wire/nodes.hpp>
-#include <engine/assets/mesh_data.hpp>
 
 #include <array>
 #include <cstddef>
@@ -67,7 +68,7 @@ struct LevelOptions {
     bool draw_wires = true;
     double subdivision_tolerance_px = 0.5;  ///< predicted geometric error of a piece on screen
     int max_subdivision_level =
-        4;  ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
+        4;                 ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
     bool close_up = true;  ///< the fly camera glides to the right wall (unbent z 7.5..14) for close-ups
     double flight_speed_mps = 2.5;
     CameraMode camera_mode = CameraMode::fly;
@@ -94,7 +95,8 @@ struct LevelFrameStats {
     std::size_t curves_built = 0;
     std::size_t rings = 0;
     /// GPU ms of the tunnel and wire passes (GL_TIME_ELAPSED, engine::gfx::GpuTimer): the newest results read
-    /// back without stalling, measured in frame gpu_ms_frame (a few frames ago; -1 and 0 ms before the first).
+    /// back without stalling, measured in frame gpu_ms_frame (a few frames ago; -1 and 0 ms before the
+    /// first).
     double pieces_gpu_ms = 0.0;
     double wires_gpu_ms = 0.0;
     int64_t gpu_ms_frame = -1;

@@ -180,10 +180,11 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
     for (const engine::ecs::SystemStats& st : level.system_stats())
         std::printf("  %-16s mean %7.3f ms  max %7.3f ms\n", st.name.c_str(), st.mean_ms, st.max_ms);
     std::printf("  rope nodes inserted %d, removed %d\n", inserted, removed);
-    std::printf("  rope max turn %.2f deg, max penetration %.4f m (radius %.3f m), piece max error %.3f px "
-                "(tolerance %.2f px), %zu close-up frames\n",
-                max_turn, max_penetration, rope_radius_min(level), max_error,
-                level.options().subdivision_tolerance_px, close_ups.size());
+    std::printf(
+        "  rope max turn %.2f deg, max penetration %.4f m (radius %.3f m), piece max error %.3f px "
+        "(tolerance %.2f px), %zu close-up frames\n",
+        max_turn, max_penetration, rope_radius_min(level), max_error,
+        level.options().subdivision_tolerance_px, close_ups.size());
     for (const std::string& p : written) std::printf("wrote %s\n", p.c_str());
     std::printf("wrote %s\n", stats_path.c_str());
     return non_finite == 0 ? 0 : 1;

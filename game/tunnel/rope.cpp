@@ -158,7 +158,8 @@ void Rope::bend(double stiffness, bool backward) {
         const double h = glm::length(off);
         if (h < 1e-12) continue;
         const double chord_len = std::max(glm::length(chord), 1e-9);
-        const double h_max = glm::length(x_[i] - x_[i - 1]) * glm::length(x_[i + 1] - x_[i]) * sin_max / chord_len;
+        const double h_max =
+            glm::length(x_[i] - x_[i - 1]) * glm::length(x_[i + 1] - x_[i]) * sin_max / chord_len;
         const double target = std::min(h * (1.0 - stiffness), h_max);
         const double c = h - target;
         const double denom = w_[i] + w_[i - 1] * (1.0 - f) * (1.0 - f) + w_[i + 1] * f * f;
@@ -173,7 +174,8 @@ void Rope::bend(double stiffness, bool backward) {
 
 void Rope::end_substep() {
     // Coulomb friction on the substep's contacts: the motion along the contact plane is cancelled up to
-    // friction times the normal push (static), reduced by it beyond (kinetic). A rope draped over a rib stays.
+    // friction times the normal push (static), reduced by it beyond (kinetic). A rope draped over a rib
+    // stays.
     const std::size_t n = x_.size();
     for (std::size_t i = 1; i + 1 < n && i < contact_.size(); ++i) {
         const double push = glm::length(contact_[i]);
@@ -263,9 +265,9 @@ AdaptResult Rope::adapt(const wire::SplineSettings& spline) {
                 graded = e;
         }
         if ((sharpest != 0 || graded < n) && n < s_.max_nodes) {
-            const std::size_t e = sharpest == 0                         ? graded
+            const std::size_t e = sharpest == 0                            ? graded
                                   : rest_[sharpest - 1] >= rest_[sharpest] ? sharpest - 1
-                                                                         : sharpest;
+                                                                           : sharpest;
             glm::dvec3 p = 0.5 * (x_[e] + x_[e + 1]);
             wire::WireNodes nodes;
             write_nodes(nodes);

@@ -54,7 +54,8 @@ struct ElementContact {
     double depth_m = 0.0;
 };
 /// Returns true and fills `out` when the element touches an obstacle.
-using Collider = std::function<bool(const glm::dvec3& a, const glm::dvec3& b, double radius_m, ElementContact& out)>;
+using Collider =
+    std::function<bool(const glm::dvec3& a, const glm::dvec3& b, double radius_m, ElementContact& out)>;
 
 class Rope {
 public:
@@ -75,13 +76,13 @@ public:
     /// obstacles, with friction.
     void step(double dt_s, const AccelerationField& field = {}, const Collider& collider = {});
     /// The pieces of step(), for callers that solve several ropes together (rope-rope contacts between the
-    /// iterations): Verlet prediction over h_s seconds, one constraint pass (distance, bending, contacts), and
-    /// the friction of the substep's contacts.
+    /// iterations): Verlet prediction over h_s seconds, one constraint pass (distance, bending, contacts),
+    /// and the friction of the substep's contacts.
     void begin_substep(double h_s, const AccelerationField& field = {});
     void solve(int iteration, const Collider& collider = {});
     void end_substep();
-    /// Pushes element ea of `a` and element eb of `b` apart along `normal` (from b to a) by `depth_m`, split by
-    /// inverse mass; the contact counts for both ropes' friction. sa, sb: where along the elements.
+    /// Pushes element ea of `a` and element eb of `b` apart along `normal` (from b to a) by `depth_m`, split
+    /// by inverse mass; the contact counts for both ropes' friction. sa, sb: where along the elements.
     static void separate(Rope& a, std::size_t ea, double sa, Rope& b, std::size_t eb, double sb,
                          const glm::dvec3& normal, double depth_m);
     [[nodiscard]] const RopeSettings& settings() const { return s_; }
@@ -109,10 +110,10 @@ private:
     void bend(double stiffness, bool backward);
 
     RopeSettings s_;
-    std::vector<glm::dvec3> x_;     // positions
-    std::vector<glm::dvec3> prev_;  // positions one substep ago (Verlet)
-    std::vector<double> w_;         // inverse masses (0: pinned)
-    std::vector<double> rest_;      // rest length of element i (node i to i + 1)
+    std::vector<glm::dvec3> x_;        // positions
+    std::vector<glm::dvec3> prev_;     // positions one substep ago (Verlet)
+    std::vector<double> w_;            // inverse masses (0: pinned)
+    std::vector<double> rest_;         // rest length of element i (node i to i + 1)
     std::vector<glm::dvec3> contact_;  // per node: sum of the contact pushes of the substep (friction)
     std::vector<uint32_t> ids_;
     uint32_t next_id_ = 0;

@@ -9,8 +9,9 @@
 //   - determinism: two runs give byte-equal images;
 //   - issue 14, on the default run (120 frames at 1280x720, 1/30 s): every frame's largest turn between rope
 //     elements <= 20 deg, deepest rope penetration <= rope radius / 4, worst predicted piece error <= the
-//     subdivision tolerance, and close-ups within 0.5 m of a rope and of a wall cable; the same rope bounds over
-//     other bend seeds and scales; the wall cables clear the refined ribs (geometry read from the asset).
+//     subdivision tolerance, and close-ups within 0.5 m of a rope and of a wall cable; the same rope bounds
+//     over other bend seeds and scales; the wall cables clear the refined ribs (geometry read from the
+//     asset).
 // If no EGL context can be created the test fails: CI machines have Mesa.
 #include "tunnel/level.hpp"
 #include "tunnel/rope.hpp"
@@ -30,10 +31,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
 #include <cstdlib>
 #include <memory>
 #include <set>
+#include <string>
 #include <vector>
 
 namespace platform = engine::platform;
@@ -352,15 +353,16 @@ TEST(TunnelSystem, TwoRunsRenderByteEqualImages) {
     EXPECT_TRUE(images[0].rgba == images[1].rgba) << "the tunnel is not reproducible at a fixed step";
 }
 
-// Per-frame figures of a simulation-only run (the wire systems, rope simulation and the piece level choice run;
-// nothing is rasterised) at the default run's viewport.
+// Per-frame figures of a simulation-only run (the wire systems, rope simulation and the piece level choice
+// run; nothing is rasterised) at the default run's viewport.
 struct RunFigures {
     std::vector<double> turn_deg, penetration_m, error_px;
     int close_ups = 0;
     double tolerance_px = 0.0;
     double rope_radius_m = 1e30;
     int max_level_used = 0;
-    double drawn_vs_fresh_m = 0.0;  // after the run: drawn (pop-free) rope curves vs the curves of their nodes
+    double drawn_vs_fresh_m =
+        0.0;  // after the run: drawn (pop-free) rope curves vs the curves of their nodes
 };
 
 RunFigures run_figures(platform::Context& ctx, const tunnel::LevelSettings& settings, int frames) {
@@ -387,7 +389,8 @@ RunFigures run_figures(platform::Context& ctx, const tunnel::LevelSettings& sett
         out.error_px.push_back(s.piece_max_error_px);
         out.close_ups += s.camera_rope_m <= 0.5 && s.camera_cable_m <= 0.5;
         for (int l = 0; l < static_cast<int>(s.piece_levels.size()); ++l)
-            if (s.piece_levels[static_cast<std::size_t>(l)] > 0) out.max_level_used = std::max(out.max_level_used, l);
+            if (s.piece_levels[static_cast<std::size_t>(l)] > 0)
+                out.max_level_used = std::max(out.max_level_used, l);
     }
     // Reported, not asserted (the wire module's geomorph, issue 17): how far the drawn rope curves lag behind
     // the curves through their current nodes.
@@ -412,7 +415,8 @@ RunFigures run_figures(platform::Context& ctx, const tunnel::LevelSettings& sett
 void print_distribution(const char* name, std::vector<double> v) {
     std::sort(v.begin(), v.end());
     if (v.empty()) return;
-    std::printf("%s: median %.4g, p90 %.4g, max %.4g\n", name, v[v.size() / 2], v[v.size() * 9 / 10], v.back());
+    std::printf("%s: median %.4g, p90 %.4g, max %.4g\n", name, v[v.size() / 2], v[v.size() * 9 / 10],
+                v.back());
 }
 
 TEST(TunnelSystem, DefaultRunRopesSmoothAndClearPiecesWithinTolerance) {
@@ -455,8 +459,8 @@ TEST(TunnelSystem, RopeBoundsHoldOverBendSeedsAndScales) {
                     << "seed " << seed << " scale " << scale << " frame " << f;
                 if (r.turn_deg[f] > worst_turn) {
                     worst_turn = r.turn_deg[f];
-                    worst_case = "seed " + std::to_string(seed) + " scale " + std::to_string(scale) + " frame " +
-                                 std::to_string(f);
+                    worst_case = "seed " + std::to_string(seed) + " scale " + std::to_string(scale) +
+                                 " frame " + std::to_string(f);
                 }
                 worst_penetration = std::max(worst_penetration, r.penetration_m[f]);
             }
@@ -470,10 +474,11 @@ TEST(TunnelSystem, RopeBoundsHoldOverBendSeedsAndScales) {
 }
 
 // Distance in the plane from q to the triangle abc.
-double point_triangle_distance_2d(const glm::dvec2& q, const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
+double point_triangle_distance_2d(const glm::dvec2& q, const glm::dvec2& a, const glm::dvec2& b,
+                                  const glm::dvec2& c) {
     auto cross = [](const glm::dvec2& u, const glm::dvec2& v) { return u.x * v.y - u.y * v.x; };
     const double d1 = cross(b - a, q - a), d2 = cross(c - b, q - b), d3 = cross(a - c, q - c);
-    const bool neg = d1 < 0 || d2 < 0 || d3 < 0, pos = d1 > 0 || d2 > 0 || d3 > 0;
+    const bool neg = d1 < 0 || d2 < 0 || d3<0, pos = d1> 0 || d2 > 0 || d3 > 0;
     if (!(neg && pos)) return 0.0;  // inside (or on an edge)
     auto seg = [](const glm::dvec2& p, const glm::dvec2& u, const glm::dvec2& v) {
         const glm::dvec2 e = v - u;
@@ -484,10 +489,10 @@ double point_triangle_distance_2d(const glm::dvec2& q, const glm::dvec2& a, cons
 }
 
 TEST(TunnelSystem, WallCablesClearTheRibs) {
-    // The wall cables run along z at fixed (x, y) in the unbent space; the bend carries cross-sections rigidly,
-    // so a cable clears a rib if its axis is at least its radius away from the rib's triangles projected on
-    // (x, y). Ribs read from the asset and refined here (level 5, finer than the level cache), and the level's
-    // own refined ribs.
+    // The wall cables run along z at fixed (x, y) in the unbent space; the bend carries cross-sections
+    // rigidly, so a cable clears a rib if its axis is at least its radius away from the rib's triangles
+    // projected on (x, y). Ribs read from the asset and refined here (level 5, finer than the level cache),
+    // and the level's own refined ribs.
     auto ctx = make_context();
     ASSERT_TRUE(ctx);
     auto level = make_level();
