@@ -137,6 +137,7 @@ void Rope::solve(int it, const Collider& collider) {
         for (std::size_t e = 0; e + 1 < n; ++e)
             if (collider(x_[e], x_[e + 1], s_.radius_m, c) && c.depth_m > 0.0)
                 push_element(e, c.t, c.normal, c.depth_m);
+        friction();  // inside the passes too: the distance constraints must not drag a resting node along
     }
     // Bending last, on the passes with contacts: the largest turn holds at the end of them (contacts pull it
     // back next time); twice the stiffness on half the passes.
@@ -173,6 +174,13 @@ void Rope::bend(double stiffness, bool backward) {
 }
 
 void Rope::end_substep() {
+    friction();
+    // A few passes of the turn limit alone: Gauss-Seidel sweeps of neighbouring nodes undo each other, and a
+    // contact may have pressed a kink in last.
+    for (int pass = 0; pass < 4; ++pass) bend(0.0, pass % 2 == 1);
+}
+
+void Rope::friction() {
     // Coulomb friction on the substep's contacts: the motion along the contact plane is cancelled up to
     // friction times the normal push (static), reduced by it beyond (kinetic). A rope draped over a rib
     // stays.
@@ -187,9 +195,6 @@ void Rope::end_substep() {
         if (t < 1e-15) continue;
         x_[i] -= tangential * std::min(1.0, s_.friction * push / t);
     }
-    // A few passes of the turn limit alone: Gauss-Seidel sweeps of neighbouring nodes undo each other, and a
-    // contact may have pressed a kink in last.
-    for (int pass = 0; pass < 4; ++pass) bend(0.0, pass % 2 == 1);
 }
 
 void Rope::separate(Rope& a, std::size_t ea, double sa, Rope& b, std::size_t eb, double sb,

@@ -108,6 +108,7 @@ private:
     void update_masses();
     void push_element(std::size_t e, double t, const glm::dvec3& normal, double depth_m);
     void bend(double stiffness, bool backward);
+    void friction();
 
     RopeSettings s_;
     std::vector<glm::dvec3> x_;        // positions

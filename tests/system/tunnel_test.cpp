@@ -532,4 +532,49 @@ TEST(TunnelSystem, WallCablesClearTheRibs) {
     EXPECT_EQ(cables, 6);
 }
 
+TEST(TunnelSystem, RopeDrapedOverARibStaysWithFriction) {
+    // A slack rope lands on a bar (a rib seen end-on: a cylinder along z) and settles; then the world tilts
+    // (a sideways acceleration of 2 m/s^2, tan = 0.2 < friction 0.7). With friction the rope stays where it
+    // lies on the bar; without, it slides over it. The material point on the bar (the node resting on it) is
+    // tracked.
+    const glm::dvec2 bar(1.0, -0.1);
+    const double bar_radius = 0.05;
+    const tunnel::Collider collider = [&](const glm::dvec3& a, const glm::dvec3& b, double r,
+                                          tunnel::ElementContact& out) {
+        const glm::dvec2 a2(a.x, a.y), e(b.x - a.x, b.y - a.y);
+        const double t = std::clamp(glm::dot(bar - a2, e) / std::max(glm::dot(e, e), 1e-18), 0.0, 1.0);
+        const glm::dvec2 v = a2 + t * e - bar;
+        const double d = glm::length(v);
+        if (d >= bar_radius + r || d < 1e-12) return false;
+        out = {t, glm::dvec3(v / d, 0.0), bar_radius + r - d};
+        return true;
+    };
+    auto slide = [&](double friction) {
+        tunnel::Rope rope({-0.2, 0.0, 0.0}, {2.2, 0.0, 0.0}, 2.4, 25, {.friction = friction});
+        rope.set_ends({0.0, 0.0, 0.0}, {2.0, 0.0, 0.0});  // slack, still straight above the bar
+        for (int i = 0; i < 120; ++i) rope.step(1.0 / 60.0, {}, collider);
+        std::size_t k = 0;  // the node resting on the bar
+        for (std::size_t i = 0; i < rope.size(); ++i)
+            if (glm::length(glm::dvec2(rope.positions()[i]) - bar) <
+                glm::length(glm::dvec2(rope.positions()[k]) - bar))
+                k = i;
+        const glm::dvec3 before = rope.positions()[k];
+        for (int i = 0; i < 180; ++i)
+            rope.step(
+                1.0 / 60.0, [](const glm::dvec3&) { return glm::dvec3(2.0, 0.0, 0.0); }, collider);
+        const glm::dvec3 after = rope.positions()[k];
+        std::printf("friction %.2g: node %zu of %zu on the bar at %.3f %.3f\n", friction, k, rope.size(),
+                    before.x, before.y);
+        // On the bar before and after (not fallen off), and no turn above the limit.
+        EXPECT_LT(glm::length(glm::dvec2(before) - bar), bar_radius + 0.02 + 0.02);
+        for (std::size_t i = 1; i + 1 < rope.size(); ++i) EXPECT_LE(rope.turn_angle(i) * 180.0 / kPi, 20.0);
+        return glm::length(after - before);
+    };
+    const double with = slide(0.7);
+    const double without = slide(1e-9);
+    std::printf("the node on the bar slid %.4f m with friction, %.4f m without\n", with, without);
+    EXPECT_LT(with, 0.005);
+    EXPECT_GT(without, 5.0 * std::max(with, 0.002));
+}
+
 }  // namespace
