@@ -69,7 +69,7 @@ public:
         if (ImGui::SliderFloat("subdiv tolerance px", &subdiv, 0.25f, 16.0f, "%.2f",
                                ImGuiSliderFlags_Logarithmic))
             o.subdivision_tolerance_px = subdiv;
-        ImGui::SliderInt("max subdiv level", &o.max_subdivision_level, 0, 3);
+        ImGui::SliderInt("max subdiv level", &o.max_subdivision_level, 0, 4);
         ImGui::Checkbox("pieces", &o.draw_pieces);
         ImGui::SameLine();
         ImGui::Checkbox("wires", &o.draw_wires);

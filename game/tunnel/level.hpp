@@ -4,8 +4,11 @@
 // themselves, and a camera flying along the bent centre line. Everything runs as named systems of one
 // engine::ecs::Schedule (timed per system):
 //   tunnel.animate  segment angles at time t -> Chain; fly camera; wire context camera/viewport
-//   tunnel.ropes    rope ends on the bent anchors, Verlet/PBD step, node insertion/removal
-//   tunnel.cables   wall cables (bent by the CPU transform) and rope nodes -> wire entities
+//   tunnel.ropes    ropes simulated in the UNBENT tunnel space (where walkway, ribs, walls and wall cables
+//   are
+//                   simple shapes): Verlet/PBD step with bending, contacts and friction, rope-rope contacts,
+//                   node insertion/removal
+//   tunnel.cables   wall cables and rope nodes bent by the CPU transform -> wire entities; rope metrics
 //   wire.curve .. wire.draw_list   (wire::systems::install)
 //   tunnel.pieces   clear, per-piece subdivision level, bent instanced pieces (GL)
 //   wire.render     WireRenderer draws the frame's DrawList (GL)
@@ -15,10 +18,12 @@
 #include "tunnel/rope.hpp"
 
 #include <curved_space/chain.hpp>
+#include <engine/assets/mesh_data.hpp>
 #include <engine/ecs/entity.hpp>
 #include <engine/ecs/schedule.hpp>
 #include <engine/platform/expected.hpp>
 #include <engine/scene/camera.hpp>
+#include <wire/curve.hpp>
 #include <wire/draw.hpp>
 #include <wire/nodes.hpp>
 
@@ -42,7 +47,7 @@ struct LevelSettings {
     double bend_scale = 0.0;         ///< multiplies the base bend angles; 0 -> 1
     std::string asset_dir{};         ///< folder of straight_section.glb, wall_details.glb, cable_hooks.glb,
                                      ///< anchors.json; empty -> the repository's assets/tunnel
-    int max_subdivision_level = -1;  ///< highest refinement level cached; -1 -> 3
+    int max_subdivision_level = -1;  ///< highest refinement level cached; -1 -> 4
     double prewarm_s = 0.0;          ///< rope simulation before frame 0 (settles the cables); 0 -> 3 s
 };
 
@@ -61,9 +66,10 @@ struct LevelOptions {
     bool gusts = true;        ///< gusts of wind travel down the tunnel and swing the hanging cables
     bool draw_pieces = true;
     bool draw_wires = true;
-    double subdivision_tolerance_px = 1.0;
+    double subdivision_tolerance_px = 0.5;  ///< predicted geometric error of a piece on screen
     int max_subdivision_level =
-        3;  ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
+        4;                 ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
+    bool close_up = true;  ///< the fly camera glides to the right wall (unbent z 7.5..14) for close-ups
     double flight_speed_mps = 2.5;
     CameraMode camera_mode = CameraMode::fly;
 };
@@ -89,10 +95,17 @@ struct LevelFrameStats {
     std::size_t curves_built = 0;
     std::size_t rings = 0;
     /// GPU ms of the tunnel and wire passes (GL_TIME_ELAPSED, engine::gfx::GpuTimer): the newest results read
-    /// back without stalling, measured in frame gpu_ms_frame (a few frames ago; -1 and 0 ms before the first).
+    /// back without stalling, measured in frame gpu_ms_frame (a few frames ago; -1 and 0 ms before the
+    /// first).
     double pieces_gpu_ms = 0.0;
     double wires_gpu_ms = 0.0;
     int64_t gpu_ms_frame = -1;
+    double rope_max_turn_deg = 0.0;   ///< largest angle between consecutive elements of any rope (bent nodes)
+    double rope_penetration_m = 0.0;  ///< deepest penetration of a rope's tube (its rendered curve) into the
+                                      ///< walkway, ribs, walls, wall cables or another rope (0: none)
+    double piece_max_error_px = 0.0;  ///< worst predicted geometric error on screen of a visible piece
+    double camera_rope_m = 0.0;       ///< distance from the eye to the nearest rope centre line
+    double camera_cable_m = 0.0;      ///< distance from the eye to the nearest wall cable centre line
 };
 
 /// A cable of the level, for tests and the debug panel.
@@ -103,6 +116,22 @@ struct CableInfo {
     int rope = -1;         ///< index into the ropes when hanging
     uint32_t material = 0;
     float radius_m = 0.0f;
+    glm::dvec2 section_m{0.0};  ///< fixed cables: unbent cross-section position (x, y); runs along all z
+};
+
+/// The level geometry the ropes collide with, in the unbent tunnel space (z along the chain, piece k covers
+/// [4k, 4k + 4)), measured from the refined meshes at the highest cached level.
+struct LevelShapes {
+    double wall_radius_m = 0.0;       ///< the wall's inner surface (smallest distance from the axis)
+    double rib_inner_radius_m = 0.0;  ///< the ribs' inner faces
+    std::vector<glm::dvec2> rib_z_m;  ///< z range of each rib within a piece
+    glm::dvec2 walkway_min_m{0.0};    ///< walkway cross-section box (x, y), all along z
+    glm::dvec2 walkway_max_m{0.0};
+    struct Cable {
+        glm::dvec2 section_m{0.0};
+        double radius_m = 0.0;
+    };
+    std::vector<Cable> cables;  ///< the fixed wall cables
 };
 
 class Level {
@@ -131,6 +160,8 @@ public:
     [[nodiscard]] const std::vector<Rope>& ropes() const { return ropes_; }
     /// The nodes the wire systems currently hold for a cable.
     [[nodiscard]] const wire::WireNodes& cable_nodes(std::size_t cable) const;
+    /// The curve the wire systems draw for a cable (pop-free: blended while rope nodes appear or vanish).
+    [[nodiscard]] const wire::Curve& cable_curve(std::size_t cable) const;
     /// Bent world position of an anchor of piece `piece` (anchor index as in anchors.json).
     [[nodiscard]] glm::dvec3 anchor_world(int piece, std::size_t anchor) const;
     /// Unbent z (along the chain) of the fly camera in the last frame.
@@ -139,6 +170,10 @@ public:
     [[nodiscard]] double piece_length_m() const;
     /// The tunnel wall radius (m) of the pieces.
     [[nodiscard]] double wall_radius_m() const;
+    /// What the ropes collide with (unbent space).
+    [[nodiscard]] const LevelShapes& shapes() const;
+    /// The subdivision level `group` (0 wall, 1 ribs, 2 walkway, 3 hooks, 4 clips) is cached up to, refined.
+    [[nodiscard]] const engine::assets::MeshData& refined_mesh(std::size_t group) const;
 
 private:
     struct State;
@@ -146,10 +181,12 @@ private:
     void animate(double time_s);
     void update_ropes(double dt_s);
     void update_cables();
+    void choose_piece_levels();
     void draw_pieces();
+    void measure_ropes();
     void draw_wires();
     void apply_options();
-    glm::dvec3 rope_end(int piece, std::size_t anchor, double inset_m) const;
+    glm::dvec3 rope_end(int piece, std::size_t anchor, double inset_m, double lift_m) const;
 
     std::unique_ptr<State> state_;
     LevelOptions options_{};

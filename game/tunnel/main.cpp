@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -86,8 +87,19 @@ struct FreeCamera {
     }
 };
 
+double rope_radius_min(const tunnel::Level& level) {
+    double r = 1e30;
+    for (const tunnel::CableInfo& c : level.cables())
+        if (c.hanging) r = std::min(r, static_cast<double>(c.radius_m));
+    return r;
+}
+
 int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args) {
+    // First, middle and last frames, and two close-ups (the default flight passes the right wall's festoon
+    // and cables around frames 90-110).
     std::set<int> capture = {0, args.frames / 2, args.frames - 1};
+    for (int f : {95, 105})
+        if (f < args.frames) capture.insert(f);
     if (args.capture_every > 0)
         for (int f = 0; f < args.frames; f += args.capture_every) capture.insert(f);
     std::filesystem::create_directories(args.out);
@@ -97,6 +109,9 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
     int inserted = 0;
     int removed = 0;
     double frame_ms_sum = 0.0;
+    double max_turn = 0.0, max_penetration = 0.0, max_error = 0.0, rope_min = 1e30, cable_min = 1e30;
+    std::size_t max_triangles = 0;
+    std::vector<int> close_ups;  // frames with the eye within 0.5 m of a rope and of a wall cable
     for (int f = 0; f < args.frames; ++f) {
         ctx.begin_frame();
         const auto start = std::chrono::steady_clock::now();
@@ -106,6 +121,14 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
         frames.push_back(tunnel::frame_record(level.stats(), level.system_stats(), non_finite));
         inserted += level.stats().nodes_inserted;
         removed += level.stats().nodes_removed;
+        const tunnel::LevelFrameStats& st = level.stats();
+        max_turn = std::max(max_turn, st.rope_max_turn_deg);
+        max_penetration = std::max(max_penetration, st.rope_penetration_m);
+        max_error = std::max(max_error, st.piece_max_error_px);
+        max_triangles = std::max(max_triangles, st.piece_triangles);
+        rope_min = std::min(rope_min, st.camera_rope_m);
+        cable_min = std::min(cable_min, st.camera_cable_m);
+        if (st.camera_rope_m <= 0.5 && st.camera_cable_m <= 0.5) close_ups.push_back(f);
         if (capture.count(f) != 0) {
             const std::string path = frame_png(args.out, static_cast<uint64_t>(f));
             if (auto s = platform::capture_png(ctx, path); !s) {
@@ -133,6 +156,15 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
                                   {"frame_ms_mean", args.frames > 0 ? frame_ms_sum / args.frames : 0.0},
                                   {"nodes_inserted", inserted},
                                   {"nodes_removed", removed},
+                                  {"rope_max_turn_deg", max_turn},
+                                  {"rope_penetration_m", max_penetration},
+                                  {"rope_radius_min_m", rope_radius_min(level)},
+                                  {"piece_max_error_px", max_error},
+                                  {"piece_tolerance_px", level.options().subdivision_tolerance_px},
+                                  {"piece_triangles_max", max_triangles},
+                                  {"camera_rope_min_m", rope_min},
+                                  {"camera_cable_min_m", cable_min},
+                                  {"close_up_frames", close_ups},
                                   {"non_finite", non_finite},
                                   {"images", written},
                                   {"gl_renderer", ctx.gl_renderer()}}}};
@@ -148,6 +180,11 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
     for (const engine::ecs::SystemStats& st : level.system_stats())
         std::printf("  %-16s mean %7.3f ms  max %7.3f ms\n", st.name.c_str(), st.mean_ms, st.max_ms);
     std::printf("  rope nodes inserted %d, removed %d\n", inserted, removed);
+    std::printf(
+        "  rope max turn %.2f deg, max penetration %.4f m (radius %.3f m), piece max error %.3f px "
+        "(tolerance %.2f px), %zu close-up frames\n",
+        max_turn, max_penetration, rope_radius_min(level), max_error,
+        level.options().subdivision_tolerance_px, close_ups.size());
     for (const std::string& p : written) std::printf("wrote %s\n", p.c_str());
     std::printf("wrote %s\n", stats_path.c_str());
     return non_finite == 0 ? 0 : 1;

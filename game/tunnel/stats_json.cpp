@@ -19,8 +19,10 @@ nlohmann::json frame_record(const LevelFrameStats& s, std::span<const engine::ec
     return {{"frame", s.frame},
             {"time_s", finite(s.time_s)},
             {"systems_ms", systems_ms},
-            {"gpu_ms", {{"tunnel.pieces", finite(s.pieces_gpu_ms)}, {"wire.render", finite(s.wires_gpu_ms)},
-                        {"frame", s.gpu_ms_frame}}},
+            {"gpu_ms",
+             {{"tunnel.pieces", finite(s.pieces_gpu_ms)},
+              {"wire.render", finite(s.wires_gpu_ms)},
+              {"frame", s.gpu_ms_frame}}},
             {"wires", s.wires},
             {"wires_drawn", s.wires_drawn},
             {"wire_vertices", s.wire_vertices},
@@ -37,7 +39,12 @@ nlohmann::json frame_record(const LevelFrameStats& s, std::span<const engine::ec
             {"nodes_removed", s.nodes_removed},
             {"curves_built", s.curves_built},
             {"rings", s.rings},
-            {"piece_levels", levels}};
+            {"piece_levels", levels},
+            {"rope_max_turn_deg", finite(s.rope_max_turn_deg)},
+            {"rope_penetration_m", finite(s.rope_penetration_m)},
+            {"piece_max_error_px", finite(s.piece_max_error_px)},
+            {"camera_rope_m", finite(s.camera_rope_m)},
+            {"camera_cable_m", finite(s.camera_cable_m)}};
 }
 
 bool all_finite(const nlohmann::json& doc) {

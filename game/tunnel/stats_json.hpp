@@ -6,9 +6,14 @@
 //                "wires": 43, "wires_drawn": 38, "wire_vertices": 51234, "wire_triangles": ...,
 //                "piece_triangles": ..., "piece_vertices": ..., "bytes_uploaded": ..., "wire_bytes_uploaded":
 //                ..., "segment_bytes_uploaded": ..., "rope_nodes": ..., "nodes_inserted": 1, "nodes_removed":
-//                0, "curves_built": ..., "rings": ..., "piece_levels": [0, 3, 2, 1, 0, 0, 0, 0]}, ...],
+//                0, "curves_built": ..., "rings": ..., "piece_levels": [0, 3, 2, 1, 0, 0, 0, 0],
+//                "rope_max_turn_deg": 12.1, "rope_penetration_m": 0.001, "piece_max_error_px": 0.41,
+//                "camera_rope_m": 1.3, "camera_cable_m": 2.0}, ...],
 //    "summary": {"frames": 120, "width": 1280, "height": 720, "dt_s": 0.0333, "systems_mean_ms": {...},
 //                "systems_max_ms": {...}, "frame_ms_mean": ..., "nodes_inserted": ..., "nodes_removed": ...,
+//                "rope_max_turn_deg": (max over frames), "rope_penetration_m": (max), "rope_radius_min_m": ...,
+//                "piece_max_error_px": (max), "piece_tolerance_px": 0.5, "piece_triangles_max": ...,
+//                "camera_rope_min_m": ..., "camera_cable_min_m": ..., "close_up_frames": [...],
 //                "gl_renderer": "llvmpipe ..."}}
 // Every number is finite (a non-finite value is written as -1 and counted in "non_finite").
 #pragma once

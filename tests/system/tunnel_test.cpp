@@ -6,12 +6,19 @@
 //     covers pixels that change when the wires are switched off;
 //   - stats: every per-frame record is finite and counts are plausible;
 //   - ropes: the hanging cables insert and remove nodes (new stable ids, placed on the current curve);
-//   - determinism: two runs give byte-equal images.
+//   - determinism: two runs give byte-equal images;
+//   - issue 14, on the default run (120 frames at 1280x720, 1/30 s): every frame's largest turn between rope
+//     elements <= 20 deg, deepest rope penetration <= rope radius / 4, worst predicted piece error <= the
+//     subdivision tolerance, and close-ups within 0.5 m of a rope and of a wall cable; the same rope bounds
+//     over other bend seeds and scales; the wall cables clear the refined ribs (geometry read from the
+//     asset).
 // If no EGL context can be created the test fails: CI machines have Mesa.
 #include "tunnel/level.hpp"
 #include "tunnel/rope.hpp"
 #include "tunnel/stats_json.hpp"
 
+#include <engine/assets/gltf.hpp>
+#include <engine/assets/subdivide.hpp>
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
 #include <wire/curve.hpp>
@@ -23,9 +30,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <set>
+#include <string>
 #include <vector>
 
 namespace platform = engine::platform;
@@ -91,11 +100,10 @@ int block_difference(const platform::Image& a, const platform::Image& b, int x, 
     return best;
 }
 
-// Dense samples of the curve the wire systems build through `nodes` (same default spline settings).
-std::vector<glm::dvec3> rendered_curve(const wire::WireNodes& nodes) {
-    wire::Curve curve;
+// Dense samples of the curve the wire systems draw (while a rope node blends in, it differs from the curve
+// through the current nodes by up to a few centimetres).
+std::vector<glm::dvec3> rendered_curve(const wire::Curve& curve) {
     std::vector<glm::dvec3> out;
-    if (!wire::build_curve(nodes, wire::SplineSettings{}, curve).ok) return out;
     for (const wire::CubicBezier& segment : curve.segments)
         for (int i = 0; i < 16; ++i) out.push_back(wire::position(segment, i / 16.0));
     return out;
@@ -181,7 +189,7 @@ TEST(TunnelSystem, WallsAndCablesWhereExpected) {
     auto coverage = [&](std::size_t cable, int& samples) {
         int covered = 0;
         samples = 0;
-        for (const glm::dvec3& p : rendered_curve(level->cable_nodes(cable))) {
+        for (const glm::dvec3& p : rendered_curve(level->cable_curve(cable))) {
             const Pixel px = project(camera, p, 6);
             if (!px.ok || px.depth_m > 14.0) continue;
             ++samples;
@@ -343,6 +351,230 @@ TEST(TunnelSystem, TwoRunsRenderByteEqualImages) {
     ASSERT_EQ(images.size(), 2u);
     ASSERT_EQ(images[0].rgba.size(), images[1].rgba.size());
     EXPECT_TRUE(images[0].rgba == images[1].rgba) << "the tunnel is not reproducible at a fixed step";
+}
+
+// Per-frame figures of a simulation-only run (the wire systems, rope simulation and the piece level choice
+// run; nothing is rasterised) at the default run's viewport.
+struct RunFigures {
+    std::vector<double> turn_deg, penetration_m, error_px;
+    int close_ups = 0;
+    double tolerance_px = 0.0;
+    double rope_radius_m = 1e30;
+    int max_level_used = 0;
+    double drawn_vs_fresh_m =
+        0.0;  // after the run: drawn (pop-free) rope curves vs the curves of their nodes
+};
+
+RunFigures run_figures(platform::Context& ctx, const tunnel::LevelSettings& settings, int frames) {
+    RunFigures out;
+    auto created = tunnel::Level::create(settings);
+    if (!created) {
+        ADD_FAILURE() << "Level::create: " << created.error().message;
+        return out;
+    }
+    tunnel::Level& level = *created.value();
+    level.set_viewport(1280, 720);
+    level.options().draw_pieces = false;
+    level.options().draw_wires = false;
+    out.tolerance_px = level.options().subdivision_tolerance_px;
+    for (const tunnel::CableInfo& c : level.cables())
+        if (c.hanging) out.rope_radius_m = std::min(out.rope_radius_m, static_cast<double>(c.radius_m));
+    for (int f = 0; f < frames; ++f) {
+        ctx.begin_frame();
+        level.frame(kDt);
+        ctx.end_frame();
+        const tunnel::LevelFrameStats& s = level.stats();
+        out.turn_deg.push_back(s.rope_max_turn_deg);
+        out.penetration_m.push_back(s.rope_penetration_m);
+        out.error_px.push_back(s.piece_max_error_px);
+        out.close_ups += s.camera_rope_m <= 0.5 && s.camera_cable_m <= 0.5;
+        for (int l = 0; l < static_cast<int>(s.piece_levels.size()); ++l)
+            if (s.piece_levels[static_cast<std::size_t>(l)] > 0)
+                out.max_level_used = std::max(out.max_level_used, l);
+    }
+    // Reported, not asserted (the wire module's geomorph, issue 17): how far the drawn rope curves lag behind
+    // the curves through their current nodes.
+    for (std::size_t c = 0; c < level.cables().size(); ++c) {
+        if (!level.cables()[c].hanging) continue;
+        wire::Curve fresh;
+        if (!wire::build_curve(level.cable_nodes(c), wire::SplineSettings{}, fresh).ok) continue;
+        std::vector<glm::dvec3> q;
+        for (const wire::CubicBezier& seg : fresh.segments)
+            for (int i = 0; i < 32; ++i) q.push_back(wire::position(seg, i / 32.0));
+        for (const wire::CubicBezier& seg : level.cable_curve(c).segments)
+            for (int i = 0; i < 8; ++i) {
+                const glm::dvec3 p = wire::position(seg, i / 8.0);
+                double best = 1e30;
+                for (const glm::dvec3& x : q) best = std::min(best, glm::length(x - p));
+                out.drawn_vs_fresh_m = std::max(out.drawn_vs_fresh_m, best);
+            }
+    }
+    return out;
+}
+
+void print_distribution(const char* name, std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    if (v.empty()) return;
+    std::printf("%s: median %.4g, p90 %.4g, max %.4g\n", name, v[v.size() / 2], v[v.size() * 9 / 10],
+                v.back());
+}
+
+TEST(TunnelSystem, DefaultRunRopesSmoothAndClearPiecesWithinTolerance) {
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    const RunFigures r = run_figures(*ctx, {}, 120);  // the default `tunnel --headless` run
+    ASSERT_EQ(r.turn_deg.size(), 120u);
+    EXPECT_DOUBLE_EQ(r.tolerance_px, 0.5);
+    for (std::size_t f = 0; f < r.turn_deg.size(); ++f) {
+        EXPECT_LE(r.turn_deg[f], 20.0) << "frame " << f;
+        EXPECT_LE(r.penetration_m[f], r.rope_radius_m / 4.0) << "frame " << f;
+        EXPECT_LE(r.error_px[f], r.tolerance_px) << "frame " << f;
+    }
+    print_distribution("rope_max_turn_deg", r.turn_deg);
+    print_distribution("rope_penetration_m", r.penetration_m);
+    print_distribution("piece_max_error_px", r.error_px);
+    std::printf("after the run, drawn rope curves vs the curves of their nodes: %.4f m (geomorph lag)\n",
+                r.drawn_vs_fresh_m);
+    // The figures are alive: ropes rest on something (a contact is measured), the close-up needs the lifted
+    // cap, and the flight has its close-ups.
+    EXPECT_GT(*std::max_element(r.penetration_m.begin(), r.penetration_m.end()), 0.0);
+    EXPECT_EQ(r.max_level_used, 4) << "no piece needed the lifted cap";
+    EXPECT_GE(r.close_ups, 10) << "frames within 0.5 m of a rope and of a wall cable";
+}
+
+TEST(TunnelSystem, RopeBoundsHoldOverBendSeedsAndScales) {
+    // A family: other bend animations (seeds) and stronger bends (the rope's gravity tilts and the contact
+    // metric stretches with the bend); 60 frames: the first gust swings the ropes of the first pieces.
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    std::vector<double> turns, penetrations;
+    double worst_turn = 0.0, worst_penetration = 0.0;
+    std::string worst_case;
+    for (uint32_t seed : {2u, 3u})
+        for (double scale : {1.0, 1.6}) {
+            const RunFigures r = run_figures(*ctx, {.seed = seed, .bend_scale = scale}, 60);
+            for (std::size_t f = 0; f < r.turn_deg.size(); ++f) {
+                EXPECT_LE(r.turn_deg[f], 20.0) << "seed " << seed << " scale " << scale << " frame " << f;
+                EXPECT_LE(r.penetration_m[f], r.rope_radius_m / 4.0)
+                    << "seed " << seed << " scale " << scale << " frame " << f;
+                if (r.turn_deg[f] > worst_turn) {
+                    worst_turn = r.turn_deg[f];
+                    worst_case = "seed " + std::to_string(seed) + " scale " + std::to_string(scale) +
+                                 " frame " + std::to_string(f);
+                }
+                worst_penetration = std::max(worst_penetration, r.penetration_m[f]);
+            }
+            turns.insert(turns.end(), r.turn_deg.begin(), r.turn_deg.end());
+            penetrations.insert(penetrations.end(), r.penetration_m.begin(), r.penetration_m.end());
+        }
+    print_distribution("family rope_max_turn_deg", turns);
+    print_distribution("family rope_penetration_m", penetrations);
+    std::printf("worst turn %.2f deg at %s; worst penetration %.4f m\n", worst_turn, worst_case.c_str(),
+                worst_penetration);
+}
+
+// Distance in the plane from q to the triangle abc.
+double point_triangle_distance_2d(const glm::dvec2& q, const glm::dvec2& a, const glm::dvec2& b,
+                                  const glm::dvec2& c) {
+    auto cross = [](const glm::dvec2& u, const glm::dvec2& v) { return u.x * v.y - u.y * v.x; };
+    const double d1 = cross(b - a, q - a), d2 = cross(c - b, q - b), d3 = cross(a - c, q - c);
+    const bool neg = d1 < 0 || d2 < 0 || d3<0, pos = d1> 0 || d2 > 0 || d3 > 0;
+    if (!(neg && pos)) return 0.0;  // inside (or on an edge)
+    auto seg = [](const glm::dvec2& p, const glm::dvec2& u, const glm::dvec2& v) {
+        const glm::dvec2 e = v - u;
+        const double t = std::clamp(glm::dot(p - u, e) / std::max(glm::dot(e, e), 1e-300), 0.0, 1.0);
+        return glm::length(p - (u + t * e));
+    };
+    return std::min({seg(q, a, b), seg(q, b, c), seg(q, c, a)});
+}
+
+TEST(TunnelSystem, WallCablesClearTheRibs) {
+    // The wall cables run along z at fixed (x, y) in the unbent space; the bend carries cross-sections
+    // rigidly, so a cable clears a rib if its axis is at least its radius away from the rib's triangles
+    // projected on (x, y). Ribs read from the asset and refined here (level 5, finer than the level cache),
+    // and the level's own refined ribs.
+    auto ctx = make_context();
+    ASSERT_TRUE(ctx);
+    auto level = make_level();
+    ASSERT_TRUE(level);
+    std::vector<engine::assets::MeshData> meshes;
+    const std::string path = std::string(WIRE_ASSET_DIR) + "/tunnel/wall_details.glb";
+    ASSERT_TRUE(engine::assets::read_gltf(path, meshes).ok()) << path;
+    std::vector<engine::assets::MeshData> ribs;
+    for (const engine::assets::MeshData& m : meshes) {
+        if (m.name.rfind("rib_", 0) != 0) continue;
+        engine::assets::MeshData refined;
+        ASSERT_TRUE(engine::assets::subdivide(m, 5, refined).ok()) << m.name;
+        ribs.push_back(std::move(refined));
+    }
+    ASSERT_EQ(ribs.size(), 4u);
+    ribs.push_back(level->refined_mesh(1));
+    int cables = 0;
+    for (const tunnel::CableInfo& c : level->cables()) {
+        if (c.hanging) continue;
+        ++cables;
+        double nearest = 1e30;
+        for (const engine::assets::MeshData& m : ribs)
+            for (std::size_t i = 0; i + 2 < m.indices.size(); i += 3) {
+                glm::dvec2 p[3];
+                for (int k = 0; k < 3; ++k) {
+                    const std::size_t v = m.indices[i + static_cast<std::size_t>(k)];
+                    p[k] = glm::dvec2(m.origin.x + m.positions[3 * v], m.origin.y + m.positions[3 * v + 1]);
+                }
+                nearest = std::min(nearest, point_triangle_distance_2d(c.section_m, p[0], p[1], p[2]));
+            }
+        std::printf("wall cable at (%.3f, %.3f) radius %.3f: %.4f m from the nearest rib\n", c.section_m.x,
+                    c.section_m.y, c.radius_m, nearest);
+        EXPECT_GE(nearest, c.radius_m + 0.005) << "wall cable at " << c.section_m.x << ", " << c.section_m.y;
+        // ... and on its clips: within 2 cm of the ribs' inner faces.
+        EXPECT_LE(nearest, c.radius_m + 0.02);
+    }
+    EXPECT_EQ(cables, 6);
+}
+
+TEST(TunnelSystem, RopeDrapedOverARibStaysWithFriction) {
+    // A slack rope lands on a bar (a rib seen end-on: a cylinder along z) and settles; then the world tilts
+    // (a sideways acceleration of 2 m/s^2, tan = 0.2 < friction 0.7). With friction the rope stays where it
+    // lies on the bar; without, it slides over it. The material point on the bar (the node resting on it) is
+    // tracked.
+    const glm::dvec2 bar(1.0, -0.1);
+    const double bar_radius = 0.05;
+    const tunnel::Collider collider = [&](const glm::dvec3& a, const glm::dvec3& b, double r,
+                                          tunnel::ElementContact& out) {
+        const glm::dvec2 a2(a.x, a.y), e(b.x - a.x, b.y - a.y);
+        const double t = std::clamp(glm::dot(bar - a2, e) / std::max(glm::dot(e, e), 1e-18), 0.0, 1.0);
+        const glm::dvec2 v = a2 + t * e - bar;
+        const double d = glm::length(v);
+        if (d >= bar_radius + r || d < 1e-12) return false;
+        out = {t, glm::dvec3(v / d, 0.0), bar_radius + r - d};
+        return true;
+    };
+    auto slide = [&](double friction) {
+        tunnel::Rope rope({-0.2, 0.0, 0.0}, {2.2, 0.0, 0.0}, 2.4, 25, {.friction = friction});
+        rope.set_ends({0.0, 0.0, 0.0}, {2.0, 0.0, 0.0});  // slack, still straight above the bar
+        for (int i = 0; i < 120; ++i) rope.step(1.0 / 60.0, {}, collider);
+        std::size_t k = 0;  // the node resting on the bar
+        for (std::size_t i = 0; i < rope.size(); ++i)
+            if (glm::length(glm::dvec2(rope.positions()[i]) - bar) <
+                glm::length(glm::dvec2(rope.positions()[k]) - bar))
+                k = i;
+        const glm::dvec3 before = rope.positions()[k];
+        for (int i = 0; i < 180; ++i)
+            rope.step(
+                1.0 / 60.0, [](const glm::dvec3&) { return glm::dvec3(2.0, 0.0, 0.0); }, collider);
+        const glm::dvec3 after = rope.positions()[k];
+        std::printf("friction %.2g: node %zu of %zu on the bar at %.3f %.3f\n", friction, k, rope.size(),
+                    before.x, before.y);
+        // On the bar before and after (not fallen off), and no turn above the limit.
+        EXPECT_LT(glm::length(glm::dvec2(before) - bar), bar_radius + 0.02 + 0.02);
+        for (std::size_t i = 1; i + 1 < rope.size(); ++i) EXPECT_LE(rope.turn_angle(i) * 180.0 / kPi, 20.0);
+        return glm::length(after - before);
+    };
+    const double with = slide(0.7);
+    const double without = slide(1e-9);
+    std::printf("the node on the bar slid %.4f m with friction, %.4f m without\n", with, without);
+    EXPECT_LT(with, 0.005);
+    EXPECT_GT(without, 5.0 * std::max(with, 0.002));
 }
 
 }  // namespace
