@@ -90,6 +90,48 @@ struct MeshJob {
 
 bool caps_of(const Style& style) { return style.caps && !style.closed; }
 
+/// What a wire keeps of build_rings' output (see WireRings): the float records (swapped, so no copy and no
+/// allocation once both buffers are large enough), ring 0's frame, scalars.
+void keep_rings(RingSet& built, WireRings& r) {
+    RingSet& k = r.rings;
+    std::swap(k.rings, built.rings);
+    k.origin_m = built.origin_m;
+    k.length_m = built.length_m;
+    k.fold_count = built.fold_count;
+    k.first_fold_ring = built.first_fold_ring;
+    k.frame_stats = built.frame_stats;
+    k.closed = built.closed;
+    if (built.frames.empty()) {
+        k.frames.clear();
+    } else {
+        k.frames.assign(1, built.frames.front());
+    }
+    r.u_close = built.closed && !built.u.empty() ? static_cast<float>(built.u.back()) : 0.0f;
+}
+
+void release_rings(WireRings& r) {
+    r.params = {};
+    r.rings.rings = {};  // ring 0's frame stays: it seeds the next build's first normal
+}
+
+template <class T>
+std::size_t bytes_of(const std::vector<T>& v) { return v.capacity() * sizeof(T); }
+
+std::size_t bytes_of(const Curve& c) {
+    return bytes_of(c.segments) + bytes_of(c.source_node) + bytes_of(c.radius_m) + bytes_of(c.stretch);
+}
+
+std::size_t bytes_of(const WireNodes& n) {
+    return bytes_of(n.positions) + bytes_of(n.ids) + bytes_of(n.stretch) + bytes_of(n.radius_m) +
+           bytes_of(n.theta_rad) + bytes_of(n.iz_m4) + bytes_of(n.length_m) + bytes_of(n.delta_length_m) +
+           bytes_of(n.area_m2) + bytes_of(n.kb_tension) + bytes_of(n.kb_bias) + bytes_of(n.kb_continuity);
+}
+
+std::size_t bytes_of(const RingSet& r) {
+    return bytes_of(r.params) + bytes_of(r.rings) + bytes_of(r.frames) + bytes_of(r.centre_m) +
+           bytes_of(r.arc_length_m) + bytes_of(r.u) + bytes_of(r.tangent_scratch);
+}
+
 }  // namespace
 
 void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
@@ -129,17 +171,24 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         const WireNodes& prev = c.previous_nodes;
         const bool same_ids = c.generation > 0 && !c.blending && nodes.ids == prev.ids &&
                               (!nodes.ids.empty() || nodes.size() == prev.size());
+        // build_curve's output: one buffer per thread (swapped with the wire's curve), not one per wire.
+        thread_local Curve scratch;
         if (!pop_free || same_ids) {
             // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
-            job.status = build_curve(nodes, spline, c.scratch);
+            job.status = build_curve(nodes, spline, scratch);
             if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
-            if (job.status.ok) std::swap(c.curve, c.scratch);
-            c.multires_stale = true;
+            if (job.status.ok) std::swap(c.curve, scratch);
+            if (!c.multires_stale) {
+                // Re-priming rebuilds the pop-free state from previous_nodes: release it until then.
+                c.multires = MultiresCurve(
+                    MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
+                c.multires_stale = true;
+            }
         } else {
             if (c.multires_stale) {
                 // Re-prime the pop-free state with the last valid nodes (what is on screen now), then step.
                 c.multires.reset();
-                (void)c.multires.update(prev, c.scratch);
+                (void)c.multires.update(prev, scratch);
                 c.multires_stale = false;
             }
             job.status = c.multires.update(nodes, c.curve);
@@ -234,8 +283,13 @@ void rings_system(Registry& registry, WireContext& ctx) {
         const Entity e = storage.at(i);
         const WireCurve* curve = registry.try_get<WireCurve>(e);
         const WireLodState* lod = registry.try_get<WireLodState>(e);
-        if (curve == nullptr || lod == nullptr || !lod->lod.visible) continue;
+        if (curve == nullptr || lod == nullptr) continue;
         WireRings& rings = storage.at_position(i);
+        if (!lod->lod.visible) {
+            // Culled, and its curve changed since the rings were built: the next visible frame rebuilds them.
+            if (rings.seen_curve != curve->generation && rings.rings.rings.capacity() != 0) release_rings(rings);
+            continue;
+        }
         // Counts computed for an older curve (cannot happen in install() order, but a caller may skip lod).
         if (lod->seen_curve != curve->generation) continue;
         if (rings.seen_curve == curve->generation && rings.seen_lod == lod->generation && rings.generation != 0) continue;
@@ -251,7 +305,9 @@ void rings_system(Registry& registry, WireContext& ctx) {
             settings.frames.has_previous_normal = true;
             settings.frames.previous_normal = r.rings.frames.front().r;
         }
-        build_rings(job.curve->curve, r.params, settings, r.rings);
+        thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
+        build_rings(job.curve->curve, r.params, settings, scratch);
+        keep_rings(scratch, r);
         ++r.generation;
         r.seen_curve = job.curve->generation;
         r.seen_lod = job.lod->generation;
@@ -268,8 +324,19 @@ void mesh_system(Registry& registry, WireContext& ctx) {
         const WireRings* rings = registry.try_get<WireRings>(e);
         const WireLodState* lod = registry.try_get<WireLodState>(e);
         const Style* style = registry.try_get<Style>(e);
-        if (rings == nullptr || lod == nullptr || style == nullptr || !lod->lod.visible || rings->generation == 0) continue;
+        if (rings == nullptr || lod == nullptr || style == nullptr) continue;
         WireMesh& mesh = storage.at_position(i);
+        if (!lod->lod.visible) {
+            // Culled with rings older than its curve (or released): the next visible frame rebuilds the mesh.
+            const WireCurve* curve = registry.try_get<WireCurve>(e);
+            if (curve != nullptr && rings->seen_curve != curve->generation && mesh.mesh.vertices.capacity() != 0) {
+                mesh.mesh.vertices = {};
+                mesh.mesh.indices = {};
+                mesh.seen_rings = 0;
+            }
+            continue;
+        }
+        if (rings->generation == 0) continue;
         if (mesh.seen_rings == rings->generation && mesh.sides == lod->lod.sides && mesh.caps == caps_of(*style)) continue;
         jobs.push_back(MeshJob{rings, lod, style, &mesh});
     }
@@ -278,7 +345,13 @@ void mesh_system(Registry& registry, WireContext& ctx) {
         WireMesh& m = *job.mesh;
         m.sides = job.lod->lod.sides;
         m.caps = caps_of(*job.style);
-        build_tube(job.rings->rings, TubeSettings{.sides = m.sides, .caps = m.caps}, m.mesh);
+        const RingSet& rs = job.rings->rings;
+        const TubeSettings ts{.sides = m.sides, .caps = m.caps};
+        const TubeCounts counts = tube_counts(rs.rings.size(), rs.closed, ts);
+        m.mesh.origin_m = rs.origin_m;
+        m.mesh.vertices.resize(counts.vertices);
+        m.mesh.indices.resize(counts.indices);
+        write_tube(rs.rings, rs.closed, job.rings->u_close, ts, m.mesh.vertices, m.mesh.indices);
         ++m.generation;
         m.seen_rings = job.rings->generation;
     });
@@ -321,7 +394,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         item.sides = std::max<uint32_t>(lod->lod.sides, 3);
         item.closed = rs.closed;
         item.caps = caps_of(*style);
-        item.u_close = rs.closed && !rs.u.empty() ? static_cast<float>(rs.u.back()) : 0.0f;
+        item.u_close = rings->u_close;
         if (ctx.path == UploadPath::cpu_mesh) {
             const WireMesh* mesh = registry.try_get<WireMesh>(e);
             if (mesh == nullptr || mesh->seen_rings != rings->generation) continue;
@@ -350,6 +423,44 @@ void install(engine::ecs::Schedule& schedule, WireContext& context) {
     schedule.add(kRingsSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { rings_system(r, *ctx); });
     schedule.add(kMeshSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { mesh_system(r, *ctx); });
     schedule.add(kDrawListSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { draw_list_system(r, *ctx); });
+}
+
+WireMemory wire_memory(Registry& registry) {
+    WireMemory m;
+    auto& curves = registry.storage<WireCurve>();
+    for (std::size_t i = 0; i < curves.size(); ++i) {
+        const Entity e = curves.at(i);
+        const WireCurve& c = curves.at_position(i);
+        std::size_t curve = sizeof(WireCurve) + bytes_of(c.curve) + bytes_of(c.previous_nodes);
+        if (!c.multires_stale) {  // live pop-free state: target and rendered curves, one id per node of each
+            const Curve& t = c.multires.target();
+            curve += 2 * (bytes_of(t) + t.node_count() * sizeof(uint32_t));
+        }
+        std::size_t lod = 0, rings = 0, mesh = 0;
+        bool visible = false;
+        if (const WireLodState* l = registry.try_get<WireLodState>(e)) {
+            lod = sizeof(WireLodState) + bytes_of(l->lod.counts) + bytes_of(l->lod.required);
+            visible = l->lod.visible;
+        }
+        if (const WireRings* r = registry.try_get<WireRings>(e)) rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
+        if (const WireMesh* w = registry.try_get<WireMesh>(e)) {
+            mesh = sizeof(WireMesh) + bytes_of(w->mesh.vertices) + bytes_of(w->mesh.indices);
+        }
+        if (const Nodes* n = registry.try_get<Nodes>(e)) m.nodes_bytes += bytes_of(static_cast<const WireNodes&>(*n));
+        m.curve_bytes += curve;
+        m.lod_bytes += lod;
+        m.rings_bytes += rings;
+        m.mesh_bytes += mesh;
+        const std::size_t total = curve + lod + rings + mesh;
+        if (visible) {
+            ++m.visible_wires;
+            m.visible_bytes += total;
+        } else {
+            ++m.culled_wires;
+            m.culled_bytes += total;
+        }
+    }
+    return m;
 }
 
 ScreenError wire_screen_error(Registry& registry, const WireContext& ctx, Entity wire, int samples_per_segment) {

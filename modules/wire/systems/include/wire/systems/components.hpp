@@ -48,10 +48,10 @@ struct WireCurve {
     float blend_s = 0.0f;              ///< Style::blend_s the multires state was made with
     // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
     // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
-    // `previous_nodes` (the last valid state) when the ids change.
+    // `previous_nodes` (the last valid state) when the ids change. While stale the multires state is released
+    // (re-priming rebuilds it from previous_nodes anyway); build_curve's output buffer is per thread, not per wire.
     WireNodes previous_nodes;     ///< the last valid nodes (re-primes `multires` when ids change)
-    Curve scratch;                ///< reused storage of the fast path
-    bool multires_stale = false;  ///< `multires` lags behind `curve` (the fast path ran)
+    bool multires_stale = false;  ///< `multires` lags behind `curve` (the fast path ran); released while it does
 };
 
 /// LOD stage: visibility, per-segment ring counts and sides for the context's camera.
@@ -64,9 +64,16 @@ struct WireLodState {
 };
 
 /// Ring stage: ring records along the wire (the gpu_rings path uploads these).
+/// Kept per wire: `params` and the float records `rings.rings`, plus rings.origin_m, rings.closed, rings.length_m,
+/// fold counts and frame stats, and ring 0's frame (`rings.frames` has one entry: carried over to the next state).
+/// The double per-ring arrays build_rings produces (frames, centres, arc length, u, tangents, its params copy)
+/// are per-thread scratch, not kept: every rebuild recomputes them. `u_close` is the closed loop's u at the join.
+/// A culled wire whose curve changed since its rings were built releases rings and params (the next visible
+/// frame rebuilds them anyway); a culled wire that did not change keeps them (the retained GPU path reuses them).
 struct WireRings {
     std::vector<RingParam> params;     ///< where the rings sit on the curve (segment, t)
-    RingSet rings;                     ///< ring centres, frames, radii and u
+    RingSet rings;                     ///< float ring records, ring 0's frame and the scalars (see above)
+    float u_close = 0.0f;              ///< closed wires: texture u where the loop closes (0 for open wires)
     uint64_t generation = 0;           ///< +1 each time the rings are rebuilt
     uint64_t seen_curve = 0;           ///< WireCurve::generation the rings were built from
     uint64_t seen_lod = 0;             ///< WireLodState::generation the rings were built from

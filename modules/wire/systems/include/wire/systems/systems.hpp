@@ -22,6 +22,7 @@
 #include <engine/ecs/registry.hpp>
 #include <engine/ecs/schedule.hpp>
 
+#include <cstddef>
 #include <cstdint>
 
 namespace wire::systems {
@@ -62,5 +63,17 @@ void draw_list_system(engine::ecs::Registry& registry, WireContext& context);
 /// The largest wire_screen_error over the visible wires of the last draw list.
 [[nodiscard]] ScreenError scene_screen_error(engine::ecs::Registry& registry, const WireContext& context,
                                              int samples_per_segment = 64);
+
+/// Heap memory the wire systems hold for their own per-wire state (capacity of the containers in WireCurve,
+/// WireLodState, WireRings, WireMesh, summed), split by the wire's last LOD visibility; Nodes (the game's input)
+/// is reported apart. The multires state's private buffers are estimated from its target curve (target and
+/// rendered curve, one id per node) while it is live; a released (stale) state holds nothing.
+struct WireMemory {
+    std::size_t visible_wires = 0, culled_wires = 0;
+    std::size_t visible_bytes = 0, culled_bytes = 0;  ///< systems' state of the visible / culled wires
+    std::size_t curve_bytes = 0, lod_bytes = 0, rings_bytes = 0, mesh_bytes = 0;  ///< all wires, per stage
+    std::size_t nodes_bytes = 0;                      ///< Nodes components (game-owned input), all wires
+};
+[[nodiscard]] WireMemory wire_memory(engine::ecs::Registry& registry);
 
 }  // namespace wire::systems
