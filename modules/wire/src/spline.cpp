@@ -29,6 +29,10 @@ std::string node_prefix(std::size_t i) { return "node " + std::to_string(i) + ":
 // lengths must stay finite; 1e12 m is far beyond any scene (DESIGN §5 asks for 1e6 m from the origin).
 constexpr double kMaxCoordinate_m = 1e12;
 
+// The log-domain knot ratio's clamp, exp(-+300), for the pow-free alphas.
+const double kMinKnotRatio = std::exp(-300.0);
+const double kMaxKnotRatio = std::exp(300.0);
+
 double smoothstep(double e0, double e1, double x) {
     const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);
@@ -392,15 +396,21 @@ double curvature_tension(double theta_rad, double iz_m4, double length_m, double
     return 1.0 - std::tanh(R / 50.0);
 }
 
+// Empties `c` keeping its capacity: a Curve reused across frames does not allocate.
+void clear_curve(Curve& c) {
+    c.segments.clear(), c.source_node.clear(), c.radius_m.clear(), c.stretch.clear();
+    c.closed = false;
+}
+
 Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
-    out = Curve{};
+    clear_curve(out);
     if (Status st = check_settings(settings); !st) return st;
     if (Status st = check_sizes(nodes); !st) return st;
     const bool physics = settings.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
                          !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
     if (Status st = check_nodes(nodes, physics); !st) return st;
 
-    Merged m;
+    thread_local Merged m;  // working memory, reused: no allocation per call once it is large enough
     merge_nodes(nodes, settings, m);
     const std::size_t n = m.p.size();
     const bool closed = settings.closed;
@@ -414,18 +424,19 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     }
     const std::size_t segs = closed ? n : n - 1;
 
-    Chords ch;
+    thread_local Chords ch;
     ch.d.resize(segs), ch.len.resize(segs);
     for (std::size_t k = 0; k < segs; ++k) {
         ch.d[k] = m.p[(k + 1) % n] - m.p[k];  // differences of nearby doubles: exact, whatever the offset
         ch.len[k] = glm::length(ch.d[k]);
     }
-    std::vector<float> seg_stretch(segs, 1.0f);
+    std::vector<float>& seg_stretch = out.stretch;  // built in place
+    seg_stretch.assign(segs, 1.0f);
     if (!nodes.stretch.empty()) {
         for (std::size_t k = 0; k < segs; ++k) seg_stretch[k] = nodes.stretch[m.last[k]];
     }
 
-    Tangents tg;
+    thread_local Tangents tg;
     tg.t0.resize(segs), tg.t1.resize(segs);
     const SplineKind kind = settings.kind;
     if (kind == SplineKind::linear) {
@@ -474,8 +485,17 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
             const double keep = 1.0 - t;
 
             // Only the knot ratio matters; computed in the log domain so extreme alpha or spacing cannot give 0/0.
-            const double lr = alpha == 0.0 ? 0.0 : std::clamp(alpha * (std::log(lout) - std::log(lin)), -300.0, 300.0);
-            const double rho = std::exp(lr);
+            // alpha 1 and 0.5 (chordal, centripetal): the ratio itself and its square root, no log/exp; the
+            // same clamp as the log domain's (both lengths are > 0 and finite, so the ratio is never 0/0).
+            double rho;
+            if (alpha == 1.0 || alpha == 0.5) {
+                rho = lout / lin;
+                if (alpha == 0.5) rho = std::sqrt(rho);
+                rho = std::clamp(rho, kMinKnotRatio, kMaxKnotRatio);
+            } else {
+                const double lr = alpha == 0.0 ? 0.0 : std::clamp(alpha * (std::log(lout) - std::log(lin)), -300.0, 300.0);
+                rho = std::exp(lr);
+            }
             const double w = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);  // w + iw = 1
             const dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
             const dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
@@ -503,7 +523,7 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         const bool finite = in_range(bz.b1) && in_range(bz.b2);  // false for NaN too
         if (!finite) {
             const uint32_t src = m.first[k];
-            out = Curve{};
+            clear_curve(out);
             return Status::error(node_prefix(src) + "tangent overflowed (alpha " + describe(settings.alpha) +
                                      " is too extreme for this node spacing)", static_cast<int>(src));
         }
@@ -515,7 +535,6 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         const float r = nodes.radius_m.empty() ? 0.0f : nodes.radius_m[m.first[j]];
         out.radius_m[j] = r > 0.0f ? r : wire_radius;
     }
-    out.stretch = std::move(seg_stretch);
     return Status::success();
 }
 
