@@ -42,6 +42,8 @@ struct SegmentCoeffs {
     double r0, r1, r2, r3;      // R(t) = r0 + t (r1 + t (r2 + t r3))
     double u_scale;             // 1 / (2 pi stretch)
     double tiny_speed;          // |B'| below this counts as vanishing (rounding noise of the control points)
+    std::size_t slope_node = static_cast<std::size_t>(-1);  // node whose slope `slope` is (the end node of the last loaded segment)
+    double slope = 0.0;
 
     SegmentCoeffs(const Curve& curve, uint32_t seg) { load(curve, seg); }
     void load(const Curve& curve, uint32_t seg) {
@@ -63,7 +65,11 @@ struct SegmentCoeffs {
             const std::size_t a = std::min<std::size_t>(seg, n - 1);
             const std::size_t b = curve.closed ? (a + 1) % n : std::min(a + 1, n - 1);
             const double ra = curve.radius_m[a], rb = curve.radius_m[b];
-            const double ma = node_slope(curve, a), mb = node_slope(curve, b);
+            // Consecutive segments share a node: its slope is computed once.
+            const double ma = a == slope_node ? slope : node_slope(curve, a);
+            const double mb = node_slope(curve, b);
+            slope_node = b;
+            slope = mb;
             // Hermite basis expanded: R = ra + ma t + (-3ra - 2ma + 3rb - mb) t^2 + (2ra + ma - 2rb + mb) t^3.
             r0 = ra;
             r1 = ma;
