@@ -26,6 +26,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <memory>
@@ -179,7 +180,22 @@ struct SceneRun {
     std::vector<double> visible_segments;  // per frame: segments of the visible wires (uniform counts)
     std::vector<Sample> samples;
     double max_error_px = 0.0;
+    wire::systems::WireMemory memory{};  // after the last frame
+    double rss_kb = 0.0;                 // VmRSS of the process after the last frame (the scene still alive)
 };
+
+// A /proc/self/status field in kB (VmRSS, VmHWM), or 0 where there is none.
+double proc_status_kb(const char* field) {
+    double kb = 0.0;
+    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+        char line[256];
+        const std::size_t len = std::strlen(field);
+        while (std::fgets(line, sizeof line, f))
+            if (std::strncmp(line, field, len) == 0 && line[len] == ':') kb = std::atof(line + len + 1);
+        std::fclose(f);
+    }
+    return kb;
+}
 
 struct RunSpec {
     SceneKind kind = SceneKind::standard;
@@ -292,6 +308,8 @@ SceneRun run_scene(const RunSpec& spec) {
         out.max_error_px = std::max(out.max_error_px, s.adaptive_error_px);
         out.samples.push_back(std::move(s));
     }
+    out.memory = wire::systems::wire_memory(registry);
+    out.rss_kb = proc_status_kb("VmRSS");
     return out;
 }
 
@@ -510,6 +528,7 @@ int run_systems_bench(const Options& o) {
     GlCheck gl;
     std::string gl_note;
     std::string scene_bytes;  // per scene: gpu-rings streamed and retained bytes, cpu-mesh bytes, ratios
+    std::string system_lines, memory_lines;  // per scene: per-system CPU table rows, memory table rows
     double scene_bytes_cpu = 0.0;
     double standard_systems_wall_cpu = 0.0, standard_systems_wall_gpu = 0.0;
     if (o.gl && !gl.init())
@@ -541,6 +560,16 @@ int run_systems_bench(const Options& o) {
                 };
             }
             SceneRun r = run_scene(spec);
+            {
+                const wire::systems::WireMemory& m = r.memory;
+                auto per = [](std::size_t bytes, std::size_t n) { return n ? bytes / 1024.0 / n : 0.0; };
+                std::snprintf(buf, sizeof buf, "| %s | %s | %zu | %.2f | %zu | %.2f | %.2f | %.2f | %.2f | %.1f |\n",
+                              name.c_str(), cpu ? "cpu-mesh" : "gpu-rings", m.visible_wires,
+                              per(m.visible_bytes, m.visible_wires), m.culled_wires, per(m.culled_bytes, m.culled_wires),
+                              per(m.mesh_bytes, m.visible_wires), per(m.nodes_bytes, m.visible_wires + m.culled_wires),
+                              (m.visible_bytes + m.culled_bytes) / 1048576.0, r.rss_kb / 1024.0);
+                memory_lines += buf;
+            }
             csv.add(row(name, cpu ? "cpu-mesh" : "gpu-rings", wires, median(r.visible), median(r.rings),
                         median(r.vertices), median(r.bytes), median(r.frame_cpu_ms), r.max_error_px));
             if (!cpu) {
@@ -581,6 +610,12 @@ int run_systems_bench(const Options& o) {
                 static_cast<std::size_t>(n), static_cast<std::size_t>(v), static_cast<std::size_t>(idx))));
         }
         const double curve_ms = system_medians(cpu_run)[0];
+        {
+            const std::array<double, kSystems> sys = system_medians(cpu_run);
+            std::snprintf(buf, sizeof buf, "| %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n", name.c_str(), sys[0],
+                          sys[1], sys[2], sys[3], sys[4], median(cpu_run.frame_cpu_ms));
+            system_lines += buf;
+        }
         csv.add(row(name, "uniform", wires, median(cpu_run.visible), median(u_rings), median(u_vertices),
                     median(u_bytes), curve_ms + u.rebuild_cpu_ms, u.max_error_px));
         std::snprintf(
@@ -616,7 +651,7 @@ int run_systems_bench(const Options& o) {
         if (kind == SceneKind::offscreen) offscreen_cpu_ms = median(cpu_run.frame_cpu_ms);
 
         // 1 vs 2 threads (wall time: the point of threads is to finish sooner), on the cpu-mesh path.
-        if (kind != SceneKind::offscreen && (!o.quick || kind == SceneKind::standard)) {
+        if (kind != SceneKind::offscreen) {
             double wall[2] = {0.0, 0.0};
             for (int t : {1, 2}) {
                 if (t == o.threads) {
@@ -701,6 +736,21 @@ int run_systems_bench(const Options& o) {
                           offscreen_cpu_ms, standard_cpu_ms, 100.0 * offscreen_cpu_ms / standard_cpu_ms);
             md += buf;
         }
+    }
+    if (!system_lines.empty()) {
+        md += "\n## Per-system CPU ms per frame (cpu-mesh, median; " + std::to_string(o.threads) +
+              " thread(s))\n\n| scene | curve | lod | rings | mesh | draw_list | frame |\n"
+              "| --- | --- | --- | --- | --- | --- | --- |\n" + system_lines;
+    }
+    if (!memory_lines.empty()) {
+        std::snprintf(buf, sizeof buf, "%.1f", proc_status_kb("VmHWM") / 1024.0);
+        md += "\n## Memory the wire systems hold (after the last frame; wire::systems::wire_memory: capacity of "
+              "their per-wire containers plus the components, KiB per wire; the mesh column is the cpu-mesh "
+              "output, included in the visible figure; nodes are the game's input, not included)\n\n"
+              "| scene | path | visible | KiB / visible wire | culled | KiB / culled wire | mesh KiB / visible | "
+              "nodes KiB / wire | systems MiB | process RSS MiB |\n"
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n" + memory_lines +
+              "\nProcess peak resident size (VmHWM) at the end of the bench: " + buf + " MiB.\n";
     }
     if (!scene_bytes.empty()) {
         md += "\n## Bytes uploaded per frame (median)\n\n| scene | gpu-rings streamed | gpu-rings retained | "
