@@ -41,7 +41,7 @@ struct SegmentCoeffs {
     glm::dvec3 e0, e1;          // B''(t) = e0 + t e1
     double r0, r1, r2, r3;      // R(t) = r0 + t (r1 + t (r2 + t r3))
     double u_scale;             // 1 / (2 pi stretch)
-    double tiny_speed;          // |B'| below this counts as vanishing (rounding noise of the control points)
+    double tiny_bound;          // >= tiny_speed() (1-norms instead of lengths): a faster speed is not tiny
     std::size_t slope_node = static_cast<std::size_t>(-1);  // node whose slope `slope` is (the end node of the last loaded segment)
     double slope = 0.0;
 
@@ -81,12 +81,16 @@ struct SegmentCoeffs {
             stretch = 1.0;
         }
         u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
-        tiny_speed = 1e-9 * (glm::length(d0) + glm::length(d1) + glm::length(d2));
+        const auto norm1 = [](const glm::dvec3& v) { return std::abs(v.x) + std::abs(v.y) + std::abs(v.z); };
+        tiny_bound = 1e-9 * (norm1(d0) + norm1(d1) + norm1(d2));
     }
     [[nodiscard]] glm::dvec3 position(double t) const { return p0 + t * (p1 + t * (p2 + t * p3)); }
     [[nodiscard]] glm::dvec3 derivative(double t) const { return d0 + t * (d1 + t * d2); }
     [[nodiscard]] glm::dvec3 second_derivative(double t) const { return e0 + t * e1; }
     [[nodiscard]] double radius(double t) const { return r0 + t * (r1 + t * (r2 + t * r3)); }
+    /// |B'| below this counts as vanishing (rounding noise of the control points); three roots, so only
+    /// computed when a speed is below tiny_bound.
+    [[nodiscard]] double tiny_speed() const { return 1e-9 * (glm::length(d0) + glm::length(d1) + glm::length(d2)); }
 };
 
 struct Interval {
@@ -158,7 +162,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         const glm::dvec3 d2 = seg.second_derivative(p.t);
         const double speed2 = glm::dot(d1, d1);
         const double speed = std::sqrt(speed2);
-        if (speed > seg.tiny_speed) {
+        if (speed > seg.tiny_bound || speed > seg.tiny_speed()) {
             out.tangent_scratch[i] = d1 * (1.0 / speed);
         } else {  // vanishing derivative: the one-sided limits of unit_tangent() (rare)
             out.tangent_scratch[i] = unit_tangent(curve.segments[p.segment], p.t);
