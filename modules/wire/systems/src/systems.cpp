@@ -109,9 +109,13 @@ void keep_rings(RingSet& built, WireRings& r) {
     r.u_close = built.closed && !built.u.empty() ? static_cast<float>(built.u.back()) : 0.0f;
 }
 
+/// Frees a vector's buffer (`v = {}` would only empty it: that is the initializer-list assignment).
+template <class T>
+void release(std::vector<T>& v) { std::vector<T>().swap(v); }
+
 void release_rings(WireRings& r) {
-    r.params = {};
-    r.rings.rings = {};  // ring 0's frame stays: it seeds the next build's first normal
+    release(r.params);
+    release(r.rings.rings);  // ring 0's frame stays: it seeds the next build's first normal
 }
 
 template <class T>
@@ -173,7 +177,10 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                               (!nodes.ids.empty() || nodes.size() == prev.size());
         // build_curve's output: one buffer per thread (swapped with the wire's curve), not one per wire.
         thread_local Curve scratch;
-        if (!pop_free || same_ids) {
+        // The first valid state has nothing to blend from: the multires would show its exact curve too (and is
+        // primed from previous_nodes if the next state changes ids, as after any fast-path frame).
+        const bool first = c.generation == 0;
+        if (!pop_free || same_ids || first) {
             // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
             job.status = build_curve(nodes, spline, scratch);
             if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
@@ -330,8 +337,8 @@ void mesh_system(Registry& registry, WireContext& ctx) {
             // Culled with rings older than its curve (or released): the next visible frame rebuilds the mesh.
             const WireCurve* curve = registry.try_get<WireCurve>(e);
             if (curve != nullptr && rings->seen_curve != curve->generation && mesh.mesh.vertices.capacity() != 0) {
-                mesh.mesh.vertices = {};
-                mesh.mesh.indices = {};
+                release(mesh.mesh.vertices);
+                release(mesh.mesh.indices);
                 mesh.seen_rings = 0;
             }
             continue;
