@@ -347,6 +347,7 @@ int run_view(const ViewOptions& o) try {
     Outputs outputs;
     const bool png_every_frame = o.png_out.find(kPerFrameToken) != std::string::npos;
     std::string csv = std::string(kRingCsvHeader) + ",sides\n";
+    wire::RingSet ring_set;  // per wire, for the CSV (reused)
     nlohmann::ordered_json frame_records = nlohmann::ordered_json::array();
     for (std::size_t f = 0; f < frames; ++f) {
         if (f > 0) {
@@ -403,8 +404,9 @@ int run_view(const ViewOptions& o) try {
                 error_px = wire::systems::wire_screen_error(registry, ctx, entities[w], kErrorSamplesPerSegment).max_px;
                 rings = item->rings.size();
                 sides = static_cast<long>(item->sides);
-                if (!o.csv_out.empty())
-                    append_ring_rows(csv, f, w, registry.get<wire::systems::WireRings>(entities[w]).rings, sides);
+                // The systems keep only the float ring records: the CSV's double columns are recomputed.
+                if (!o.csv_out.empty() && wire::systems::wire_ring_set(registry, entities[w], ring_set))
+                    append_ring_rows(csv, f, w, ring_set, sides);
             }
             frame_error = std::max(frame_error, error_px);
             wire_records.push_back({{"wire", w},

@@ -314,6 +314,7 @@ void rings_system(Registry& registry, WireContext& ctx) {
         }
         thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
         build_rings(job.curve->curve, r.params, settings, scratch);
+        r.frame_settings = settings.frames;
         keep_rings(scratch, r);
         ++r.generation;
         r.seen_curve = job.curve->generation;
@@ -430,6 +431,17 @@ void install(engine::ecs::Schedule& schedule, WireContext& context) {
     schedule.add(kRingsSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { rings_system(r, *ctx); });
     schedule.add(kMeshSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { mesh_system(r, *ctx); });
     schedule.add(kDrawListSystem, [ctx](Registry& r, const engine::ecs::FrameContext&) { draw_list_system(r, *ctx); });
+}
+
+bool wire_ring_set(Registry& registry, Entity wire, RingSet& out) {
+    const WireCurve* curve = registry.try_get<WireCurve>(wire);
+    const WireRings* rings = registry.try_get<WireRings>(wire);
+    if (curve == nullptr || rings == nullptr || rings->generation == 0 || rings->seen_curve != curve->generation ||
+        rings->rings.rings.size() != rings->params.size()) {
+        return false;
+    }
+    build_rings(curve->curve, rings->params, RingSettings{.frames = rings->frame_settings}, out);
+    return true;
 }
 
 WireMemory wire_memory(Registry& registry) {

@@ -74,6 +74,7 @@ struct WireRings {
     std::vector<RingParam> params;     ///< where the rings sit on the curve (segment, t)
     RingSet rings;                     ///< float ring records, ring 0's frame and the scalars (see above)
     float u_close = 0.0f;              ///< closed wires: texture u where the loop closes (0 for open wires)
+    FrameSettings frame_settings{};    ///< what the last build seeded its first normal with (wire_ring_set redoes it)
     uint64_t generation = 0;           ///< +1 each time the rings are rebuilt
     uint64_t seen_curve = 0;           ///< WireCurve::generation the rings were built from
     uint64_t seen_lod = 0;             ///< WireLodState::generation the rings were built from

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "wire/systems/context.hpp"
+#include "wire/rings.hpp"
 
 #include <engine/ecs/registry.hpp>
 #include <engine/ecs/schedule.hpp>
@@ -63,6 +64,12 @@ void draw_list_system(engine::ecs::Registry& registry, WireContext& context);
 /// The largest wire_screen_error over the visible wires of the last draw list.
 [[nodiscard]] ScreenError scene_screen_error(engine::ecs::Registry& registry, const WireContext& context,
                                              int samples_per_segment = 64);
+
+/// The wire's current rings with every per-ring array build_rings produces (double frames, centres, arc length,
+/// u), which WireRings does not keep: recomputed from the wire's curve and ring parameters with the settings of
+/// its last ring build, so it equals what the rings system built, bit for bit. False (out untouched) if the wire
+/// has no rings for its current curve (culled, released, or not built yet).
+bool wire_ring_set(engine::ecs::Registry& registry, engine::ecs::Entity wire, RingSet& out);
 
 /// Heap memory the wire systems hold for their own per-wire state (capacity of the containers in WireCurve,
 /// WireLodState, WireRings, WireMesh, summed), split by the wire's last LOD visibility; Nodes (the game's input)
