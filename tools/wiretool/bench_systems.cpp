@@ -651,7 +651,8 @@ int run_systems_bench(const Options& o) {
         if (kind == SceneKind::offscreen) offscreen_cpu_ms = median(cpu_run.frame_cpu_ms);
 
         // 1 vs 2 threads (wall time: the point of threads is to finish sooner), on the cpu-mesh path.
-        if (kind != SceneKind::offscreen) {
+        if (kind != SceneKind::offscreen &&
+            (!o.quick || kind == SceneKind::standard || kind == SceneKind::swaying)) {
             double wall[2] = {0.0, 0.0};
             for (int t : {1, 2}) {
                 if (t == o.threads) {
