@@ -150,6 +150,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             seg_index = i;
         }
     };
+    SegmentCoeffs crossed = seg;  // segments an interval crosses without a ring (LOD below node resolution)
     double s = 0.0;
     double u = settings.u_start;
     for (std::size_t i = 0; i < n; ++i) {
@@ -196,7 +197,8 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             if (wrap || b.segment != p.segment) {
                 const std::size_t end = wrap ? curve.segment_count() : b.segment;
                 for (std::size_t k = p.segment + 1; k < end; ++k) {  // crossed segments, whole
-                    const Interval ik = integrate(SegmentCoeffs(curve, static_cast<uint32_t>(k)), 0.0, 1.0);
+                    crossed.load(curve, static_cast<uint32_t>(k));  // one object: shared node slopes reused
+                    const Interval ik = integrate(crossed, 0.0, 1.0);
                     iv.length_m += ik.length_m;
                     iv.u += ik.u;
                 }
