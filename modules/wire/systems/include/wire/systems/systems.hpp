@@ -71,8 +71,8 @@ void draw_list_system(engine::ecs::Registry& registry, WireContext& context);
 /// has no rings for its current curve (culled, released, or not built yet).
 bool wire_ring_set(engine::ecs::Registry& registry, engine::ecs::Entity wire, RingSet& out);
 
-/// Heap memory the wire systems hold for their own per-wire state (capacity of the containers in WireCurve,
-/// WireLodState, WireRings, WireMesh, summed), split by the wire's last LOD visibility; Nodes (the game's input)
+/// Heap memory the wire systems hold for their own per-wire state (capacity of the containers in WireCurve
+/// (curve, previous nodes, LOD bounds), WireLodState, WireRings, WireMesh, summed, plus the components' sizes), split by the wire's last LOD visibility; Nodes (the game's input)
 /// is reported apart. The multires state's private buffers are estimated from its target curve (target and
 /// rendered curve, one id per node) while it is live; a released (stale) state holds nothing.
 struct WireMemory {
