@@ -42,7 +42,8 @@ struct SegmentCoeffs {
     double r0, r1, r2, r3;      // R(t) = r0 + t (r1 + t (r2 + t r3))
     double u_scale;             // 1 / (2 pi stretch)
     double tiny_bound;          // >= tiny_speed() (1-norms instead of lengths): a faster speed is not tiny
-    std::size_t slope_node = static_cast<std::size_t>(-1);  // node whose slope `slope` is (the end node of the last loaded segment)
+    // `slope` is node `slope_node`'s radius slope (the end node of the last loaded segment).
+    std::size_t slope_node = static_cast<std::size_t>(-1);
     double slope = 0.0;
 
     SegmentCoeffs(const Curve& curve, uint32_t seg) { load(curve, seg); }

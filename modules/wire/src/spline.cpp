@@ -509,7 +509,8 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     for (std::size_t k = 0; k < segs; ++k) {
         const dvec3& p0 = m.p[k];
         const dvec3& p1 = m.p[(k + 1) % n];
-        const CubicBezier& bz = out.segments.emplace_back(CubicBezier{p0, p0 + tg.t0[k] / 3.0, p1 - tg.t1[k] / 3.0, p1});
+        const CubicBezier& bz =
+            out.segments.emplace_back(CubicBezier{p0, p0 + tg.t0[k] / 3.0, p1 - tg.t1[k] / 3.0, p1});
         // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the
         // tube's float vertices downstream.
         constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;

@@ -450,7 +450,8 @@ WireMemory wire_memory(Registry& registry) {
     for (std::size_t i = 0; i < curves.size(); ++i) {
         const Entity e = curves.at(i);
         const WireCurve& c = curves.at_position(i);
-        std::size_t curve = sizeof(WireCurve) + bytes_of(c.curve) + bytes_of(c.previous_nodes) + bytes_of(c.lod_bounds.data);
+        std::size_t curve =
+            sizeof(WireCurve) + bytes_of(c.curve) + bytes_of(c.previous_nodes) + bytes_of(c.lod_bounds.data);
         if (!c.multires_stale) {  // live pop-free state: target and rendered curves, one id per node of each
             const Curve& t = c.multires.target();
             curve += 2 * (bytes_of(t) + t.node_count() * sizeof(uint32_t));
@@ -461,7 +462,9 @@ WireMemory wire_memory(Registry& registry) {
             lod = sizeof(WireLodState) + bytes_of(l->lod.counts) + bytes_of(l->lod.required);
             visible = l->lod.visible;
         }
-        if (const WireRings* r = registry.try_get<WireRings>(e)) rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
+        if (const WireRings* r = registry.try_get<WireRings>(e)) {
+            rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
+        }
         if (const WireMesh* w = registry.try_get<WireMesh>(e)) {
             mesh = sizeof(WireMesh) + bytes_of(w->mesh.vertices) + bytes_of(w->mesh.indices);
         }

@@ -71,16 +71,24 @@ void draw_list_system(engine::ecs::Registry& registry, WireContext& context);
 /// has no rings for its current curve (culled, released, or not built yet).
 bool wire_ring_set(engine::ecs::Registry& registry, engine::ecs::Entity wire, RingSet& out);
 
-/// Heap memory the wire systems hold for their own per-wire state (capacity of the containers in WireCurve
-/// (curve, previous nodes, LOD bounds), WireLodState, WireRings, WireMesh, summed, plus the components' sizes), split by the wire's last LOD visibility; Nodes (the game's input)
-/// is reported apart. The multires state's private buffers are estimated from its target curve (target and
-/// rendered curve, one id per node) while it is live; a released (stale) state holds nothing.
+/// Heap memory the wire systems hold for their own per-wire state: the capacity of the containers in WireCurve
+/// (curve, previous nodes, LOD bounds), WireLodState, WireRings and WireMesh, summed, plus the components' sizes,
+/// split by the wire's last LOD visibility. Nodes (the game's input) is reported apart. The multires state's
+/// private buffers are estimated from its target curve (target and rendered curve, one id per node) while it is
+/// live; a released (stale) state holds nothing.
 struct WireMemory {
-    std::size_t visible_wires = 0, culled_wires = 0;
-    std::size_t visible_bytes = 0, culled_bytes = 0;  ///< systems' state of the visible / culled wires
-    std::size_t curve_bytes = 0, lod_bytes = 0, rings_bytes = 0, mesh_bytes = 0;  ///< all wires, per stage
-    std::size_t nodes_bytes = 0;                      ///< Nodes components (game-owned input), all wires
+    std::size_t visible_wires = 0;  ///< wires the LOD last found visible
+    std::size_t culled_wires = 0;   ///< wires the LOD last culled (or not yet seen by the LOD)
+    std::size_t visible_bytes = 0;  ///< systems' state of the visible wires, bytes
+    std::size_t culled_bytes = 0;   ///< systems' state of the culled wires, bytes
+    std::size_t curve_bytes = 0;    ///< WireCurve of all wires, bytes
+    std::size_t lod_bytes = 0;      ///< WireLodState of all wires, bytes
+    std::size_t rings_bytes = 0;    ///< WireRings of all wires, bytes
+    std::size_t mesh_bytes = 0;     ///< WireMesh of all wires (the cpu_mesh path's output), bytes
+    std::size_t nodes_bytes = 0;    ///< Nodes components (the game's input, not the systems' state), bytes
 };
+
+/// Sums the memory the wire systems hold for every wire of `registry` (see WireMemory); O(wires), no allocation.
 [[nodiscard]] WireMemory wire_memory(engine::ecs::Registry& registry);
 
 }  // namespace wire::systems
