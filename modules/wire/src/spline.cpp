@@ -148,7 +148,8 @@ template <class V>
 void thomas(const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& c,
             std::vector<V>& r) {
     const std::size_t n = b.size();
-    std::vector<double> cp(n);
+    thread_local std::vector<double> cp;  // working memory, reused (no allocation per call)
+    cp.resize(n);
     double den = b[0];
     cp[0] = c[0] / den;
     r[0] = r[0] / den;
@@ -165,11 +166,13 @@ void thomas_cyclic(const std::vector<double>& a, const std::vector<double>& b, c
                    std::vector<dvec3>& r) {
     const std::size_t n = b.size();
     const double alpha = c[n - 1], beta = a[0], gamma = -b[0];
-    std::vector<double> bb = b;
+    thread_local std::vector<double> bb;
+    bb.assign(b.begin(), b.end());
     bb[0] = b[0] - gamma;
     bb[n - 1] = b[n - 1] - alpha * beta / gamma;
     thomas(a, bb, c, r);
-    std::vector<double> z(n, 0.0);
+    thread_local std::vector<double> z;
+    z.assign(n, 0.0);
     z[0] = gamma, z[n - 1] = alpha;
     thomas(a, bb, c, z);
     const dvec3 fact = (r[0] + beta * r[n - 1] / gamma) / (1.0 + z[0] + beta * z[n - 1] / gamma);
@@ -263,14 +266,17 @@ constexpr double kStraightLo = 0.0, kStraightHi = 0.1;
 constexpr double kStraightTension = 30.0;
 
 /// Per-node tension weight g in [0, 1] from the turning pattern (see the constants above).
-std::vector<double> concentrated_turns(const Chords& ch, bool closed, std::vector<double>* straight = nullptr) {
+/// The result is per-thread storage, valid until the next call on the same thread.
+const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std::vector<double>* straight = nullptr) {
     const std::size_t segs = ch.d.size();
     const std::size_t n = closed ? segs : segs + 1;
-    std::vector<double> g(n, 0.0);
+    thread_local std::vector<double> g;
+    g.assign(n, 0.0);
     if (straight) straight->assign(n, 0.0);
     if (n < 3) return g;
     // Curvature vectors k_i = (e_out - e_in) / (mean of the two elements): |k| ~ 2 sin(phi/2) / h.
-    std::vector<dvec3> k(n, dvec3(0.0));
+    thread_local std::vector<dvec3> k;
+    k.assign(n, dvec3(0.0));
     auto interior = [&](std::size_t i) { return closed || (i > 0 && i + 1 < n); };
     for (std::size_t i = 0; i < n; ++i) {
         if (!interior(i)) continue;
@@ -279,7 +285,8 @@ std::vector<double> concentrated_turns(const Chords& ch, bool closed, std::vecto
     }
     // Node tangents (chord bisectors), to carry a neighbour's curvature vector to node i by the rotation that
     // takes its tangent to node i's (on a circle this maps one curvature vector exactly onto the next).
-    std::vector<dvec3> t(n);
+    thread_local std::vector<dvec3> t;
+    t.assign(n, dvec3(0.0));
     for (std::size_t i = 0; i < n; ++i) {
         const bool in = closed || i > 0, out = closed || i + 1 < n;
         const dvec3 e_in = in ? ch.d[(i + segs - 1) % segs] / ch.len[(i + segs - 1) % segs] : dvec3(0.0);
@@ -320,14 +327,19 @@ std::vector<double> concentrated_turns(const Chords& ch, bool closed, std::vecto
 void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>& g, const std::vector<double>& gs, Tangents& tg) {
     const std::size_t segs = ch.d.size();
     const std::size_t n = closed ? segs : segs + 1;
-    std::vector<dvec3> s(segs);
+    // Working memory: per thread, reused (no allocation per call once large enough).
+    thread_local std::vector<dvec3> s;
+    s.assign(segs, dvec3(0.0));
     for (std::size_t k = 0; k < segs; ++k) s[k] = ch.d[k] / ch.len[k];
-    std::vector<double> w(n);
+    thread_local std::vector<double> w;
+    w.assign(n, 0.0);
     for (std::size_t i = 0; i < n; ++i)  // log-uniform in g
         w[i] = std::expm1(g[i] * std::log1p(kMaxNodeTension)) + std::expm1(gs[i] * std::log1p(kStraightTension));
-    std::vector<dvec3> D(n);
+    thread_local std::vector<dvec3> D;
+    D.assign(n, dvec3(0.0));
     if (closed) {
-        std::vector<double> a(n), b(n), c(n);
+        thread_local std::vector<double> a, b, c;
+        a.assign(n, 0.0), b.assign(n, 0.0), c.assign(n, 0.0);
         for (std::size_t i = 0; i < n; ++i) {
             const std::size_t kin = (i + segs - 1) % segs, kout = i;
             const double hin = ch.len[kin], hout = ch.len[kout], sum = hin + hout;
@@ -349,8 +361,10 @@ void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>
         const double beta0 = (1.0 - g0) * h1 / (h0 + h1) + 2.0 * g0, betal = (1.0 - gl) * hP / (hP + hL) + 2.0 * gl;
         const dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s[0], rl = (1.0 - gl) * rln + (3.0 * gl) * s[segs - 1];
         const std::size_t m = n - 2;
-        std::vector<double> a(m), b(m), c(m);
-        std::vector<dvec3> r(m);
+        thread_local std::vector<double> a, b, c;
+        a.assign(m, 0.0), b.assign(m, 0.0), c.assign(m, 0.0);
+        thread_local std::vector<dvec3> r;
+        r.assign(m, dvec3(0.0));
         for (std::size_t j = 0; j < m; ++j) {
             const std::size_t i = j + 1;
             const double hin = ch.len[i - 1], hout = ch.len[i], sum = hin + hout;
@@ -444,8 +458,8 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     } else if (kind == SplineKind::c2) {
         c2_tangents(ch, closed, tg);
     } else if (kind == SplineKind::automatic) {
-        std::vector<double> gs;
-        const std::vector<double> g = concentrated_turns(ch, closed, &gs);
+        thread_local std::vector<double> gs;
+        const std::vector<double>& g = concentrated_turns(ch, closed, &gs);
         automatic_tangents(ch, closed, g, gs, tg);
         // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
         // C2 only where it is 0).
