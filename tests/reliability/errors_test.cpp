@@ -233,6 +233,70 @@ TEST(CurveErrors, PipelineKeepsThePreviousStateOnError) {
     EXPECT_EQ(pipeline.mesh().vertices.size(), vertices);
 }
 
+// Found by `tools/fuzz run fuzz_geometry 60` (tests/fuzz/corpus/fuzz_geometry/regression_denormal_radius.bin):
+// a closed uniform Catmull-Rom wire of 28 nodes with 8.6e9 m jumps and a denormal tube radius (1.04e-42 m).
+// Texture u = arc length / (2 pi radius stretch) overflowed float: the mesh had uv = Inf. Now the radius is
+// below the contract's minimum and the curve stage says so.
+TEST(CurveErrors, DenormalRadiusRegression) {
+    wire::PipelineSettings s;
+    s.spline.kind = wire::SplineKind::catmull_rom;
+    s.spline.alpha = 1.8442538971087601e-165;
+    s.spline.tension = 4.4001711491141884e-310;
+    s.spline.closed = true;
+    s.spline.radius_m = 1.04116476e-42f;
+    s.spline.merge_epsilon_rel = 1.9285913728758249e-168;
+    s.tessellate.tolerance_m = 1.9285913724732417e-168;
+    s.tessellate.max_rings_per_segment = 7;
+    s.tube.sides = 3;
+    s.tube.caps = false;
+    s.pop_free = false;
+    const glm::dvec3 far{-1.9100168016818808e-23, 1.5231766383643548e-313, 8589935840.0470562};
+    const glm::dvec3 tiny{8.0868664911295234e-320, 1.2132797677859884e-279, 1.2132797677859895e-279};
+    const glm::dvec3 a{-0.058823529411764497, -0.058823529411764497, -0.058823529411764497};
+    const glm::dvec3 b{-0.058823529411764497, -0.058823529411764497, -3.4705882352941178};
+    const glm::dvec3 c{-6.9656775329448006, -8.0465278620169966e-213, -7.1018096169245837};
+    wire::WireNodes nodes;
+    nodes.positions = {{1.9285913724732417e-168, -7.6464255144538837, -4.2315673801155569},
+                       {1.0000000000000001e-09, -7.6464255144538837, -4.2315673801155569},
+                       {-1.0744871516639058, 1.9285913724732417e-168, -5.6862747669114624},
+                       {-3.9924434147613677, -2.8431372549019605, -2.8431372549019605},
+                       {-2.8455882352941178, -3.47058773041514, 4.9999999999999822},
+                       {1.9285913724732417e-168, 3.2637615056148837e-43, 1.0410273767909543e-42},
+                       {1.0410273767909543e-42, 1.0410273767909543e-42, 1.0410273767909543e-42},
+                       far, tiny, far, tiny, far, tiny, far, tiny, far,
+                       a, b, a, b, a, b, a, c, c, c,
+                       {-4.6875, -5, 4.3850708007826356},
+                       {-4.9999994039550364, -5, -5}};
+    EXPECT_EQ(pipeline_error(nodes, s), "settings.radius_m is 1.04116476e-42 (below the smallest supported radius, 1e-6 m)");
+    // At the smallest supported radius, and a node radius and stretch at their minimum too, the same wire's mesh
+    // is finite, uv included.
+    s.spline.radius_m = 1e-6f;
+    nodes.radius_m.assign(nodes.positions.size(), 0.0f);
+    nodes.radius_m[7] = 1e-6f;
+    nodes.stretch.assign(nodes.positions.size(), 1e-6f);
+    wire::WirePipeline pipeline;
+    const wire::Status st = pipeline.update(nodes, s);
+    ASSERT_TRUE(st.ok) << st.message;
+    ASSERT_FALSE(pipeline.mesh().vertices.empty());
+    float max_u = 0.0f;
+    for (const wire::TubeVertex& v : pipeline.mesh().vertices) {
+        ASSERT_TRUE(std::isfinite(v.uv.x) && std::isfinite(v.uv.y) && std::isfinite(v.position.x) &&
+                    std::isfinite(v.position.y) && std::isfinite(v.position.z));
+        max_u = std::max(max_u, v.uv.x);
+    }
+    EXPECT_GT(max_u, 1e20f);  // the case is extreme: u is huge, but finite
+}
+
+TEST(CurveErrors, NodeRadiusAndStretchBelowTheMinimum) {
+    wire::WireNodes nodes;
+    nodes.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+    nodes.radius_m = {0.01f, 1e-7f, 0.01f};
+    EXPECT_EQ(pipeline_error(nodes), "node 1: radius_m is 1.00000001e-07 (below the smallest supported radius, 1e-6 m)");
+    nodes.radius_m.clear();
+    nodes.stretch = {1.0f, 1.0f, 5e-7f};
+    EXPECT_EQ(pipeline_error(nodes), "node 2: stretch is 4.99999999e-07 (must be finite and >= 1e-6)");
+}
+
 // ---- glTF (engine::assets::read_gltf / read_gltf_memory) ----
 
 TEST(GltfErrors, MissingFile) {
