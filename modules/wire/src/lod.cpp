@@ -802,7 +802,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         // Per-segment hysteresis on the Wang counts (all >= 1), then the spans over both.
         lod.counts.resize(n);
         for (std::size_t i = 0; i < n; ++i)
-            lod.counts[i] = hysteresis_count(old[i], lod.required[i], lim.band);
+            // Hysteresis keeps an old count, but never above the cap in force now (it may have been lowered).
+            lod.counts[i] = std::min(hysteresis_count(old[i], lod.required[i], lim.band), lim.max_rings);
         if (merge) lod.spans = merger.apply(lod.required, lod.counts);
     }
     bool changed = restart;

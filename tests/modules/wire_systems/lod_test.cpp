@@ -434,6 +434,40 @@ TEST(LodHysteresis, CountsComeDownWhenTheCameraLeaves) {
     }
 }
 
+// Found by fuzz_lod (tests/fuzz/corpus/fuzz_lod/regression_lowered_ring_cap.bin): with max_rings_per_segment
+// lowered between two updates, hysteresis kept counts above the new cap. Family: random camera walks around a
+// hanging cable with the ring and side caps changed every few frames; every count stays within the cap in force.
+TEST(LodHysteresis, CountsNeverExceedACapLoweredBetweenUpdates) {
+    const Curve curve = hanging_curve(16);
+    Rng rng(15);
+    std::size_t capped_updates = 0;
+    for (int walk = 0; walk < 20; ++walk) {
+        WireLod lod;
+        LodSettings settings;
+        double angle = uniform(rng, 0.0, 6.28), distance = uniform(rng, 0.3, 3.0);
+        for (int frame = 0; frame < 40; ++frame) {
+            if (frame % 5 == 0) {
+                settings.max_rings_per_segment = static_cast<uint32_t>(uniform(rng, 0.0, 64.0));  // 0: default 256
+                settings.max_sides = static_cast<uint32_t>(uniform(rng, 0.0, 40.0));
+                settings.tolerance_px = uniform(rng, 0.05, 2.0);
+            }
+            angle += uniform(rng, -0.05, 0.05);
+            distance = std::clamp(distance * std::exp(uniform(rng, -0.3, 0.3)), 0.2, 50.0);
+            update_lod(curve, orbit_camera(angle, distance), settings, lod);
+            if (!lod.visible) continue;
+            const uint32_t cap = settings.max_rings_per_segment ? settings.max_rings_per_segment : 256u;
+            const uint32_t side_cap = std::max<uint32_t>(settings.max_sides ? settings.max_sides : 32u, 3u);
+            for (std::size_t i = 0; i < lod.counts.size(); ++i) {
+                ASSERT_LE(lod.counts[i], cap) << "walk " << walk << " frame " << frame << " segment " << i;
+                ASSERT_GE(lod.counts[i], lod.required[i]);
+                capped_updates += lod.required[i] == cap ? 1 : 0;
+            }
+            ASSERT_LE(lod.sides, side_cap);
+        }
+    }
+    EXPECT_GT(capped_updates, 0u);  // the family does reach the cap
+}
+
 TEST(LodCulling, CulledWireGetsNoRings) {
     const Curve curve = hanging_curve(16);
     WireLod lod;
