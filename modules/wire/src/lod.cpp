@@ -818,10 +818,11 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     lod.z_min_m = std::isfinite(wire_z) ? wire_z : 0.0;
     lod.required_sides =
         std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides) : 3u;
-    const uint32_t sides =
-        restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band);
+    // Clamped before the comparison: a lowered max_sides changes the sides, and the caller must hear of it.
+    const uint32_t sides = std::min(
+        restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band), lim.max_sides);
     changed = changed || sides != lod.sides;
-    lod.sides = std::min(sides, lim.max_sides);
+    lod.sides = sides;
     if (use_bound && lod.bounded && sb.inside && merger.margin() > 1.0) {
         WireLod::Coherence& c = lod.coherence;
         c.valid = true;

@@ -434,9 +434,11 @@ TEST(LodHysteresis, CountsComeDownWhenTheCameraLeaves) {
     }
 }
 
-// Found by fuzz_lod (tests/fuzz/corpus/fuzz_lod/regression_lowered_ring_cap.bin): with max_rings_per_segment
-// lowered between two updates, hysteresis kept counts above the new cap. Family: random camera walks around a
-// hanging cable with the ring and side caps changed every few frames; every count stays within the cap in force.
+// Found by fuzz_lod (tests/fuzz/corpus/fuzz_lod/regression_lowered_ring_cap.bin, regression_lowered_side_cap.bin):
+// with max_rings_per_segment lowered between two updates, hysteresis kept counts above the new cap; with
+// max_sides lowered, the sides were clamped but update_lod returned "unchanged". Family: random camera walks around a
+// hanging cable with the ring and side caps changed every few frames; every count stays within the cap in force
+// and every change is reported.
 TEST(LodHysteresis, CountsNeverExceedACapLoweredBetweenUpdates) {
     const Curve curve = hanging_curve(16);
     Rng rng(15);
@@ -453,7 +455,12 @@ TEST(LodHysteresis, CountsNeverExceedACapLoweredBetweenUpdates) {
             }
             angle += uniform(rng, -0.05, 0.05);
             distance = std::clamp(distance * std::exp(uniform(rng, -0.3, 0.3)), 0.2, 50.0);
-            update_lod(curve, orbit_camera(angle, distance), settings, lod);
+            const WireLod before = lod;
+            const bool changed = update_lod(curve, orbit_camera(angle, distance), settings, lod);
+            // The return value tells the ring stage to rebuild: it must be true whenever counts or sides changed.
+            if (lod.counts != before.counts || lod.sides != before.sides) {
+                ASSERT_TRUE(changed) << "frame " << frame;
+            }
             if (!lod.visible) continue;
             const uint32_t cap = settings.max_rings_per_segment ? settings.max_rings_per_segment : 256u;
             const uint32_t side_cap = std::max<uint32_t>(settings.max_sides ? settings.max_sides : 32u, 3u);
