@@ -693,7 +693,12 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     const std::size_t n = curve.segment_count();
     if (sphere_cull && bounds.sphere.radius_m >= 0.0) {
         const ViewTransform tf(view);
-        if (PlaneTest(view, bounds.sphere.radius_m).outside(tf(bounds.sphere.centre_m)) != 0) {
+        // The centre and the hull's control points each reach view space with a rounding error of a few ulps of
+        // |point| + |eye|; far from the origin (5e11 m: ~1e-4 m) that exceeds the sphere's own slack and the
+        // sphere could cull a wire the hull test keeps. Inflate the sphere by a bound of both errors.
+        const double rounding = 64.0 * std::numeric_limits<double>::epsilon() *
+                                (glm::length(bounds.sphere.centre_m) + glm::length(view.eye_m));
+        if (PlaneTest(view, bounds.sphere.radius_m + rounding).outside(tf(bounds.sphere.centre_m)) != 0) {
             bool changed = false;
             mark_culled(lod, changed);
             return changed;
