@@ -527,6 +527,16 @@ TEST(GltfErrors, HugeAccessorCountIsOutOfRangeNotAnOverflow) {
     EXPECT_EQ(gltf_memory_error(text), "piece.gltf: mesh 0 'quad' primitive 0: accessor 0 reads past its buffer");
 }
 
+// tinygltf 2.7.0 converts extras recursively: 100,000 nested arrays (a 200 kB file) overflowed the stack.
+TEST(GltfErrors, DeeplyNestedJsonIsRefused) {
+    const std::string deep = R"({"asset":{"version":"2.0"},"extras":)" + std::string(100000, '[') +
+                             std::string(100000, ']') + "}";
+    EXPECT_EQ(gltf_memory_error(deep), "piece.gltf: not a readable glTF file: JSON nested deeper than 128 levels");
+    // Within the limit: read as before (no mesh in it).
+    const std::string fine = R"({"asset":{"version":"2.0"},"extras":)" + std::string(120, '[') + std::string(120, ']') + "}";
+    EXPECT_EQ(gltf_memory_error(fine), "piece.gltf: contains no triangle mesh");
+}
+
 TEST(GltfErrors, ExternalBufferOutsideTheFilesDirectoryIsRefused) {
     const fs::path dir = temp_dir();
     fs::create_directories(dir / "level");

@@ -580,9 +580,20 @@ Status load(const unsigned char* data, std::size_t size, const std::string& name
         json_text += glb.json_offset;
         json_size = glb.json_size;
     }
+    // tinygltf converts extras and extensions to its Value recursively: a deeply nested array overflowed the stack
+    // (100,000 levels in a 200 kB file). glTF itself nests about 6 levels; 128 leaves room for any extras.
+    constexpr int kMaxDepth = 128;
+    struct TooDeep {};
     nlohmann::json root;
     try {
-        root = nlohmann::json::parse(json_text, json_text + json_size);
+        root = nlohmann::json::parse(json_text, json_text + json_size,
+                                     [](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+                                         if (depth > kMaxDepth) throw TooDeep{};
+                                         return true;
+                                     });
+    } catch (const TooDeep&) {
+        return Status::failure(name + ": not a readable glTF file: JSON nested deeper than " +
+                               std::to_string(kMaxDepth) + " levels");
     } catch (const std::exception& e) {
         return Status::failure(name + ": not a readable glTF file: " + e.what());
     }
