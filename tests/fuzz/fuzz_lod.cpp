@@ -3,10 +3,12 @@
 // the wire, a curve point exactly on the near plane or behind the eye, and degenerate ones (eye == target, up
 // along the view direction, fov 0 or >= pi, empty or negative viewports, near 0 or beyond far, NaN/Inf).
 // Properties of every update: no crash or UB; a culled wire has no counts and 0 sides; a visible one has one
-// count per segment, each in [1, max_rings] (the stated cap; 0 -> 256) and >= what the tolerance requires now,
-// required counts in [1, max_rings], sides in [3, max_sides] (0 -> 32), z_min finite. For a valid camera the
+// count per segment, each in [1, max_rings] (the stated cap; 0 -> 256; 0 allowed for a segment a ring span crosses
+// without keep_node_resolution, but never for the first) and >= what the tolerance requires now, required counts
+// <= max_rings, sides in [3, max_sides] (0 -> 32), z_min finite. For a valid camera the
 // O(1) bounding-sphere test gives the same result as the hull test, and the decision is conservative: a curve
-// point inside the frustum makes the wire visible and its segment tessellated for the tolerance (not coarse).
+// point inside the frustum makes the wire visible and (with keep_node_resolution) its segment tessellated for the
+// tolerance, not coarse.
 // WIRE_FUZZ_DUMP=1 prints the decoded cameras and settings.
 #include "fuzz_checks.hpp"
 
@@ -154,6 +156,7 @@ wire::LodSettings read_settings(FuzzedDataProvider& in) {
     const uint8_t band = in.ConsumeIntegral<uint8_t>();
     s.hysteresis_band = band < 128 ? 0.0 : band < 192 ? in.ConsumeFloatingPointInRange<double>(-1.0, 2.0) : special_or_raw(in);
     s.coarse_offscreen_segments = in.ConsumeIntegral<uint8_t>() < 200;
+    s.keep_node_resolution = in.ConsumeBool();
     return s;
 }
 
@@ -189,9 +192,12 @@ void check(const wire::Curve& curve, const wire::LodView& view, const wire::LodS
     } else {
         wire_fuzz::require(lod.counts.size() == curve.segment_count(), "count per segment missing");
         wire_fuzz::require(lod.required.size() == curve.segment_count(), "required count per segment missing");
+        // Below the node resolution a ring interval may span segments: counts of 0 mark the segments it crosses.
+        const uint32_t least = s.keep_node_resolution ? 1u : 0u;
+        wire_fuzz::require(lod.counts.empty() || lod.counts[0] >= 1, "visible wire without a first ring");
         for (std::size_t i = 0; i < lod.counts.size(); ++i) {
-            wire_fuzz::require(lod.required[i] >= 1 && lod.required[i] <= max_rings, "required count outside [1, max_rings]");
-            wire_fuzz::require(lod.counts[i] >= 1 && lod.counts[i] <= max_rings, "count outside [1, max_rings]");
+            wire_fuzz::require(lod.required[i] >= least && lod.required[i] <= max_rings, "required count outside [least, max_rings]");
+            wire_fuzz::require(lod.counts[i] >= least && lod.counts[i] <= max_rings, "count outside [least, max_rings]");
             wire_fuzz::require(lod.counts[i] >= lod.required[i], "count below what the tolerance requires");
         }
         wire_fuzz::require(lod.sides >= 3 && lod.sides <= max_sides, "sides outside [3, max_sides]");
@@ -218,6 +224,7 @@ void check(const wire::Curve& curve, const wire::LodView& view, const wire::LodS
             std::fprintf(stderr, "segment %zu has a point inside the frustum\n", i);
             wire_fuzz::fail("wire culled although a curve point is on screen");
         }
+        if (!s.keep_node_resolution) continue;  // spans decide counts across segments: visibility is the property
         const uint32_t need = wire::segment_ring_count_px(curve.segments[i], view, s.tolerance_px, s.max_rings_per_segment);
         if (lod.required[i] != need) {
             std::fprintf(stderr, "segment %zu: required %u, the tolerance needs %u\n", i, lod.required[i], need);
