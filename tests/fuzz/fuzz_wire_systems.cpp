@@ -38,9 +38,9 @@ using engine::ecs::Registry;
 namespace ws = wire::systems;
 
 constexpr double kDt = 1.0 / 60.0;
-// Frames run after the last operation until no wire blends. A geomorph lasts at most
-// MultiresSettings::max_blend_frames (240) today and a bounded blend time (~0.25 s) after the remedy's rewrite:
-// 600 frames of 1/60 s (10 s) is beyond both, and independent of how the bound is expressed.
+// Frames run after the last operation until no wire blends. A geomorph lasts Style::blend_s (0 -> 0.25 s) and at
+// most MultiresSettings::max_blend_s (4 s, 240 frames at 60 Hz): 600 frames of 1/60 s (10 s) is beyond that, and
+// the property reads only the public WireContext::blending / WireCurve::blending.
 constexpr int kSettleFrames = 600;
 constexpr std::size_t kMaxWires = 6;
 constexpr std::size_t kMaxNodes = 40;
