@@ -1,6 +1,10 @@
 // glTF reading and writing; the only translation unit that compiles tinygltf's implementation.
 #define TINYGLTF_IMPLEMENTATION
-// stb's implementations come from Debian's libstb.so (see cmake/Dependencies.cmake).
+// Geometry only: no image is ever decoded (no stb_image on untrusted bytes, see the image loader below) nor
+// written, and an image's external URI is never opened.
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
 
 #include <engine/assets/gltf.hpp>
@@ -11,12 +15,17 @@
 #include <glm/mat3x3.hpp>
 #include <glm/mat4x4.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 namespace engine::assets {
@@ -174,10 +183,15 @@ Status read_float_accessor(const tinygltf::Model& model, int index, int componen
     const std::vector<unsigned char>& data = model.buffers[v.buffer].data;
     const std::size_t elem = std::size_t(components) * 4;
     const std::size_t stride = v.byteStride ? v.byteStride : elem;
-    const std::size_t start = v.byteOffset + a.byteOffset;
-    if (a.count > 0 && (stride < elem || start + stride * (a.count - 1) + elem > data.size() ||
-                        start + stride * (a.count - 1) + elem > v.byteOffset + v.byteLength))
+    // Overflow-safe (counts and offsets come from the file): the last element, [start + stride * (count - 1),
+    // + elem), lies within the view, and the view within the buffer.
+    const std::size_t view_begin = std::min(v.byteOffset, data.size());
+    const std::size_t view_end = v.byteLength > data.size() - view_begin ? data.size() : view_begin + v.byteLength;
+    const std::size_t room = view_end - view_begin;
+    if (a.count > 0 && (stride < elem || a.byteOffset > room || room - a.byteOffset < elem ||
+                        a.count - 1 > (room - a.byteOffset - elem) / stride))
         return Status::failure(who + ": accessor " + std::to_string(index) + " reads past its buffer");
+    const std::size_t start = view_begin + a.byteOffset;
     out.resize(a.count * components);
     for (std::size_t i = 0; i < a.count; ++i) std::memcpy(&out[i * components], &data[start + i * stride], elem);
     return {};
@@ -203,9 +217,13 @@ Status read_indices(const tinygltf::Model& model, int index, std::vector<uint32_
         return Status::failure(who + ": index buffer view names no buffer");
     const std::vector<unsigned char>& data = model.buffers[v.buffer].data;
     const std::size_t stride = v.byteStride ? v.byteStride : size;
-    const std::size_t start = v.byteOffset + a.byteOffset;
-    if (a.count > 0 && (stride < size || start + stride * (a.count - 1) + size > data.size()))
+    // Overflow-safe, as in read_float_accessor.
+    const std::size_t begin = std::min(v.byteOffset, data.size());
+    const std::size_t room = data.size() - begin;
+    if (a.count > 0 && (stride < size || a.byteOffset > room || room - a.byteOffset < size ||
+                        a.count - 1 > (room - a.byteOffset - size) / stride))
         return Status::failure(who + ": index accessor reads past its buffer");
+    const std::size_t start = begin + a.byteOffset;
     out.resize(a.count);
     for (std::size_t i = 0; i < a.count; ++i) {
         const unsigned char* p = &data[start + i * stride];
@@ -351,7 +369,189 @@ Status convert_model(const tinygltf::Model& model, const std::string& file, std:
     return {};
 }
 
-// Filesystem callbacks for in-memory reading: there is no directory, so an external URI is an error.
+// ---- untrusted input: the GLB container, the JSON's buffers and images, external URIs ----
+
+constexpr uint32_t kChunkJson = 0x4E4F534Au;  // "JSON" little-endian
+constexpr uint32_t kChunkBin = 0x004E4942u;   // "BIN\0"
+constexpr std::size_t kMaxBytes = std::numeric_limits<unsigned int>::max();  // tinygltf takes an unsigned int size
+
+uint32_t le32(const unsigned char* p) {
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+std::string chunk_name(uint32_t type) {
+    if (type == kChunkJson) return "JSON";
+    if (type == kChunkBin) return "BIN";
+    char hex[16];
+    std::snprintf(hex, sizeof hex, "0x%08x", type);
+    return std::string("of unknown type ") + hex;
+}
+
+/// The GLB container as validated by check_glb.
+struct Glb {
+    uint32_t length = 0;     ///< bytes of the GLB (the header's length; trailing bytes after it are ignored)
+    std::size_t json_offset = 0, json_size = 0;
+    bool has_bin = false;
+    std::size_t bin_size = 0;
+};
+
+/// Checks the binary glTF container before tinygltf sees it (tinygltf 2.7.0 trusts the BIN chunk's length:
+/// a BIN chunk claiming more bytes than the file holds is read past the end). Returns what is wrong, or nothing.
+/// Layout: 12-byte header (magic "glTF", version 2, total length), then chunks of [length, type, data], each
+/// length a multiple of 4; the first chunk is JSON, the second (if any) BIN, later chunks of unknown types are
+/// skipped (glTF 2.0 spec), and the chunks fill the length exactly.
+std::optional<std::string> check_glb(const unsigned char* data, std::size_t size, Glb& glb) {
+    if (size < 12) return "shorter than the 12-byte GLB header (" + std::to_string(size) + " bytes)";
+    if (std::memcmp(data, "glTF", 4) != 0) return std::string("the magic is not 'glTF'");
+    const uint32_t version = le32(data + 4);
+    if (version != 2) return "GLB version " + std::to_string(version) + " is not supported (only version 2)";
+    const uint32_t length = le32(data + 8);
+    if (length > size)
+        return "the header's length " + std::to_string(length) + " exceeds the " + std::to_string(size) +
+               " bytes given (truncated file?)";
+    if (length % 4 != 0) return "the header's length " + std::to_string(length) + " is not a multiple of 4";
+    if (length < 20) return "the header's length " + std::to_string(length) + " leaves no room for the JSON chunk";
+    glb.length = length;
+    std::size_t offset = 12;
+    for (std::size_t k = 0; offset < length; ++k) {
+        const std::string at = "chunk " + std::to_string(k) + " at byte " + std::to_string(offset);
+        if (length - offset < 8)
+            return at + ": its 8-byte header runs past the GLB length " + std::to_string(length);
+        const uint32_t chunk_length = le32(data + offset);
+        const uint32_t type = le32(data + offset + 4);
+        const std::string what = "chunk " + std::to_string(k) + " (" + chunk_name(type) + ") at byte " +
+                                 std::to_string(offset);
+        const std::size_t left = length - offset - 8;
+        if (chunk_length > left)
+            return what + " claims " + std::to_string(chunk_length) + " bytes but only " + std::to_string(left) +
+                   " follow its header (GLB length " + std::to_string(length) + ")";
+        if (chunk_length % 4 != 0)
+            return what + ": length " + std::to_string(chunk_length) + " is not a multiple of 4 (4-byte alignment)";
+        if (k == 0 && type != kChunkJson) return "the first chunk is not JSON: " + what;
+        if (k > 0 && type == kChunkJson) return what + " is a second JSON chunk";
+        if (type == kChunkBin && glb.has_bin) return what + " is a second BIN chunk";
+        if (type == kChunkBin && k != 1) return what + ": the BIN chunk must directly follow the JSON chunk";
+        if (k == 1 && type != kChunkBin) return what + ": the second chunk must be BIN";
+        if (chunk_length == 0) return what + " is empty";
+        if (k == 0) {
+            glb.json_offset = offset + 8;
+            glb.json_size = chunk_length;
+        } else if (type == kChunkBin) {
+            glb.has_bin = true;
+            glb.bin_size = chunk_length;
+        }
+        offset += 8 + std::size_t(chunk_length);
+    }
+    return std::nullopt;
+}
+
+/// A non-negative integer member of a JSON object (absent: `fallback`; present but not one: nothing).
+std::optional<uint64_t> unsigned_member(const nlohmann::json& o, const char* key, std::optional<uint64_t> fallback) {
+    const auto it = o.find(key);
+    if (it == o.end()) return fallback;
+    if (it->is_number_unsigned()) return it->get<uint64_t>();
+    if (it->is_number_integer() && it->get<int64_t>() >= 0) return static_cast<uint64_t>(it->get<int64_t>());
+    return std::nullopt;
+}
+
+/// What tinygltf 2.7.0 does not check on its own, in the parsed JSON: a GLB's BIN-chunk buffers (every buffer
+/// without a uri reads the BIN chunk: its byteLength must be 1..BIN size) and the byte range of an image's buffer
+/// view (tinygltf takes a pointer at the view's offset into the buffer without checking it). Returns what is wrong.
+std::optional<std::string> check_json(const nlohmann::json& root, const Glb* glb) {
+    std::vector<uint64_t> buffer_bytes;
+    if (const auto b = root.find("buffers"); b != root.end() && b->is_array()) {
+        for (std::size_t i = 0; i < b->size(); ++i) {
+            const nlohmann::json& buffer = (*b)[i];
+            const std::string who = "buffer " + std::to_string(i);
+            if (!buffer.is_object()) return who + " is not a JSON object";
+            const std::optional<uint64_t> bytes = unsigned_member(buffer, "byteLength", std::nullopt);
+            if (!bytes || *bytes == 0) return who + ": byteLength must be a positive integer";
+            buffer_bytes.push_back(*bytes);
+            if (glb == nullptr || buffer.contains("uri")) continue;
+            if (!glb->has_bin) return who + " has no uri and the GLB has no BIN chunk";
+            if (*bytes > glb->bin_size)
+                return who + ": byteLength " + std::to_string(*bytes) + " exceeds the BIN chunk (" +
+                       std::to_string(glb->bin_size) + " bytes)";
+        }
+    }
+    const auto views = root.find("bufferViews");
+    if (const auto images = root.find("images"); images != root.end() && images->is_array()) {
+        for (std::size_t i = 0; i < images->size(); ++i) {
+            const nlohmann::json& image = (*images)[i];
+            if (!image.is_object() || !image.contains("bufferView")) continue;  // tinygltf reports those
+            const std::string who = "image " + std::to_string(i);
+            const std::optional<uint64_t> v = unsigned_member(image, "bufferView", std::nullopt);
+            if (!v || views == root.end() || !views->is_array() || *v >= views->size())
+                return who + ": bufferView does not exist";
+            const nlohmann::json& view = (*views)[*v];
+            bool in_range = false;
+            if (view.is_object()) {
+                const uint64_t buffer = unsigned_member(view, "buffer", std::nullopt).value_or(UINT64_MAX);
+                const uint64_t offset = unsigned_member(view, "byteOffset", 0).value_or(UINT64_MAX);
+                const uint64_t bytes = unsigned_member(view, "byteLength", std::nullopt).value_or(UINT64_MAX);
+                in_range = buffer < buffer_bytes.size() && offset <= buffer_bytes[buffer] &&
+                           bytes <= buffer_bytes[buffer] - offset;
+            }
+            if (!in_range)
+                return who + ": buffer view " + std::to_string(*v) + " is not a byte range of an existing buffer";
+        }
+    }
+    return std::nullopt;
+}
+
+// Images are never decoded (geometry only): the loader keeps nothing and succeeds, so a file with textures loads.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;
+}
+
+// Filesystem callbacks. In memory there is no directory, so an external URI is an error. From a file, an
+// external buffer must be a regular file inside the glTF file's directory (no absolute path, no '..' out of it,
+// no device or pipe): a hostile file cannot make the loader read /etc/..., block on a FIFO, or pick up files
+// from the working directory (tinygltf also searches '.').
+struct FileScope {
+    std::filesystem::path dir;  // canonical directory of the glTF file
+};
+
+std::optional<std::filesystem::path> inside(const std::string& path, const FileScope& scope) {
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+    if (ec) return std::nullopt;
+    const std::filesystem::path rel = p.lexically_relative(scope.dir);
+    if (rel.empty() || *rel.begin() == "..") return std::nullopt;
+    return p;
+}
+
+bool scoped_file_exists(const std::string& path, void*) {
+    std::error_code ec;
+    return std::filesystem::exists(path, ec);  // reported (or refused) by scoped_read with a clear reason
+}
+
+bool scoped_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    const FileScope& scope = *static_cast<const FileScope*>(user);
+    const std::optional<std::filesystem::path> p = inside(path, scope);
+    std::error_code ec;
+    if (!p) {
+        if (err) *err += "external file '" + path + "' is outside the directory of the glTF file\n";
+        return false;
+    }
+    if (!std::filesystem::is_regular_file(*p, ec)) {
+        if (err) *err += "external file '" + path + "' is not a regular file\n";
+        return false;
+    }
+    const auto bytes = std::filesystem::file_size(*p, ec);
+    if (ec || bytes > kMaxBytes) {
+        if (err) *err += "external file '" + path + "' cannot be sized or is larger than 4 GiB\n";
+        return false;
+    }
+    std::ifstream in(*p, std::ios::binary);
+    out->resize(static_cast<std::size_t>(bytes));
+    if (!in || !in.read(reinterpret_cast<char*>(out->data()), static_cast<std::streamsize>(out->size()))) {
+        if (err) *err += "external file '" + path + "' cannot be read\n";
+        return false;
+    }
+    return true;
+}
+
 bool no_file_exists(const std::string&, void*) { return false; }
 std::string same_path(const std::string& path, void*) { return path; }
 bool no_read(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
@@ -363,43 +563,86 @@ bool no_write(std::string* err, const std::string&, const std::vector<unsigned c
     return false;
 }
 
+/// Every read: the container and JSON checks, then tinygltf (geometry only), then the conversion. `scope` null:
+/// in memory (no external file); otherwise the directory external buffers may come from.
+Status load(const unsigned char* data, std::size_t size, const std::string& name, FileScope* scope,
+            std::vector<MeshData>& out) {
+    out.clear();
+    if (size > kMaxBytes) return Status::failure(name + ": larger than 4 GiB");
+    const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
+    Glb glb;
+    if (size == 0) data = reinterpret_cast<const unsigned char*>("");
+    const char* json_text = reinterpret_cast<const char*>(data);
+    std::size_t json_size = size;
+    if (binary) {
+        if (const auto bad = check_glb(data, size, glb))
+            return Status::failure(name + ": not a valid GLB file: " + *bad);
+        json_text += glb.json_offset;
+        json_size = glb.json_size;
+    }
+    // tinygltf converts extras and extensions to its Value recursively: a deeply nested array overflowed the stack
+    // (100,000 levels in a 200 kB file). glTF itself nests about 6 levels; 128 leaves room for any extras.
+    constexpr int kMaxDepth = 128;
+    struct TooDeep {};
+    nlohmann::json root;
+    try {
+        root = nlohmann::json::parse(json_text, json_text + json_size,
+                                     [](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+                                         if (depth > kMaxDepth) throw TooDeep{};
+                                         return true;
+                                     });
+    } catch (const TooDeep&) {
+        return Status::failure(name + ": not a readable glTF file: JSON nested deeper than " +
+                               std::to_string(kMaxDepth) + " levels");
+    } catch (const std::exception& e) {
+        return Status::failure(name + ": not a readable glTF file: " + e.what());
+    }
+    if (root.is_object())  // otherwise tinygltf says what is wrong
+        if (const auto bad = check_json(root, binary ? &glb : nullptr))
+            return Status::failure(name + ": not a readable glTF file: " + *bad);
+
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    if (scope != nullptr)
+        loader.SetFsCallbacks(tinygltf::FsCallbacks{&scoped_file_exists, &same_path, &scoped_read, &no_write, scope});
+    else
+        loader.SetFsCallbacks(tinygltf::FsCallbacks{&no_file_exists, &same_path, &no_read, &no_write, nullptr});
+    loader.SetImageLoader(&skip_image, nullptr);
+    const std::string base_dir = scope != nullptr ? scope->dir.string() : std::string();
+    std::string err, warn;
+    bool ok = false;
+    try {  // tinygltf 2.7.0 throws std::out_of_range on some inputs (.at(0) of an empty vector)
+        ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, glb.length, base_dir)
+                    : loader.LoadASCIIFromString(&model, &err, &warn, json_text, static_cast<unsigned int>(size),
+                                                 base_dir);
+    } catch (const std::exception& e) {
+        return Status::failure(name + ": not a readable glTF file: " + e.what());
+    }
+    if (!ok) return Status::failure(name + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
+    return convert_model(model, name, out);
+}
+
 }  // namespace
 
 Status read_gltf(const std::string& path, std::vector<MeshData>& out) {
     out.clear();
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) return Status::failure(path + ": cannot open: " + std::strerror(errno));
-    char magic[4] = {};
-    probe.read(magic, 4);
-    const bool binary = probe.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
-    probe.close();
-
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    std::string err, warn;
-    const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                           : loader.LoadASCIIFromFile(&model, &err, &warn, path);
-    if (!ok) return Status::failure(path + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
-    return convert_model(model, path, out);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return Status::failure(path + ": cannot open: " + std::strerror(errno));
+    std::vector<unsigned char> bytes;
+    char block[1 << 16];
+    while (in.read(block, sizeof block) || in.gcount() > 0) {
+        bytes.insert(bytes.end(), block, block + in.gcount());
+        if (bytes.size() > kMaxBytes) return Status::failure(path + ": larger than 4 GiB");
+    }
+    if (in.bad()) return Status::failure(path + ": read error: " + std::strerror(errno));
+    FileScope scope;
+    std::error_code ec;
+    scope.dir = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec).parent_path(), ec);
+    return load(bytes.data(), bytes.size(), path, &scope, out);
 }
 
 Status read_gltf_memory(std::span<const std::byte> bytes, const std::string& name, std::vector<MeshData>& out) {
-    out.clear();
-    if (bytes.size() > std::numeric_limits<unsigned int>::max())
-        return Status::failure(name + ": larger than 4 GiB");
-    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-    const auto size = static_cast<unsigned int>(bytes.size());
-    const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
-
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    loader.SetFsCallbacks(tinygltf::FsCallbacks{&no_file_exists, &same_path, &no_read, &no_write, nullptr});
-    std::string err, warn;
-    const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, size, "")
-                           : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(data),
-                                                        size, "");
-    if (!ok) return Status::failure(name + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
-    return convert_model(model, name, out);
+    return load(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), name, nullptr, out);
 }
 
 }  // namespace engine::assets

@@ -693,7 +693,12 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     const std::size_t n = curve.segment_count();
     if (sphere_cull && bounds.sphere.radius_m >= 0.0) {
         const ViewTransform tf(view);
-        if (PlaneTest(view, bounds.sphere.radius_m).outside(tf(bounds.sphere.centre_m)) != 0) {
+        // The centre and the hull's control points each reach view space with a rounding error of a few ulps of
+        // |point| + |eye|; far from the origin (5e11 m: ~1e-4 m) that exceeds the sphere's own slack and the
+        // sphere could cull a wire the hull test keeps. Inflate the sphere by a bound of both errors.
+        const double rounding = 64.0 * std::numeric_limits<double>::epsilon() *
+                                (glm::length(bounds.sphere.centre_m) + glm::length(view.eye_m));
+        if (PlaneTest(view, bounds.sphere.radius_m + rounding).outside(tf(bounds.sphere.centre_m)) != 0) {
             bool changed = false;
             mark_culled(lod, changed);
             return changed;
@@ -802,7 +807,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         // Per-segment hysteresis on the Wang counts (all >= 1), then the spans over both.
         lod.counts.resize(n);
         for (std::size_t i = 0; i < n; ++i)
-            lod.counts[i] = hysteresis_count(old[i], lod.required[i], lim.band);
+            // Hysteresis keeps an old count, but never above the cap in force now (it may have been lowered).
+            lod.counts[i] = std::min(hysteresis_count(old[i], lod.required[i], lim.band), lim.max_rings);
         if (merge) lod.spans = merger.apply(lod.required, lod.counts);
     }
     bool changed = restart;
@@ -817,10 +823,11 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     lod.z_min_m = std::isfinite(wire_z) ? wire_z : 0.0;
     lod.required_sides =
         std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides) : 3u;
-    const uint32_t sides =
-        restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band);
+    // Clamped before the comparison: a lowered max_sides changes the sides, and the caller must hear of it.
+    const uint32_t sides = std::min(
+        restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band), lim.max_sides);
     changed = changed || sides != lod.sides;
-    lod.sides = std::min(sides, lim.max_sides);
+    lod.sides = sides;
     if (use_bound && lod.bounded && sb.inside && merger.margin() > 1.0) {
         WireLod::Coherence& c = lod.coherence;
         c.valid = true;

@@ -28,6 +28,12 @@ std::string node_prefix(std::size_t i) { return "node " + std::to_string(i) + ":
 // Largest accepted |coordinate| (metres): the tube's float vertices (relative to ring 0) and squared chord
 // lengths must stay finite; 1e12 m is far beyond any scene (DESIGN §5 asks for 1e6 m from the origin).
 constexpr double kMaxCoordinate_m = 1e12;
+// Smallest accepted tube radius (metres) and node stretch: texture u grows as arc length / (2 pi radius stretch)
+// and is stored as float; with both >= 1e-6 it stays below ~1e32 for any curve within kMaxCoordinate_m (a
+// denormal radius overflowed it to Inf: fuzz_geometry). The radius polynomial between nodes is monotone, so
+// node radii bound it from below.
+constexpr float kMinRadius_m = 1e-6f;
+constexpr float kMinStretch = 1e-6f;
 
 // The log-domain knot ratio's clamp, exp(-+300), for the pow-free alphas.
 const double kMinKnotRatio = std::exp(-300.0);
@@ -74,6 +80,8 @@ Status check_settings(const SplineSettings& s) {
         if (!std::isfinite(f.v)) return Status::error(std::string("settings.") + f.name + " is " + describe(f.v));
     }
     if (s.radius_m < 0.0f) return Status::error("settings.radius_m is " + describe(s.radius_m) + " (must be > 0; 0 means 1 cm)");
+    if (s.radius_m > 0.0f && s.radius_m < kMinRadius_m)
+        return Status::error("settings.radius_m is " + describe(s.radius_m) + " (below the smallest supported radius, 1e-6 m)");
     if (s.merge_epsilon_rel < 0.0) return Status::error("settings.merge_epsilon_rel is " + describe(s.merge_epsilon_rel) + " (must be >= 0)");
     return Status::success();
 }
@@ -88,12 +96,16 @@ Status check_nodes(const WireNodes& w, bool use_physics) {
                 return Status::error(node_prefix(i) + "position." + kAxis[a] + " is " + describe(v) +
                                          " (beyond the supported range of +-1e12 m)", static_cast<int>(i));
         }
-        if (!w.stretch.empty() && !(w.stretch[i] > 0.0f && std::isfinite(w.stretch[i]))) {
-            return Status::error(node_prefix(i) + "stretch is " + describe(w.stretch[i]) + " (must be finite and > 0)", static_cast<int>(i));
+        if (!w.stretch.empty() && !(w.stretch[i] >= kMinStretch && std::isfinite(w.stretch[i]))) {
+            return Status::error(node_prefix(i) + "stretch is " + describe(w.stretch[i]) + " (must be finite and >= 1e-6)", static_cast<int>(i));
         }
         if (!w.radius_m.empty() && !(w.radius_m[i] >= 0.0f && std::isfinite(w.radius_m[i]))) {
             return Status::error(node_prefix(i) + "radius_m is " + describe(w.radius_m[i]) +
                                      " (must be finite and >= 0; 0 uses the wire's radius)", static_cast<int>(i));
+        }
+        if (!w.radius_m.empty() && w.radius_m[i] > 0.0f && w.radius_m[i] < kMinRadius_m) {
+            return Status::error(node_prefix(i) + "radius_m is " + describe(w.radius_m[i]) +
+                                     " (below the smallest supported radius, 1e-6 m)", static_cast<int>(i));
         }
         const struct { const char* name; const std::vector<float>& v; } kb[] = {
             {"kb_tension", w.kb_tension}, {"kb_bias", w.kb_bias}, {"kb_continuity", w.kb_continuity}};

@@ -434,6 +434,47 @@ TEST(LodHysteresis, CountsComeDownWhenTheCameraLeaves) {
     }
 }
 
+// Found by fuzz_lod (tests/fuzz/corpus/fuzz_lod/regression_lowered_ring_cap.bin, regression_lowered_side_cap.bin):
+// with max_rings_per_segment lowered between two updates, hysteresis kept counts above the new cap; with
+// max_sides lowered, the sides were clamped but update_lod returned "unchanged". Family: random camera walks around a
+// hanging cable with the ring and side caps changed every few frames; every count stays within the cap in force
+// and every change is reported.
+TEST(LodHysteresis, CountsNeverExceedACapLoweredBetweenUpdates) {
+    const Curve curve = hanging_curve(16);
+    Rng rng(15);
+    std::size_t capped_updates = 0;
+    for (int walk = 0; walk < 20; ++walk) {
+        WireLod lod;
+        LodSettings settings;
+        double angle = uniform(rng, 0.0, 6.28), distance = uniform(rng, 0.3, 3.0);
+        for (int frame = 0; frame < 40; ++frame) {
+            if (frame % 5 == 0) {
+                settings.max_rings_per_segment = static_cast<uint32_t>(uniform(rng, 0.0, 64.0));  // 0: default 256
+                settings.max_sides = static_cast<uint32_t>(uniform(rng, 0.0, 40.0));
+                settings.tolerance_px = uniform(rng, 0.05, 2.0);
+            }
+            angle += uniform(rng, -0.05, 0.05);
+            distance = std::clamp(distance * std::exp(uniform(rng, -0.3, 0.3)), 0.2, 50.0);
+            const WireLod before = lod;
+            const bool changed = update_lod(curve, orbit_camera(angle, distance), settings, lod);
+            // The return value tells the ring stage to rebuild: it must be true whenever counts or sides changed.
+            if (lod.counts != before.counts || lod.sides != before.sides) {
+                ASSERT_TRUE(changed) << "frame " << frame;
+            }
+            if (!lod.visible) continue;
+            const uint32_t cap = settings.max_rings_per_segment ? settings.max_rings_per_segment : 256u;
+            const uint32_t side_cap = std::max<uint32_t>(settings.max_sides ? settings.max_sides : 32u, 3u);
+            for (std::size_t i = 0; i < lod.counts.size(); ++i) {
+                ASSERT_LE(lod.counts[i], cap) << "walk " << walk << " frame " << frame << " segment " << i;
+                ASSERT_GE(lod.counts[i], lod.required[i]);
+                capped_updates += lod.required[i] == cap ? 1 : 0;
+            }
+            ASSERT_LE(lod.sides, side_cap);
+        }
+    }
+    EXPECT_GT(capped_updates, 0u);  // the family does reach the cap
+}
+
 TEST(LodCulling, CulledWireGetsNoRings) {
     const Curve curve = hanging_curve(16);
     WireLod lod;
@@ -745,6 +786,74 @@ TEST(LodSpans, RingsKeepFramesAndTextureContinuous) {
         EXPECT_LT(coarse.size(), fine.size());
     }
     EXPECT_GT(spanned, 10);
+}
+
+// Found by fuzz_lod (tests/fuzz/corpus/fuzz_lod/regression_far_sphere_cull.bin): 5e11 m from the origin the
+// sphere test culled a wire the hull test keeps (rounding of the centre and of the view transform, ~1e-4 m
+// there, exceeded the sphere's relative slack; a 155-degree view amplified it). Family: the wires above, shrunk
+// to 1e-5..1 m, anywhere up to the contract's 1e12 m from the origin, cameras with 17..172-degree views within
+// 10 m of them or with a curve point on the near plane; the sphere must never decide otherwise than the hull test.
+// (This family did not trip the old code: the exact case is the regression test below.)
+TEST(LodCulling, BoundingSphereAgreesWithTheHullTestFarFromTheOrigin) {
+    Rng rng(29);
+    int culled = 0, visible = 0, collapsed = 0;
+    for (int i = 0; i < 600; ++i) {
+        WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
+        const glm::dvec3 shift = random_unit(rng) * std::pow(10.0, uniform(rng, 0.0, 11.9));
+        const double scale = std::pow(10.0, uniform(rng, -5.0, 0.0));
+        for (glm::dvec3& p : nodes.positions) p = shift + scale * p;
+        Curve curve;
+        const float radius = std::max(1e-6f, static_cast<float>(scale * uniform(rng, 0.001, 0.3)));
+        if (!build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok) {
+            ++collapsed;  // nodes that collapse in double at this distance
+            continue;
+        }
+        const BoundingSphere sphere = curve_bounding_sphere(curve);
+        // Half the cameras see the wire from up to 10 m; half put a curve point on the near plane (the decision at
+        // the frustum's edge is where rounding matters).
+        const double near_m = std::pow(10.0, uniform(rng, -4.0, 1.0));
+        const glm::dvec3 on = position(curve.segments[0], uniform(rng, 0.0, 1.0));
+        const glm::dvec3 dir = random_unit(rng);
+        const bool edge = i % 2 == 1;
+        const glm::dvec3 eye = edge ? on - near_m * dir : shift + random_unit(rng) * (scale * uniform(rng, 0.0, 10.0));
+        const glm::dvec3 target = edge ? on + dir : shift + random_unit(rng) * scale * 5.0;
+        const LodView view = LodView::perspective(eye, target, glm::dvec3(0, 1, 0), uniform(rng, 0.3, 3.0), kWidth,
+                                                  kHeight * uniform(rng, 0.5, 2.0), near_m, near_m + 60.0);
+        WireLod with, without;
+        update_lod(curve, view, {}, without);
+        update_lod(curve, view, {}, with, &sphere);
+        ASSERT_EQ(with.visible, without.visible) << "case " << i << " at " << glm::length(shift) << " m";
+        ASSERT_EQ(with.counts, without.counts) << "case " << i;
+        culled += with.visible ? 0 : 1;
+        visible += with.visible ? 1 : 0;
+    }
+    EXPECT_GT(culled, 60);
+    EXPECT_GT(visible, 60);
+    EXPECT_LT(collapsed, 100);
+}
+
+// The fuzz_lod input of the test above, decoded: a 0.1 mm wire 9.7e11 m from the origin on the near plane of a
+// 155-degree view. The hull test keeps it; the sphere culled it before the rounding bound.
+TEST(LodCulling, BoundingSphereFarFromTheOriginRegression) {
+    Curve curve;
+    curve.segments = {{{555364265685.56042, -735673314417.42676, 294024426490.06848},
+                       {555364265685.56055, -735673314417.42676, 294024426490.06854},
+                       {555364265685.56042, -735673314417.42676, 294024426490.06842},
+                       {555364265685.56042, -735673314417.42676, 294024426490.06854}}};
+    curve.source_node = {0, 1};
+    curve.radius_m = {1.5159344e-05f, 2.70267756e-05f};
+    curve.stretch = {1.0f};
+    const LodView view = LodView::perspective({555364265690.31885, -735673314417.73718, 294024426491.73529},
+                                              {555364265684.61841, -735673314417.36523, 294024426489.73853},
+                                              {0, 1, 0}, 2.6987877391675328, 4366.9661316839656, 5607.6537742491,
+                                              5.0514119181361661, 249.85603216593867);
+    const BoundingSphere sphere = curve_bounding_sphere(curve);
+    WireLod with, without;
+    update_lod(curve, view, {}, without);
+    update_lod(curve, view, {}, with, &sphere);
+    EXPECT_TRUE(without.visible);
+    EXPECT_EQ(with.visible, without.visible);
+    EXPECT_EQ(with.counts, without.counts);
 }
 
 TEST(LodCulling, OffscreenSegmentsAreCoarse) {

@@ -440,6 +440,34 @@ TEST(WireSystems, InsertAndRemoveNodeKeepArraysAndIds) {
     EXPECT_EQ(w.ctx.draw_list.items.size(), 1u);
 }
 
+// Found by fuzz_wire_systems (tests/fuzz/corpus/fuzz_wire_systems/regression_insert_short_array.bin): a wire
+// whose stretch array is one short (reported as a WireError) got insert_node at the end: the array was written
+// past its end (vector::insert beyond end(), ASan negative-size-param). Now the array stays one short, the error
+// stays reported with the new count, and the wire recovers once the array is fixed.
+TEST(WireSystems, InsertAndRemoveNodeOnAWireWithAShortArray) {
+    World w;
+    WireNodes n = cable(6, {-1, 0, 0}, 2.0, 0.2);
+    n.stretch.assign(5, 1.0f);  // one short
+    const Entity e = spawn_wire(w.registry, n);
+    w.run();
+    ASSERT_NE(wire_error(w.registry, e), nullptr);
+    EXPECT_EQ(wire_error(w.registry, e)->message,
+              describe_entity(e) + ": stretch has 5 entries for 6 nodes (must be empty or one per node)");
+    (void)insert_node(w.registry, e, 6, glm::dvec3(1.2, 0.0, 0.0));  // append: past the stretch array's end
+    (void)insert_node(w.registry, e, 0, glm::dvec3(-1.2, 0.0, 0.0));
+    EXPECT_EQ(w.registry.get<Nodes>(e).positions.size(), 8u);
+    EXPECT_EQ(w.registry.get<Nodes>(e).stretch.size(), 7u);
+    w.run();
+    ASSERT_EQ(w.ctx.new_errors.size(), 1u);  // the message changed: reported again, once
+    EXPECT_EQ(w.ctx.new_errors[0].message,
+              describe_entity(e) + ": stretch has 7 entries for 8 nodes (must be empty or one per node)");
+    remove_node(w.registry, e, 7);  // past the stretch array's end: nothing to erase there, lengths now agree
+    EXPECT_EQ(w.registry.get<Nodes>(e).stretch.size(), 7u);
+    w.run();
+    EXPECT_EQ(wire_error(w.registry, e), nullptr);
+    EXPECT_EQ(w.ctx.draw_list.items.size(), 1u);
+}
+
 TEST(WireSystems, FirstFrameIsCarriedOver) {
     // The wire's first tangent sweeps through the world axes while it turns slowly: a re-seeded first normal
     // would jump; the carried one turns as little as the tangent does.

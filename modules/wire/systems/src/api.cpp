@@ -12,9 +12,12 @@ using engine::ecs::Entity;
 using engine::ecs::Registry;
 
 // Inserts a copy of the neighbouring entry at `at` into an optional per-node array (empty arrays stay empty).
+// An array of the wrong length (a caller error the curve system reports) stays wrong by as much, never written
+// past its end.
 template <class T>
 void insert_like_neighbour(std::vector<T>& v, std::size_t at) {
     if (v.empty()) return;
+    at = std::min(at, v.size());
     const std::size_t from = at < v.size() ? at : v.size() - 1;
     const T value = v[from];
     v.insert(v.begin() + static_cast<std::ptrdiff_t>(at), value);
