@@ -220,6 +220,19 @@ BoundingSphere curve_bounding_sphere(const Curve& curve) {
 
 namespace {
 
+/// Tube, strip (2) or line (1) for a projected radius. Hysteresis: a thinner mode used last update is kept
+/// until the radius exceeds its threshold by the band (like the counts), so a wire at the switch distance does
+/// not alternate between two modes while the camera drifts.
+uint32_t drawn_sides_for(double radius_px, uint32_t sides, uint32_t old_drawn, const LodSettings& settings,
+                         double band) {
+    const double strip = settings.strip_radius_px == 0.0 ? 2.0 : settings.strip_radius_px;
+    const double line = settings.line_radius_px == 0.0 ? 0.5 : settings.line_radius_px;
+    const double keep = 1.0 + std::max(band, 0.0);
+    if (line > 0.0 && (radius_px < line || (old_drawn == 1 && radius_px < line * keep))) return 1;
+    if (strip > 0.0 && (radius_px < strip || (old_drawn == 2 && radius_px < strip * keep))) return 2;
+    return sides;
+}
+
 void mark_culled(WireLod& lod, bool& changed) {
     changed = lod.visible || !lod.counts.empty();
     lod.visible = false;
@@ -227,6 +240,8 @@ void mark_culled(WireLod& lod, bool& changed) {
     lod.required.clear();
     lod.sides = 0;
     lod.required_sides = 0;
+    lod.drawn_sides = 0;
+    lod.radius_px = 0.0;
     lod.z_min_m = 0.0;
     lod.visible_segments = 0;
     lod.clamped_segments = 0;
@@ -828,6 +843,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band), lim.max_sides);
     changed = changed || sides != lod.sides;
     lod.sides = sides;
+    lod.radius_px = std::isfinite(wire_z) ? radius * view.focal_px * wire_k / std::max(wire_z, view.near_m) : 0.0;
+    lod.drawn_sides = drawn_sides_for(lod.radius_px, lod.sides, lod.drawn_sides, settings, lim.band);
     if (use_bound && lod.bounded && sb.inside && merger.margin() > 1.0) {
         WireLod::Coherence& c = lod.coherence;
         c.valid = true;

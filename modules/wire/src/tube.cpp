@@ -8,6 +8,8 @@
 #include <cstring>
 #include <numbers>
 
+#include <glm/gtc/quaternion.hpp>
+
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -263,6 +265,48 @@ void build_tube(const RingSet& rings, const TubeSettings& settings, TubeMesh& ou
     out.indices.resize(c.indices);
     const float u_close = rings.closed && !rings.u.empty() ? static_cast<float>(rings.u.back()) : 0.0f;
     write_tube(rings.rings, rings.closed, u_close, settings, out.vertices, out.indices);
+}
+
+glm::vec3 ring_frame_quaternion_xyz(const Ring& ring) {
+    const glm::dvec3 r(ring.normal), s(ring.binormal);
+    const glm::dquat q = glm::normalize(glm::quat_cast(glm::dmat3(r, s, glm::cross(r, s))));
+    const double sign = q.w < 0.0 ? -1.0 : 1.0;
+    return glm::vec3(sign * q.x, sign * q.y, sign * q.z);
+}
+
+TubeCounts strip_counts(std::size_t ring_count, bool closed) {
+    if (ring_count == 0) return {};
+    const std::size_t rows = ring_count + (closed ? 1 : 0);
+    return {.vertices = rows * 2, .indices = (rows - 1) * 6};
+}
+
+TubeCounts write_strip(std::span<const Ring> rings, bool closed, float u_close, std::span<TubeVertex> vertices,
+                       std::span<uint32_t> indices, uint32_t base_vertex) {
+    const TubeCounts c = strip_counts(rings.size(), closed);
+    assert(vertices.size() >= c.vertices && indices.size() >= c.indices);
+    const std::size_t rows = c.vertices / 2;
+    for (std::size_t row = 0; row < rows; ++row) {
+        const Ring& ring = rings[row == rings.size() ? 0 : row];
+        const float u = row == rings.size() ? u_close : ring.u;
+        const glm::vec3 q = ring_frame_quaternion_xyz(ring);
+        vertices[2 * row] = {ring.centre_m, q, {u, -ring.radius_m}};
+        vertices[2 * row + 1] = {ring.centre_m, q, {u, ring.radius_m}};
+    }
+    for (std::size_t b = 0; b + 1 < rows; ++b) {
+        const auto a = static_cast<uint32_t>(base_vertex + 2 * b);
+        uint32_t* out = indices.data() + 6 * b;
+        out[0] = a + 1, out[1] = a + 3, out[2] = a + 2, out[3] = a + 1, out[4] = a + 2, out[5] = a;
+    }
+    return c;
+}
+
+void build_strip(const RingSet& rings, TubeMesh& out) {
+    const TubeCounts c = strip_counts(rings.rings.size(), rings.closed);
+    out.origin_m = rings.origin_m;
+    out.vertices.resize(c.vertices);
+    out.indices.resize(c.indices);
+    const float u_close = rings.closed && !rings.u.empty() ? static_cast<float>(rings.u.back()) : 0.0f;
+    write_strip(rings.rings, rings.closed, u_close, out.vertices, out.indices);
 }
 
 }  // namespace wire

@@ -882,5 +882,52 @@ TEST(LodCulling, OffscreenSegmentsAreCoarse) {
     EXPECT_LE(measure_screen_error(curve, params, view, 256).max_px, 0.5 * (1 + 1e-9));
 }
 
+
+// Thin wires: walking the camera away, the LOD draws a tube while the projected radius is >= 2 px
+// (strip_radius_px), a strip (drawn_sides 2) below, a phone-wire line (1) below 0.5 px; walking back, a thinner
+// mode is kept until the radius exceeds its threshold by the hysteresis band (1.25x). radius_px is the
+// projected radius at the nearest depth, checked against the pinhole formula.
+TEST(LodThinWires, TubeStripLineByProjectedRadiusWithHysteresis) {
+    const Curve curve = hanging_curve(16);
+    const double focal = 0.5 * kHeight / std::tan(0.5 * kFov);
+    WireLod lod;
+    uint32_t last = 0;
+    std::vector<uint32_t> seen;
+    auto mode_at = [&](double distance) {
+        const LodView view = orbit_camera(0.0, distance);
+        update_lod(curve, view, LodSettings{}, lod);
+        EXPECT_TRUE(lod.visible);
+        EXPECT_GT(lod.radius_px, 0.0);
+        EXPECT_LE(lod.radius_px, 0.02 * focal / (distance - 2.5) * 1.5);  // depth >= distance - half the wire
+        return lod.drawn_sides;
+    };
+    for (double d = 3.0; d < 300.0; d *= 1.03) {  // away
+        const uint32_t m = mode_at(d);
+        const double r = lod.radius_px;
+        if (r >= 2.0 * 1.25) EXPECT_EQ(m, lod.sides) << d;
+        if (r < 2.0 && r >= 0.5) EXPECT_EQ(m, 2u) << d;
+        if (r < 0.5) EXPECT_EQ(m, 1u) << d;
+        if (last != 0) EXPECT_LE(std::min(m, 3u), std::min(last, 3u)) << "modes only thin out going away";
+        if (seen.empty() || seen.back() != std::min(m, 3u)) seen.push_back(std::min(m, 3u));
+        last = m;
+    }
+    EXPECT_EQ(seen, (std::vector<uint32_t>{3, 2, 1}));
+    seen.clear();
+    for (double d = 300.0; d > 3.0; d /= 1.03) {  // back
+        const uint32_t m = mode_at(d);
+        const double r = lod.radius_px;
+        if (r < 0.5 * 1.25) EXPECT_EQ(m, 1u) << d;
+        if (r >= 0.5 * 1.25 && r < 2.0 * 1.25) EXPECT_EQ(m, 2u) << d;
+        if (r >= 2.0 * 1.25) EXPECT_GE(m, 3u) << d;
+        if (seen.empty() || seen.back() != std::min(m, 3u)) seen.push_back(std::min(m, 3u));
+    }
+    EXPECT_EQ(seen, (std::vector<uint32_t>{1, 2, 3}));
+    // Off: never a strip or line.
+    WireLod off;
+    update_lod(curve, orbit_camera(0.0, 250.0), LodSettings{.strip_radius_px = -1, .line_radius_px = -1}, off);
+    EXPECT_EQ(off.drawn_sides, off.sides);
+    EXPECT_GE(off.drawn_sides, 3u);
+}
+
 }  // namespace
 }  // namespace wire

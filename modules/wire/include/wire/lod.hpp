@@ -108,6 +108,12 @@ struct LodSettings {
     /// span several segments where the screen error allows (see the header comment); counts of 0 then mark the
     /// segments an interval crosses.
     bool keep_node_resolution = false;
+    /// Thin wires (DESIGN 4.5). Below a projected radius of strip_radius_px a wire is drawn as a camera-facing
+    /// strip (WireLod::drawn_sides 2: 2 vertices a ring, shaded as the tube it stands for), below line_radius_px
+    /// as a one-pixel phone-wire line with opacity = true width / drawn width (drawn_sides 1). 0 -> 2 px and
+    /// 0.5 px (a wire one pixel across); negative: never.
+    double strip_radius_px = 0.0;
+    double line_radius_px = 0.0;
 };
 
 /// One wire's LOD state for one camera (kept between frames for hysteresis).
@@ -120,6 +126,11 @@ struct WireLod {
     std::vector<uint32_t> required;  ///< per segment: rings the tolerance needs now (Wang count, or the spans)
     uint32_t sides = 0;              ///< radial sides used (>= required_sides); 0 if culled
     uint32_t required_sides = 0;     ///< radial sides the tolerance needs now
+    /// What the wire is drawn with: `sides` (a tube), 2 (a camera-facing strip) or 1 (a phone-wire line),
+    /// from radius_px against LodSettings::strip_radius_px / line_radius_px; 0 if culled.
+    uint32_t drawn_sides = 0;
+    /// Largest projected radius of the wire's visible part (pixels, at z_min_m with the off-axis factor).
+    double radius_px = 0.0;
     bool visible = false;            ///< the wire's control hull, inflated by its radius, meets the frustum
     uint32_t visible_segments = 0;   ///< segments whose inflated hull meets the frustum
     uint32_t clamped_segments = 0;   ///< segments whose required count hit max_rings_per_segment (bound not met)

@@ -65,4 +65,22 @@ struct TubeMesh {
 /// The tube of a ring set into `out` (resized).
 void build_tube(const RingSet& rings, const TubeSettings& settings, TubeMesh& out);
 
+// ---- camera-facing strips (thin wires, DESIGN 4.5) ------------------------------------------------------------
+// A strip wire is drawn with 2 vertices per ring, spread across the view by the vertex shader (the camera is not
+// known here, so the mesh does not change when the camera moves). Strip vertex, in TubeVertex's 32 bytes:
+//   position = ring centre, normal = xyz of the ring frame's unit quaternion (columns r, s, t; w >= 0 rebuilt as
+//   sqrt(1 - |xyz|^2)), uv = (ring u, -R) for the vertex on the -side edge, (ring u, +R) for the +side one.
+// Ring i's vertices are 2i (-) and 2i + 1 (+); a closed wire repeats ring 0 at the end with u = u_close.
+// Triangles per band i: (2i+1, 2i+3, 2i+2), (2i+1, 2i+2, 2i): counter-clockwise on screen when the +side edge
+// lies along t x (to eye). No caps.
+
+/// Frame quaternion (x, y, z) with w >= 0 of a ring (columns normal, binormal, normal x binormal).
+[[nodiscard]] glm::vec3 ring_frame_quaternion_xyz(const Ring& ring);
+/// Vertices and indices write_strip() needs: (rings [+1 closed]) * 2 and (rings - 1 [+1 closed]) * 6.
+[[nodiscard]] TubeCounts strip_counts(std::size_t ring_count, bool closed);
+TubeCounts write_strip(std::span<const Ring> rings, bool closed, float u_close, std::span<TubeVertex> vertices,
+                       std::span<uint32_t> indices, uint32_t base_vertex = 0);
+/// The strip of a ring set into `out` (resized).
+void build_strip(const RingSet& rings, TubeMesh& out);
+
 }  // namespace wire

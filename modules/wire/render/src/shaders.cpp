@@ -24,11 +24,64 @@ struct DrawData {
   uint ring_count; uint sides; uint flags; float u_close;
 };
 layout(std430, binding = 0) readonly buffer Draws { DrawData draws[]; };
-const uint kClosed = 1u, kCaps = 2u, kTilt = 4u;
+const uint kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;
+// 2: camera-facing strip, 1: phone-wire line, 0: tube.
+uint strip_mode(DrawData d) { return (d.flags & kStrip) != 0u ? 2u : (d.flags & kLine) != 0u ? 1u : 0u; }
 uniform mat4 u_clip_from_rel;   // projection * camera rotation: positions are camera-relative
+uniform vec2 u_viewport_px;     // viewport size (phone-wire lines are sized in pixels)
+uniform float u_focal_px;       // (viewport height / 2) * projection[1][1]: pixels per metre at depth 1
 out vec3 v_normal;
 out vec2 v_uv;
 out vec3 v_rel_m;               // fragment position minus camera position
+// Strips and phone-wire lines (DrawData.sides 2 and 1; 0 for tubes): the ring frame and the strip coordinate,
+// from which the fragment shader rebuilds the tube's normal.
+flat out uint v_mode;
+out vec3 v_tangent;
+out vec3 v_frame_r;
+out vec3 v_frame_s;
+out float v_strip;              // -1 .. 1 across the strip
+out float v_alpha;              // phone-wire opacity: true width / drawn width
+
+vec3 rotate_by(vec4 q, vec3 v) { return v + 2.0 * cross(q.xyz, cross(q.xyz, v) + q.w * v); }
+
+void tube_outputs() {
+  v_mode = 0u; v_tangent = vec3(0.0); v_frame_r = vec3(0.0); v_frame_s = vec3(0.0); v_strip = 0.0; v_alpha = 1.0;
+}
+
+// A camera-facing strip vertex (sides 2): the ring centre moved by +-R along t x (to eye), i.e. the edge of the
+// tube's silhouette seen from the eye. A phone-wire vertex (sides 1): the centre moved in screen space so the
+// line is one pixel across along the screen axis that crosses it most (each pixel column, or row, of the wire
+// gets one pixel), its opacity the true width over that drawn width.
+void strip_vertex(DrawData d, uint mode, vec3 centre, vec3 r, vec3 s, vec3 t, float radius, float u, float side) {
+  vec3 rel = d.offset_m + centre;
+  vec3 across = cross(t, -rel);
+  float len = length(across);
+  across = len > 1e-30 ? across / len : r;  // looking along the wire: any direction across it
+  v_mode = mode; v_tangent = t; v_frame_r = r; v_frame_s = s; v_strip = side;
+  v_normal = normalize(-rel);
+  v_uv = vec2(u, 0.0);
+  if (mode == 2u) {
+    rel += (side * radius) * across;
+    v_alpha = 1.0;
+    v_rel_m = rel;
+    gl_Position = u_clip_from_rel * vec4(rel, 1.0);
+    return;
+  }
+  vec4 clip = u_clip_from_rel * vec4(rel, 1.0);
+  vec4 ahead = u_clip_from_rel * vec4(rel + t * max(radius, 1e-3 * max(clip.w, 1e-6)), 1.0);
+  vec2 dir = ahead.xy / ahead.w - clip.xy / clip.w;
+  dir *= u_viewport_px;  // to pixels (times 2, irrelevant for the direction)
+  float dl = length(dir);
+  dir = dl > 0.0 ? dir / dl : vec2(1.0, 0.0);
+  float drawn_half_px = 0.5 * max(abs(dir.x), abs(dir.y));  // half of 1 px along the crossing axis
+  float true_half_px = radius * u_focal_px / max(clip.w, 1e-6);
+  float half_px = max(drawn_half_px, true_half_px);
+  v_alpha = clamp(true_half_px / half_px, 0.0, 1.0);
+  vec2 perp = vec2(dir.y, -dir.x);  // t x (to eye) on screen: the strip side, same winding
+  clip.xy += (side * half_px * 2.0 * clip.w) * (perp / u_viewport_px);
+  v_rel_m = rel;
+  gl_Position = clip;
+}
 )";
 
 constexpr std::string_view kCpuMain = R"(
@@ -37,6 +90,13 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 void main() {
   DrawData d = draws[draw_index()];
+  if (strip_mode(d) != 0u) {  // strip vertex (wire::write_strip): centre, frame quaternion xyz, (u, +-R)
+    vec4 q = vec4(a_normal, sqrt(max(0.0, 1.0 - dot(a_normal, a_normal))));
+    strip_vertex(d, strip_mode(d), a_position, rotate_by(q, vec3(1.0, 0.0, 0.0)), rotate_by(q, vec3(0.0, 1.0, 0.0)),
+                 rotate_by(q, vec3(0.0, 0.0, 1.0)), abs(a_uv.y), a_uv.x, a_uv.y < 0.0 ? -1.0 : 1.0);
+    return;
+  }
+  tube_outputs();
   vec3 rel = d.offset_m + a_position;
   v_rel_m = rel;
   v_normal = a_normal;
@@ -115,6 +175,15 @@ void main() {
   DrawData d = draws[draw_index()];
   uint n = d.sides;
   uint vid = uint(gl_VertexID);
+  if (strip_mode(d) != 0u) {  // strip: vertex 2 row + (0: -side, 1: +side); a closed wire's last row repeats ring 0
+    uint row = vid >> 1u;
+    uint i = row == d.ring_count ? 0u : row;
+    Ring r = load_ring(d, i);
+    float u = row == d.ring_count ? d.u_close : r.u;
+    strip_vertex(d, strip_mode(d), r.centre_m, r.normal, r.binormal, r.tangent, r.radius_m, u, (vid & 1u) == 0u ? -1.0 : 1.0);
+    return;
+  }
+  tube_outputs();
   vec3 pos;
   vec3 nrm;
   vec2 uv;
@@ -161,6 +230,12 @@ constexpr std::string_view kFragmentHead = R"(#version 450 core
 in vec3 v_normal;
 in vec2 v_uv;
 in vec3 v_rel_m;
+flat in uint v_mode;
+in vec3 v_tangent;
+in vec3 v_frame_r;
+in vec3 v_frame_s;
+in float v_strip;
+in float v_alpha;
 layout(binding = 0) uniform sampler2D u_texture;
 uniform vec3 u_tint;
 uniform vec3 u_to_light;     // unit, toward the light
@@ -182,6 +257,25 @@ vec3 shade(vec3 albedo, vec3 n, vec3 to_eye) {
 
 constexpr std::string_view kFragmentMain = R"(
 void main() {
+  if (v_mode != 0u) {
+    // The tube a strip stands for: across = t x (to eye), facing = the to-eye direction without its t part;
+    // the tube point seen at strip coordinate s has normal s across + sqrt(1 - s^2) facing (a phone-wire line
+    // shades its centre, s = 0). Texture v is the angle of that normal in the ring frame, as the tube's j / n.
+    vec3 to_eye = normalize(-v_rel_m);
+    vec3 t = normalize(v_tangent);
+    vec3 across = cross(t, to_eye);
+    float len = length(across);
+    across = len > 1e-6 ? across / len : normalize(v_frame_r);
+    vec3 facing = cross(across, t);
+    float s = v_mode == 2u ? clamp(v_strip, -1.0, 1.0) : 0.0;
+    vec3 n = s * across + sqrt(max(0.0, 1.0 - s * s)) * facing;
+    float v = fract(atan(dot(n, v_frame_s), dot(n, v_frame_r)) * 0.15915494);
+    // Gradients of the continuous (u, s / 4) instead of v: no mip seam where v wraps.
+    vec2 g = vec2(v_uv.x, 0.25 * v_strip);
+    vec3 albedo = textureGrad(u_texture, vec2(v_uv.x, v), dFdx(g), dFdy(g)).rgb * u_tint;
+    o_color = vec4(shade(albedo, n, to_eye), v_alpha);
+    return;
+  }
   vec3 n = normalize(v_normal);
   if (!gl_FrontFacing) n = -n;  // wireframe and cut-away views see back faces
   vec3 albedo = texture(u_texture, v_uv).rgb * u_tint;

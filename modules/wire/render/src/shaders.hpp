@@ -13,11 +13,11 @@ struct GpuDraw {
     uint32_t ring_first;  ///< gpu-rings: first 32-bit word of the wire's PackedRings in the ring SSBO (binding 1)
     uint32_t ring_count;
     uint32_t sides;
-    uint32_t flags;  ///< kClosed | kCaps | kTilt
+    uint32_t flags;  ///< kClosed | kCaps | kTilt | kStrip | kLine
     float u_close;
 };
 static_assert(sizeof(GpuDraw) == 32);
-inline constexpr uint32_t kClosed = 1u, kCaps = 2u, kTilt = 4u;
+inline constexpr uint32_t kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;  // kStrip: sides 2, kLine: sides 1
 
 /// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex). Otherwise the ring expansion from
 /// gl_VertexID of an indexed draw over the static pattern (upload_plan.hpp). `draw_parameters`: the draw index is gl_BaseInstanceARB (ARB_shader_draw_parameters), else

@@ -103,6 +103,7 @@ uint32_t band_count(const DrawItem& item) {
 bool has_geometry(const DrawItem& item, UploadPath path) {
     if (path == UploadPath::cpu_mesh) return !item.vertices.empty() && !item.indices.empty();
     if (item.rings.empty()) return false;
+    if (item.sides <= 2) return band_count(item) > 0;  // strips and lines have no caps
     return band_count(item) > 0 || (!item.closed && item.caps);
 }
 
@@ -115,12 +116,14 @@ uint32_t command_count(const DrawItem& item) {
 uint32_t expanded_vertices(const DrawItem& item) {
     if (!has_geometry(item, UploadPath::gpu_rings)) return 0;
     const uint32_t rows = static_cast<uint32_t>(item.rings.size()) + (item.closed ? 1u : 0u);
+    if (item.sides <= 2) return rows * 2;  // wire::strip_counts
     const uint32_t caps = !item.closed && item.caps ? 2u : 0u;
     return (rows + caps) * (item.sides + 1);
 }
 
 uint32_t expanded_triangles(const DrawItem& item) {
     if (!has_geometry(item, UploadPath::gpu_rings)) return 0;
+    if (item.sides <= 2) return band_count(item) * 2;
     const uint32_t caps = !item.closed && item.caps ? 2u : 0u;
     return (band_count(item) * 2 + caps) * item.sides;
 }

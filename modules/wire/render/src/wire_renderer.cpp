@@ -99,6 +99,11 @@ struct WireRenderer::State {
         const uint32_t top = std::max(max_sides, std::max(kPatternMinSides, 2 * pattern_max_sides));
         std::vector<uint32_t> indices;
         std::vector<uint32_t> first(top + 1, 0);
+        // Strip and line pattern first (first[1] = first[2] = 0): wire::write_strip's band triangles.
+        for (uint32_t b = 0; b < kChunkBands; ++b) {
+            const uint32_t a = 2 * b;
+            indices.insert(indices.end(), {a + 1, a + 3, a + 2, a + 1, a + 2, a});
+        }
         for (uint32_t n = 3; n <= top; ++n) {
             first[n] = static_cast<uint32_t>(indices.size());
             append_pattern(n, indices);
@@ -333,13 +338,17 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
     for (uint32_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         assert(item.material < s.materials.size() && "DrawItem::material out of range");
-        assert((cpu || item.sides >= 3) && "DrawItem::sides must be >= 3");
+        assert((cpu || item.sides >= 1) && "DrawItem::sides must be >= 1");
         if (!has_geometry(item, list.path)) continue;
         s.order.push_back(i);
         max_sides = std::max(max_sides, item.sides);
     }
-    std::stable_sort(s.order.begin(), s.order.end(),
-                     [&](uint32_t a, uint32_t b) { return list.items[a].material < list.items[b].material; });
+    // Opaque items (tubes, strips) first, then the blended phone-wire lines (sides 1), each by material.
+    auto blended = [&](uint32_t i) { return list.items[i].sides == 1; };
+    std::stable_sort(s.order.begin(), s.order.end(), [&](uint32_t a, uint32_t b) {
+        if (blended(a) != blended(b)) return blended(b);
+        return list.items[a].material < list.items[b].material;
+    });
     if (retained) {
         s.retain(list, stats);  // also on an empty list: culled and destroyed wires age out
     }
@@ -401,6 +410,9 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         const DrawItem& item = list.items[s.order[k]];
         const glm::vec3 offset(item.origin_m - eye);  // difference in double, then float
         detail::GpuDraw draw{{offset.x, offset.y, offset.z}, 0, 0, 0, 0, 0.0f};
+        const uint32_t strip_flags =
+            item.sides == 2 ? detail::kStrip : item.sides == 1 ? detail::kLine : 0u;  // both paths
+        draw.flags = strip_flags;
         if (cpu) {
             const auto vertex_count = static_cast<uint32_t>(item.vertices.size());
             const auto index_count = static_cast<uint32_t>(item.indices.size());
@@ -439,14 +451,22 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
                                              [r0](const Ring& r) { return r.radius_m != r0; });
             const bool caps = !item.closed && item.caps;
             draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) |
-                         (varying ? detail::kTilt : 0u);
+                         (varying ? detail::kTilt : 0u) | strip_flags;
             draw.u_close = item.u_close;
             // Commands over the side count's pattern: the first carries the caps, each covers <= kChunkBands.
             const uint32_t sides = item.sides;
             const uint32_t bands = band_count(item);
             const uint32_t pattern = s.pattern_first[sides];
-            for (uint32_t c = 0, first_band = 0; c < s.command_first[k + 1] - s.command_first[k];
-                 ++c, first_band += kChunkBands) {
+            if (sides <= 2) {  // strip or line: 2 vertices a row, no caps
+                for (uint32_t c = 0, first_band = 0; c < s.command_first[k + 1] - s.command_first[k];
+                     ++c, first_band += kChunkBands) {
+                    const uint32_t chunk = std::min(kChunkBands, bands - std::min(bands, first_band));
+                    put_command(s.command_first[k] + c, {chunk * 6, 1, pattern,
+                                                         static_cast<int32_t>(first_band * 2), static_cast<uint32_t>(k)});
+                }
+            }
+            for (uint32_t c = 0; sides > 2 && c < s.command_first[k + 1] - s.command_first[k]; ++c) {
+                const uint32_t first_band = c * kChunkBands;
                 const uint32_t chunk = std::min(kChunkBands, bands - std::min(bands, first_band));
                 const bool with_caps = c == 0 && caps;
                 put_command(s.command_first[k] + c,
@@ -483,6 +503,11 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
     program.set("u_ambient", settings.light.ambient);
     program.set("u_specular", settings.light.specular);
     program.set("u_shininess", settings.light.shininess);
+    GLint viewport[4] = {0, 0, 1, 1};
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    program.set("u_viewport_px", glm::vec2(static_cast<float>(std::max(viewport[2], 1)),
+                                           static_cast<float>(std::max(viewport[3], 1))));
+    program.set("u_focal_px", 0.5f * static_cast<float>(std::max(viewport[3], 1)) / std::tan(0.5f * camera.fov_y_rad));
 
     const GLuint buffer = region.buffer;
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, buffer, static_cast<GLintptr>(region.offset_bytes),
@@ -507,10 +532,20 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, buffer);
 
+    bool blending = false;
     for (std::size_t first = 0; first < n;) {
         const uint32_t material_index = list.items[s.order[first]].material;
+        const bool line = list.items[s.order[first]].sides == 1;
         std::size_t last = first + 1;
-        while (last < n && list.items[s.order[last]].material == material_index) ++last;
+        while (last < n && list.items[s.order[last]].material == material_index &&
+               (list.items[s.order[last]].sides == 1) == line)
+            ++last;
+        if (line && !blending) {  // phone-wire lines: opacity = true width / drawn width, over the opaque wires
+            glEnable(GL_BLEND);
+            glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+            glDepthMask(GL_FALSE);
+            blending = true;
+        }
         const Material& material = s.materials[material_index];
         program.set("u_tint", material.tint);
         s.textures[material.texture].bind(0);
@@ -520,6 +555,10 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, indirect, count, 0);
         ++stats.multi_draw_calls;
         first = last;
+    }
+    if (blending) {
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
     }
     s.stream.end();
     if (retained) s.ring_storage.end_frame();

@@ -345,21 +345,27 @@ void mesh_system(Registry& registry, WireContext& ctx) {
             continue;
         }
         if (rings->generation == 0) continue;
-        if (mesh.seen_rings == rings->generation && mesh.sides == lod->lod.sides && mesh.caps == caps_of(*style)) continue;
+        if (mesh.seen_rings == rings->generation && mesh.sides == lod->lod.drawn_sides && mesh.caps == caps_of(*style)) continue;
         jobs.push_back(MeshJob{rings, lod, style, &mesh});
     }
     parallel_over(jobs.size(), [&](std::size_t i) {
         MeshJob& job = jobs[i];
         WireMesh& m = *job.mesh;
-        m.sides = job.lod->lod.sides;
+        m.sides = job.lod->lod.drawn_sides;
         m.caps = caps_of(*job.style);
         const RingSet& rs = job.rings->rings;
         const TubeSettings ts{.sides = m.sides, .caps = m.caps};
-        const TubeCounts counts = tube_counts(rs.rings.size(), rs.closed, ts);
+        // Strip or phone-wire line (drawn_sides 2 or 1): 2 vertices a ring (wire::write_strip); else the tube.
+        const TubeCounts counts = m.sides <= 2 ? strip_counts(rs.rings.size(), rs.closed)
+                                               : tube_counts(rs.rings.size(), rs.closed, ts);
         m.mesh.origin_m = rs.origin_m;
         m.mesh.vertices.resize(counts.vertices);
         m.mesh.indices.resize(counts.indices);
-        write_tube(rs.rings, rs.closed, job.rings->u_close, ts, m.mesh.vertices, m.mesh.indices);
+        if (m.sides <= 2) {
+            write_strip(rs.rings, rs.closed, job.rings->u_close, m.mesh.vertices, m.mesh.indices);
+        } else {
+            write_tube(rs.rings, rs.closed, job.rings->u_close, ts, m.mesh.vertices, m.mesh.indices);
+        }
         ++m.generation;
         m.seen_rings = job.rings->generation;
     });
@@ -399,7 +405,9 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         item.wire_id = engine::ecs::to_integral(e);
         item.rings = rs.rings;
         item.rings_generation = rings->generation;
-        item.sides = std::max<uint32_t>(lod->lod.sides, 3);
+        // Tube sides (>= 3), or 2 for a camera-facing strip, 1 for a phone-wire line.
+        item.sides = lod->lod.drawn_sides <= 2 && lod->lod.drawn_sides >= 1 ? lod->lod.drawn_sides
+                                                                            : std::max<uint32_t>(lod->lod.sides, 3);
         item.closed = rs.closed;
         item.caps = caps_of(*style);
         item.u_close = rings->u_close;
@@ -411,7 +419,8 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
             ctx.stats.vertices += mesh->mesh.vertices.size();
             ctx.stats.indices += mesh->mesh.indices.size();
         } else {
-            const TubeCounts counts = tube_counts(rs.rings.size(), rs.closed, TubeSettings{.sides = item.sides, .caps = item.caps});
+            const TubeCounts counts = item.sides <= 2 ? strip_counts(rs.rings.size(), rs.closed)
+                                                      : tube_counts(rs.rings.size(), rs.closed, TubeSettings{.sides = item.sides, .caps = item.caps});
             ctx.stats.vertices += counts.vertices;
             ctx.stats.indices += counts.indices;
         }

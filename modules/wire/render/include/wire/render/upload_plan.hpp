@@ -48,6 +48,8 @@ struct DecodedFrame {
 // side count: [start cap 3n][end cap 3n][kChunkBands bands of 6n]; a wire with more bands draws several
 // commands over it with base vertex = chunk * kChunkBands * (n + 1). Every vertex is shaded once per draw
 // command, i.e. once per ring row (twice at a chunk boundary).
+// Strips (sides 2) and phone-wire lines (sides 1): 2 vertices a row (wire::write_strip's layout), no caps; one
+// pattern of kChunkBands bands of 6 indices shared by both.
 inline constexpr uint32_t kChunkBands = 128;
 inline constexpr uint32_t kCapVertexBase = 1u << 30;
 
