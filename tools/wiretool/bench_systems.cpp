@@ -301,8 +301,12 @@ SceneRun run_scene(const RunSpec& spec) {
                 const double radius = registry.get<wire::systems::Style>(e).radius_m;
                 const double r_px = radius * ctx.view.focal_px / lod.z_min_m;
                 s.max_radial_scale_px = std::max(s.max_radial_scale_px, r_px);
-                s.adaptive_radial_px =
-                    std::max(s.adaptive_radial_px, r_px * (1.0 - std::cos(std::numbers::pi / item.sides)));
+                // A strip's silhouette is the tube's (2R across, no polygon error); a phone-wire line's edge
+                // lies 0.5 px - R from the true one (its coverage is the true width's).
+                const double radial = item.sides == 2   ? 0.0
+                                      : item.sides == 1 ? std::max(0.0, 0.5 - r_px)
+                                                        : r_px * (1.0 - std::cos(std::numbers::pi / item.sides));
+                s.adaptive_radial_px = std::max(s.adaptive_radial_px, radial);
             }
         }
         out.max_error_px = std::max(out.max_error_px, s.adaptive_error_px);
