@@ -904,10 +904,18 @@ TEST(LodThinWires, TubeStripLineByProjectedRadiusWithHysteresis) {
     for (double d = 3.0; d < 300.0; d *= 1.03) {  // away
         const uint32_t m = mode_at(d);
         const double r = lod.radius_px;
-        if (r >= 2.0 * 1.25) EXPECT_EQ(m, lod.sides) << d;
-        if (r < 2.0 && r >= 0.5) EXPECT_EQ(m, 2u) << d;
-        if (r < 0.5) EXPECT_EQ(m, 1u) << d;
-        if (last != 0) EXPECT_LE(std::min(m, 3u), std::min(last, 3u)) << "modes only thin out going away";
+        if (r >= 2.0 * 1.25) {
+            EXPECT_EQ(m, lod.sides) << d;
+        }
+        if (r < 2.0 && r >= 0.5) {
+            EXPECT_EQ(m, 2u) << d;
+        }
+        if (r < 0.5) {
+            EXPECT_EQ(m, 1u) << d;
+        }
+        if (last != 0) {
+            EXPECT_LE(std::min(m, 3u), std::min(last, 3u)) << "modes only thin out going away";
+        }
         if (seen.empty() || seen.back() != std::min(m, 3u)) seen.push_back(std::min(m, 3u));
         last = m;
     }
@@ -916,9 +924,15 @@ TEST(LodThinWires, TubeStripLineByProjectedRadiusWithHysteresis) {
     for (double d = 300.0; d > 3.0; d /= 1.03) {  // back
         const uint32_t m = mode_at(d);
         const double r = lod.radius_px;
-        if (r < 0.5 * 1.25) EXPECT_EQ(m, 1u) << d;
-        if (r >= 0.5 * 1.25 && r < 2.0 * 1.25) EXPECT_EQ(m, 2u) << d;
-        if (r >= 2.0 * 1.25) EXPECT_GE(m, 3u) << d;
+        if (r < 0.5 * 1.25) {
+            EXPECT_EQ(m, 1u) << d;
+        }
+        if (r >= 0.5 * 1.25 && r < 2.0 * 1.25) {
+            EXPECT_EQ(m, 2u) << d;
+        }
+        if (r >= 2.0 * 1.25) {
+            EXPECT_GE(m, 3u) << d;
+        }
         if (seen.empty() || seen.back() != std::min(m, 3u)) seen.push_back(std::min(m, 3u));
     }
     EXPECT_EQ(seen, (std::vector<uint32_t>{1, 2, 3}));
