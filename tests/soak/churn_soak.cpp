@@ -415,7 +415,8 @@ void Soak::check_frame() {
         if (!std::isfinite(item.origin_m.x) || !std::isfinite(item.origin_m.y) || !std::isfinite(item.origin_m.z))
             fail("draw item %zu (wire %u): origin is not finite", k, id);
         // Both paths carry the ring records; cpu-mesh items also the mesh built from them.
-        if (item.sides < 3) fail("wire %u: %u sides", id, item.sides);
+        // 1 = one-pixel anti-aliased line, 2 = camera-facing strip (thin far wires), >= 3 = tube.
+        if (item.sides == 0) fail("wire %u: %u sides", id, item.sides);
         for (std::size_t r = 0; r < item.rings.size(); ++r) {
             const wire::Ring& g = item.rings[r];
             const float sum = g.centre_m.x + g.centre_m.y + g.centre_m.z + g.radius_m + g.normal.x + g.normal.y +

@@ -38,7 +38,7 @@ struct DrawItem {
 
     // gpu_rings path
     std::span<const Ring> rings;  ///< ring records (gpu_rings path)
-    uint32_t sides = 8;      ///< radial sides, >= 3
+    uint32_t sides = 8;      ///< radial sides of a tube (>= 3); 2 = camera-facing strip, 1 = one-pixel AA line
     bool closed = false;     ///< closed loop (the last ring connects back to the first)
     bool caps = true;        ///< flat end caps on open wires
     float u_close = 0.0f;    ///< closed wires: u where the loop returns to ring 0 (RingSet::u.back())
