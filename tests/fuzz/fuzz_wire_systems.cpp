@@ -257,7 +257,7 @@ struct Harness {
             if (const ws::WireCurve* c = registry.try_get<ws::WireCurve>(w.entity)) check_curve(c->curve);
         for (const wire::DrawItem& item : ctx.draw_list.items) {
             wire_fuzz::require(wire_fuzz::finite_vec(item.origin_m), "draw item origin not finite");
-            wire_fuzz::require(item.sides >= 3, "draw item with fewer than 3 sides");
+            wire_fuzz::require(item.sides >= 1, "draw item with no sides (1 = AA line, 2 = strip, >= 3 = tube)");
             for (const wire::Ring& r : item.rings)
                 wire_fuzz::require(wire_fuzz::finite_vec(r.centre_m) && wire_fuzz::finite_vec(r.normal) &&
                                        wire_fuzz::finite_vec(r.binormal) && std::isfinite(r.radius_m) && std::isfinite(r.u),
