@@ -21,7 +21,11 @@ constexpr uint32_t default_max_sides = 32;
 constexpr double default_band = 0.25;
 
 double tolerance_or_default(double tolerance_px) {
-    return tolerance_px > 0.0 ? tolerance_px : default_tolerance_px;
+    // Below 1e-6 px a finer tolerance changes nothing on screen, and a denormal one underflows the world-space
+    // bound (tolerance * z / focal) to 0 on some paths but not others (fuzz_lod: 2.2e-317 px).
+    constexpr double min_tolerance_px = 1e-6;
+    if (!(tolerance_px > 0.0)) return default_tolerance_px;
+    return tolerance_px < min_tolerance_px ? min_tolerance_px : tolerance_px;
 }
 
 // Nearest depth (clamped to near) and off-axis factor k of one segment's control hull.
