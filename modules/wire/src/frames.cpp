@@ -184,6 +184,19 @@ glm::dvec3 unit_tangent(const CubicBezier& c, double t, bool* degenerate) {
     return glm::dvec3(0.0);
 }
 
+namespace {
+/// Unit tangent at t = 0, computed as build_rings computes a ring's there (B'(0) = 3 (b1 - b0), times the
+/// reciprocal of its length), so a crossed boundary and a ring at the same point carry the same tangent; where the
+/// derivative vanishes, unit_tangent()'s one-sided limits.
+glm::dvec3 boundary_tangent(const CubicBezier& c) {
+    const glm::dvec3 d = 3.0 * (c.b1 - c.b0);
+    const double speed = std::sqrt(glm::dot(d, d));
+    const double extent = std::max({max_abs(c.b1 - c.b0), max_abs(c.b2 - c.b0), max_abs(c.b3 - c.b0)});
+    if (speed > 1e-10 * extent + 1e-15 * max_abs(c.b0) + 1e-300) return d * (1.0 / speed);
+    return unit_tangent(c, 0.0);
+}
+}  // namespace
+
 FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, std::span<Frame> out) {
     FrameStats stats;
     const std::size_t n = in.params.size();
@@ -265,41 +278,73 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         return transport.step(pa.segment, pa.t, a, r_prev, tb, b);
     };
     if (settings.method == FrameMethod::double_reflection) {
+        // The points the normal is carried through, in order: every ring and, between two rings, every segment
+        // boundary the interval crosses (LOD below the node resolution), so a span's rings get the frames that one
+        // ring per segment would give them (no twist pop when spans merge or split), and the boundaries take the
+        // same independent-per-step path as rings. A boundary's tangent is computed as a ring's at t = 0 is.
         // Pass 1, independent per step: the product of the two reflections as one matrix,
         // H2 H1 = I - w1 w1^T - w2 w2^T + (w2.w1) w2 w1^T; a NaN marks a step for the guarded path. Pass 2 then
         // carries r by one matrix-vector product per step: the only serial dependency, and a short one (no square
         // root, no division), which is what bounds the speed. Reflections keep |r| = 1 and r normal to t up to
-        // rounding, which is removed every 64 steps (drift stays ~1e-15). Pass 3: binormals.
-        thread_local std::vector<glm::dmat3> step_matrix;  // grows once per thread, then reused
-        step_matrix.resize(n);
-        constexpr double kSpecial = std::numeric_limits<double>::quiet_NaN();
+        // rounding, which is removed every 64 steps (drift stays ~1e-15); the count runs over points, so a span's
+        // rings are re-projected exactly where the node-resolution rings are. Pass 3: binormals.
+        struct Point {
+            Sample s;
+            uint32_t seg;   // the segment a step from this point runs along
+            double ta;      // ... from this parameter
+            int64_t ring;   // ring index, or -1 for a crossed boundary
+        };
+        thread_local std::vector<Point> points;  // grows once per thread, then reused
+        points.clear();
+        points.push_back(Point{{in.centre_m[0], out[0].t}, in.params[0].segment, in.params[0].t, 0});
         for (std::size_t i = 1; i < n; ++i) {
-            const Sample a{in.centre_m[i - 1], out[i - 1].t};
-            const Sample b{in.centre_m[i], out[i].t};
-            glm::dvec3 w1{}, w2{};
-            if (!crosses(in.params[i - 1], in.params[i], false) &&
-                mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
-                const double k = glm::dot(w2, w1);
-                glm::dmat3 m(1.0);
-                for (int c = 0; c < 3; ++c) {  // column c: e_c - w1 w1_c - w2 w2_c + k w2 w1_c
-                    m[c] -= w1 * w1[c] + w2 * (w2[c] - k * w1[c]);
+            const RingParam& pa = in.params[i - 1];
+            const RingParam& pb = in.params[i];
+            if (crosses(pa, pb, false)) {
+                glm::dvec3 cur_t = out[i - 1].t;
+                for (std::size_t k = static_cast<std::size_t>(pa.segment) + 1; k < boundary_end(pb, false); ++k) {
+                    const CubicBezier& c = in.curve->segments[k];
+                    glm::dvec3 t = boundary_tangent(c);
+                    if (t == glm::dvec3(0.0)) t = cur_t;
+                    points.push_back(Point{{c.b0 - in.origin_m, t}, static_cast<uint32_t>(k), 0.0, -1});
+                    cur_t = t;
                 }
-                step_matrix[i] = m;
+            }
+            points.push_back(Point{{in.centre_m[i], out[i].t}, pb.segment, pb.t, static_cast<int64_t>(i)});
+        }
+        const std::size_t m = points.size();
+        thread_local std::vector<glm::dmat3> step_matrix;
+        step_matrix.resize(m);
+        constexpr double kSpecial = std::numeric_limits<double>::quiet_NaN();
+        for (std::size_t j = 1; j < m; ++j) {
+            const Sample& a = points[j - 1].s;
+            const Sample& b = points[j].s;
+            glm::dvec3 w1{}, w2{};
+            if (mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
+                const double k = glm::dot(w2, w1);
+                glm::dmat3 mat(1.0);
+                for (int c = 0; c < 3; ++c) {  // column c: e_c - w1 w1_c - w2 w2_c + k w2 w1_c
+                    mat[c] -= w1 * w1[c] + w2 * (w2[c] - k * w1[c]);
+                }
+                step_matrix[j] = mat;
             } else {
-                step_matrix[i][0][0] = kSpecial;
+                step_matrix[j][0][0] = kSpecial;
             }
         }
         glm::dvec3 r = r0;
-        for (std::size_t i = 1; i < n; ++i) {
-            if (std::isnan(step_matrix[i][0][0])) {
-                r = general_step(i, glm::normalize(r));
+        for (std::size_t j = 1; j < m; ++j) {
+            const Point& a = points[j - 1];
+            const Point& b = points[j];
+            if (std::isnan(step_matrix[j][0][0])) {
+                const double tb = b.seg == a.seg ? b.ta : 1.0;
+                r = transport.step(a.seg, a.ta, a.s, glm::normalize(r), tb, b.s);
             } else {
-                r = step_matrix[i] * r;
-                if ((i & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
-                    r = orthonormalize(r, out[i].t);
+                r = step_matrix[j] * r;
+                if ((j & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
+                    r = orthonormalize(r, b.s.t);
                 }
             }
-            out[i].r = r;
+            if (b.ring >= 0) out[static_cast<std::size_t>(b.ring)].r = r;
         }
         for (std::size_t i = 1; i < n; ++i) {
             out[i].s = glm::cross(out[i].t, out[i].r);

@@ -255,11 +255,17 @@ void mark_culled(WireLod& lod, bool& changed) {
     lod.coherence.valid = false;
 }
 
-double distance_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
+/// Squared distance from p to the chord a-b (distance_to_chord() is its root).
+double distance2_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
     const glm::dvec3 ab = b - a;
     const double len2 = glm::dot(ab, ab);
     const double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-    return glm::length(p - (a + t * ab));
+    const glm::dvec3 v = p - (a + t * ab);
+    return glm::dot(v, v);
+}
+
+double distance_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
+    return std::sqrt(distance2_to_chord(p, a, b));
 }
 
 struct Sphere {
@@ -910,14 +916,16 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
         const SpanNode node = out.node(level, j);
         return Sphere{node.centre_m, node.radius_m};
     };
-    // Level 0: one node per segment.
+    // Level 0: one node per segment. A larger of two lengths is the root of the larger squared length (the
+    // root is monotone and correctly rounded: the same value, one root fewer).
     for (std::size_t i = 0; i < n; ++i) {
         const CubicBezier& c = curve.segments[i];
-        wang[i] = std::max(glm::length(c.b0 - 2.0 * c.b1 + c.b2), glm::length(c.b1 - 2.0 * c.b2 + c.b3));
+        const glm::dvec3 m0 = c.b0 - 2.0 * c.b1 + c.b2, m1 = c.b1 - 2.0 * c.b2 + c.b3;
+        wang[i] = std::sqrt(std::max(glm::dot(m0, m0), glm::dot(m1, m1)));
         out.wang_m_max = std::max(out.wang_m_max, wang[i]);
         const glm::dvec3 lo = glm::min(glm::min(c.b0, c.b1), glm::min(c.b2, c.b3));
         const glm::dvec3 hi = glm::max(glm::max(c.b0, c.b1), glm::max(c.b2, c.b3));
-        const double hull = std::max(distance_to_chord(c.b1, c.b0, c.b3), distance_to_chord(c.b2, c.b0, c.b3));
+        const double hull = std::sqrt(std::max(distance2_to_chord(c.b1, c.b0, c.b3), distance2_to_chord(c.b2, c.b0, c.b3)));
         double deviation = std::min(hull, 0.75 * wang[i]);
         if (!std::isfinite(deviation)) deviation = std::numeric_limits<double>::infinity();
         put(0, i, Sphere{0.5 * (lo + hi), 0.5 * glm::length(hi - lo) * (1.0 + 1e-12)}, deviation);

@@ -40,7 +40,7 @@ const double kMinKnotRatio = std::exp(-300.0);
 const double kMaxKnotRatio = std::exp(300.0);
 
 double smoothstep(double e0, double e1, double x) {
-    const double t = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+    const double t = std::clamp((x - e0) * (1.0 / (e1 - e0)), 0.0, 1.0);  // constant edges: one product
     return t * t * (3.0 - 2.0 * t);
 }
 
@@ -162,13 +162,13 @@ void thomas(const std::vector<double>& a, const std::vector<double>& b, const st
     const std::size_t n = b.size();
     thread_local std::vector<double> cp;  // working memory, reused (no allocation per call)
     cp.resize(n);
-    double den = b[0];
-    cp[0] = c[0] / den;
-    r[0] = r[0] / den;
+    double inv = 1.0 / b[0];  // one division per row, products for the rest
+    cp[0] = c[0] * inv;
+    r[0] = r[0] * inv;
     for (std::size_t i = 1; i < n; ++i) {
-        den = b[i] - a[i] * cp[i - 1];
-        cp[i] = c[i] / den;
-        r[i] = (r[i] - a[i] * r[i - 1]) / den;
+        inv = 1.0 / (b[i] - a[i] * cp[i - 1]);
+        cp[i] = c[i] * inv;
+        r[i] = (r[i] - a[i] * r[i - 1]) * inv;
     }
     for (std::size_t i = n - 1; i-- > 0;) r[i] = r[i] - cp[i] * r[i + 1];
 }
@@ -194,6 +194,7 @@ void thomas_cyclic(const std::vector<double>& a, const std::vector<double>& b, c
 struct Chords {
     std::vector<dvec3> d;     // segment chords
     std::vector<double> len;  // their lengths (> merge epsilon)
+    std::vector<dvec3> e;     // unit directions d / len (computed once; every kind that needs them reads these)
 };
 
 // Per-segment Hermite tangents (per unit of the segment parameter u): t0 at the start, t1 at the end.
@@ -205,13 +206,12 @@ struct Tangents {
 void c2_tangents(const Chords& ch, bool closed, Tangents& tg) {
     const std::size_t segs = ch.d.size();
     const std::size_t n = closed ? segs : segs + 1;  // nodes
-    std::vector<dvec3> s(segs);
-    for (std::size_t k = 0; k < segs; ++k) s[k] = ch.d[k] / ch.len[k];
+    const std::vector<dvec3>& s = ch.e;
     std::vector<dvec3> D(n);
     if (closed) {
         std::vector<double> a(n), b(n, 2.0), c(n);
         for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t kin = (i + segs - 1) % segs, kout = i;
+            const std::size_t kin = i == 0 ? segs - 1 : i - 1, kout = i;
             const double hin = ch.len[kin], hout = ch.len[kout], sum = hin + hout;
             a[i] = hout / sum, c[i] = hin / sum;
             D[i] = 3.0 * (a[i] * s[kin] + c[i] * s[kout]);
@@ -252,7 +252,7 @@ void c2_tangents(const Chords& ch, bool closed, Tangents& tg) {
     }
     for (std::size_t k = 0; k < segs; ++k) {
         tg.t0[k] = D[k] * ch.len[k];
-        tg.t1[k] = D[(k + 1) % n] * ch.len[k];
+        tg.t1[k] = D[k + 1 == n ? 0 : k + 1] * ch.len[k];
     }
 }
 
@@ -290,10 +290,13 @@ const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std
     thread_local std::vector<dvec3> k;
     k.assign(n, dvec3(0.0));
     auto interior = [&](std::size_t i) { return closed || (i > 0 && i + 1 < n); };
+    // Index arithmetic without `%` (an integer division per use: it was most of this function's time).
+    const auto seg_in = [segs](std::size_t i) { return i == 0 ? segs - 1 : i - 1; };
+    const auto seg_out = [segs](std::size_t i) { return i == segs ? 0 : i; };
     for (std::size_t i = 0; i < n; ++i) {
         if (!interior(i)) continue;
-        const std::size_t kin = (i + segs - 1) % segs, kout = i % segs;
-        k[i] = (ch.d[kout] / ch.len[kout] - ch.d[kin] / ch.len[kin]) * (2.0 / (ch.len[kin] + ch.len[kout]));
+        const std::size_t kin = seg_in(i), kout = seg_out(i);
+        k[i] = (ch.e[kout] - ch.e[kin]) * (2.0 / (ch.len[kin] + ch.len[kout]));
     }
     // Node tangents (chord bisectors), to carry a neighbour's curvature vector to node i by the rotation that
     // takes its tangent to node i's (on a circle this maps one curvature vector exactly onto the next).
@@ -301,11 +304,11 @@ const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std
     t.assign(n, dvec3(0.0));
     for (std::size_t i = 0; i < n; ++i) {
         const bool in = closed || i > 0, out = closed || i + 1 < n;
-        const dvec3 e_in = in ? ch.d[(i + segs - 1) % segs] / ch.len[(i + segs - 1) % segs] : dvec3(0.0);
-        const dvec3 e_out = out ? ch.d[i % segs] / ch.len[i % segs] : dvec3(0.0);
+        const dvec3 e_in = in ? ch.e[seg_in(i)] : dvec3(0.0);
+        const dvec3 e_out = out ? ch.e[seg_out(i)] : dvec3(0.0);
         const dvec3 b = e_in + e_out;
         const double lb = glm::length(b);
-        t[i] = lb > 1e-12 ? b / lb : (out ? e_out : e_in);
+        t[i] = lb > 1e-12 ? b * (1.0 / lb) : (out ? e_out : e_in);
     }
     if (!closed) k[0] = k[1], k[n - 1] = k[n - 2], t[0] = t[1], t[n - 1] = t[n - 2];  // constant extrapolation
     const auto carry = [&](std::size_t from, std::size_t to) {  // Rodrigues rotation t[from] -> t[to] applied to k
@@ -316,19 +319,23 @@ const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std
     };
     for (std::size_t i = 0; i < n; ++i) {
         if (!interior(i)) continue;
-        const std::size_t kin = (i + segs - 1) % segs, kout = i % segs;
+        const std::size_t kin = seg_in(i), kout = seg_out(i);
         const double hin = ch.len[kin], hout = ch.len[kout];
         // What the neighbours predict at node i: their curvature vectors, carried to node i's tangent,
         // interpolated linearly in arc length.
-        const dvec3 pred = (hout * carry((i + n - 1) % n, i) + hin * carry((i + 1) % n, i)) / (hin + hout);
+        const dvec3 pred =
+            (hout * carry(i == 0 ? n - 1 : i - 1, i) + hin * carry(i + 1 == n ? 0 : i + 1, i)) * (1.0 / (hin + hout));
         const double lk = glm::length(k[i]), lp = glm::length(pred), sum = lk + lp;
         if (!(sum > 0.0) || !std::isfinite(sum)) continue;  // straight here and around: nothing to decide
-        const double d = glm::length(k[i] - pred) / sum;
+        const double inv_sum = 1.0 / sum;
+        const double d = glm::length(k[i] - pred) * inv_sum;
+        if (d <= kSpreadLo) continue;  // the neighbours predict this turn: g = 0 and straight = 0 (the common case)
         // Turning below ~1e-6 rad is rounding noise of collinear nodes (and invisible): nothing to decide.
         const double turn = 0.5 * sum * (hin + hout);
         const double unshared = smoothstep(kSpreadLo, kSpreadHi, d) * smoothstep(1e-8, 1e-6, turn);
-        g[i] = unshared * smoothstep(kShareLo, kShareHi, lk / sum);
-        if (straight) (*straight)[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, lk / sum));
+        const double share = lk * inv_sum;
+        g[i] = unshared * smoothstep(kShareLo, kShareHi, share);
+        if (straight) (*straight)[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, share));
     }
     return g;
 }
@@ -340,20 +347,23 @@ void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>
     const std::size_t segs = ch.d.size();
     const std::size_t n = closed ? segs : segs + 1;
     // Working memory: per thread, reused (no allocation per call once large enough).
-    thread_local std::vector<dvec3> s;
-    s.assign(segs, dvec3(0.0));
-    for (std::size_t k = 0; k < segs; ++k) s[k] = ch.d[k] / ch.len[k];
+    const std::vector<dvec3>& s = ch.e;
     thread_local std::vector<double> w;
-    w.assign(n, 0.0);
-    for (std::size_t i = 0; i < n; ++i)  // log-uniform in g
-        w[i] = std::expm1(g[i] * std::log1p(kMaxNodeTension)) + std::expm1(gs[i] * std::log1p(kStraightTension));
+    w.resize(n);
+    // Log-uniform in g; most nodes are untensed (g = 0: expm1(0) = 0 exactly, so the calls are skipped).
+    const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
+    for (std::size_t i = 0; i < n; ++i) {
+        const double wc = g[i] != 0.0 ? std::expm1(g[i] * log_max) : 0.0;
+        const double ws = gs[i] != 0.0 ? std::expm1(gs[i] * log_straight) : 0.0;
+        w[i] = wc + ws;
+    }
     thread_local std::vector<dvec3> D;
-    D.assign(n, dvec3(0.0));
+    D.resize(n);
     if (closed) {
         thread_local std::vector<double> a, b, c;
         a.assign(n, 0.0), b.assign(n, 0.0), c.assign(n, 0.0);
         for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t kin = (i + segs - 1) % segs, kout = i;
+            const std::size_t kin = i == 0 ? segs - 1 : i - 1, kout = i;
             const double hin = ch.len[kin], hout = ch.len[kout], sum = hin + hout;
             a[i] = hout / sum, c[i] = hin / sum, b[i] = 2.0 + w[i];
             D[i] = 3.0 * (a[i] * s[kin] + c[i] * s[kout]);
@@ -408,7 +418,7 @@ void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>
     }
     for (std::size_t k = 0; k < segs; ++k) {
         tg.t0[k] = D[k] * ch.len[k];
-        tg.t1[k] = D[(k + 1) % n] * ch.len[k];
+        tg.t1[k] = D[k + 1 == n ? 0 : k + 1] * ch.len[k];
     }
 }
 
@@ -451,10 +461,11 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     const std::size_t segs = closed ? n : n - 1;
 
     thread_local Chords ch;
-    ch.d.resize(segs), ch.len.resize(segs);
+    ch.d.resize(segs), ch.len.resize(segs), ch.e.resize(segs);
     for (std::size_t k = 0; k < segs; ++k) {
-        ch.d[k] = m.p[(k + 1) % n] - m.p[k];  // differences of nearby doubles: exact, whatever the offset
+        ch.d[k] = m.p[k + 1 == n ? 0 : k + 1] - m.p[k];  // differences of nearby doubles: exact, whatever the offset
         ch.len[k] = glm::length(ch.d[k]);
+        ch.e[k] = ch.d[k] * (1.0 / ch.len[k]);
     }
     std::vector<float>& seg_stretch = out.stretch;  // built in place
     seg_stretch.assign(segs, 1.0f);
@@ -483,16 +494,16 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
                                           : 0.0;
             const double keep = (1.0 - t_user) * (1.0 - t_curv);
             if (keep == 1.0) continue;
-            if (closed || j + 1 < n) tg.t0[j % segs] *= keep;
-            if (closed || j > 0) tg.t1[(j + segs - 1) % segs] *= keep;
+            if (closed || j + 1 < n) tg.t0[j == segs ? 0 : j] *= keep;
+            if (closed || j > 0) tg.t1[j == 0 ? segs - 1 : j - 1] *= keep;
         }
     } else {
         const double alpha = settings.alpha;
         for (std::size_t j = 0; j < n; ++j) {
             const uint32_t src = m.first[j];
             const bool has_in = closed || j > 0, has_out = closed || j + 1 < n;
-            const std::size_t kin = has_in ? (j + segs - 1) % segs : 0;
-            const std::size_t kout = has_out ? j % segs : segs - 1;
+            const std::size_t kin = has_in ? (j == 0 ? segs - 1 : j - 1) : 0;
+            const std::size_t kout = has_out ? (j == segs ? 0 : j) : segs - 1;
             // Open ends reflect the missing neighbour (P[-1] = 2P[0]-P[1]): the missing chord equals the other.
             const dvec3 din = has_in ? ch.d[kin] : ch.d[kout];
             const dvec3 dout = has_out ? ch.d[kout] : ch.d[kin];
@@ -534,9 +545,9 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     out.segments.reserve(segs);  // appended, not resized: no zero-fill of what is written next
     for (std::size_t k = 0; k < segs; ++k) {
         const dvec3& p0 = m.p[k];
-        const dvec3& p1 = m.p[(k + 1) % n];
+        const dvec3& p1 = m.p[k + 1 == n ? 0 : k + 1];
         const CubicBezier& bz =
-            out.segments.emplace_back(CubicBezier{p0, p0 + tg.t0[k] / 3.0, p1 - tg.t1[k] / 3.0, p1});
+            out.segments.emplace_back(CubicBezier{p0, p0 + tg.t0[k] * (1.0 / 3.0), p1 - tg.t1[k] * (1.0 / 3.0), p1});
         // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the
         // tube's float vertices downstream.
         constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
