@@ -57,6 +57,10 @@ Action add_bench_command(CLI::App& app) {
         "streamed and gpu-rings retained: check FrameStats::bytes_uploaded against the computed bytes and "
         "report draw() ms, GPU ms (GL_TIME_ELAPSED timer queries) and draw + finish ms per path in bench.md");
     cmd->add_flag("--no-systems", o->skip_systems, "Skip bench.csv/md (the ECS scenes)");
+    cmd->add_option("--spline", o->spline,
+                    "Spline of the ECS scenes' wires (bench.csv's method column): "
+                    "uniform|centripetal|chordal|c2|auto|linear; default auto (the runtime's default)")
+        ->check(CLI::IsMember({"uniform", "centripetal", "chordal", "c2", "auto", "linear"}));
     return [o] { return run_bench(*o); };
 }
 

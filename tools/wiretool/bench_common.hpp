@@ -22,6 +22,7 @@ struct Options {
     bool skip_accuracy = false;  ///< only bench.csv/bench.md
     bool skip_systems = false;   ///< only accuracy/stability outputs
     bool gl = false;             ///< also draw `standard` with the real WireRenderer (headless EGL)
+    std::string spline = "auto";  ///< spline of the ECS scenes' wires (bench.csv's method column)
 };
 
 /// Process CPU time (all threads), milliseconds: robust against other load on a shared machine.

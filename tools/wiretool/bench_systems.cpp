@@ -10,6 +10,7 @@
 #include <engine/gfx/lit_renderer.hpp>
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
+#include <wire/io/wire_json.hpp>
 #include <wire/lod.hpp>
 #include <wire/reference.hpp>
 #include <wire/render/upload_plan.hpp>
@@ -207,6 +208,7 @@ struct RunSpec {
     int error_samples = 3;  // frames at which the screen error is measured (spread over the run)
     /// Called after the systems of every frame, frame 0 included (untimed), e.g. to draw the DrawList with GL.
     std::function<void(const wire::systems::WireContext&, int frame)> after_frame;
+    wire::SplineSettings spline{.kind = wire::SplineKind::automatic};  ///< the wires' Style::spline (--spline)
 };
 
 SceneRun run_scene(const RunSpec& spec) {
@@ -225,11 +227,11 @@ SceneRun run_scene(const RunSpec& spec) {
         if (spec.kind == SceneKind::far) {
             FarWire w = far_wire(i);
             wires.push_back(wire::systems::spawn_wire(registry, std::move(w.nodes),
-                                                      {.radius_m = w.radius_m, .material = static_cast<uint32_t>(i % 4)}));
+                                                      {.radius_m = w.radius_m, .spline = spec.spline, .material = static_cast<uint32_t>(i % 4)}));
             continue;
         }
         wires.push_back(wire::systems::spawn_wire(
-            registry, hanging_wire(i), {.radius_m = kRadiusM, .material = static_cast<uint32_t>(i % 4)}));
+            registry, hanging_wire(i), {.radius_m = kRadiusM, .spline = spec.spline, .material = static_cast<uint32_t>(i % 4)}));
     }
     std::vector<int> sample_frames;
     for (int k = 0; k < spec.error_samples; ++k)
@@ -406,12 +408,12 @@ std::array<double, kSystems> system_medians(const SceneRun& r) {
     return m;
 }
 
-std::vector<std::string> row(const std::string& scene, const std::string& mode, int wires, double visible,
-                             double rings, double vertices, double bytes, double cpu_ms_frame,
+std::vector<std::string> row(const std::string& scene, const std::string& method, const std::string& mode, int wires,
+                             double visible, double rings, double vertices, double bytes, double cpu_ms_frame,
                              double error_px) {
     const double ns_per_vertex = vertices > 0 ? cpu_ms_frame * 1e6 / vertices : 0.0;
     return {scene,
-            "centripetal",
+            method,
             mode,
             num(kTolerancePx),
             std::to_string(wires),
@@ -515,6 +517,15 @@ struct GlCheck {
 }  // namespace
 
 int run_systems_bench(const Options& o) {
+    // The wires' spline (--spline; default auto, the runtime's Style default), resolved as `wiretool mesh` does.
+    wire::PipelineSettings resolved;
+    wire::io::SettingsOverrides overrides;
+    overrides.spline_type = o.spline;
+    if (wire::Status st = wire::io::resolve_settings(wire::io::WireSpec{}, overrides, resolved); !st.ok) {
+        std::fprintf(stderr, "wiretool bench: --spline: %s\n", st.message.c_str());
+        return 2;
+    }
+    const wire::SplineSettings spline = resolved.spline;
     const int frames = o.quick ? 16 : 120;
     const int error_samples = o.quick ? 2 : 3;
     Table csv;
@@ -556,7 +567,8 @@ int run_systems_bench(const Options& o) {
                          .wires = wires,
                          .sample_errors = true,
                          .error_samples = error_samples,
-                         .after_frame = {}};
+                         .after_frame = {},
+                         .spline = spline};
             if (use_gl && kind == SceneKind::standard) {
                 const std::filesystem::path dir = o.out_dir;
                 spec.after_frame = [&gl, dir, scene_frames](const wire::systems::WireContext& c, int f) {
@@ -574,11 +586,11 @@ int run_systems_bench(const Options& o) {
                               (m.visible_bytes + m.culled_bytes) / 1048576.0, r.rss_kb / 1024.0);
                 memory_lines += buf;
             }
-            csv.add(row(name, cpu ? "cpu-mesh" : "gpu-rings", wires, median(r.visible), median(r.rings),
+            csv.add(row(name, o.spline, cpu ? "cpu-mesh" : "gpu-rings", wires, median(r.visible), median(r.rings),
                         median(r.vertices), median(r.bytes), median(r.frame_cpu_ms), r.max_error_px));
             if (!cpu) {
                 // The same frames through the retained ring storage: only changed wires' rings are sent.
-                csv.add(row(name, "gpu-retained", wires, median(r.visible), median(r.rings), median(r.vertices),
+                csv.add(row(name, o.spline, "gpu-retained", wires, median(r.visible), median(r.rings), median(r.vertices),
                             median(r.retained_bytes), median(r.frame_cpu_ms), r.max_error_px));
                 scene_bytes += "| " + name + " | " + num(median(r.bytes), 8) + " | " +
                                num(median(r.retained_bytes), 8) + " |";
@@ -620,7 +632,7 @@ int run_systems_bench(const Options& o) {
                           sys[1], sys[2], sys[3], sys[4], median(cpu_run.frame_cpu_ms));
             system_lines += buf;
         }
-        csv.add(row(name, "uniform", wires, median(cpu_run.visible), median(u_rings), median(u_vertices),
+        csv.add(row(name, o.spline, "uniform", wires, median(cpu_run.visible), median(u_rings), median(u_vertices),
                     median(u_bytes), curve_ms + u.rebuild_cpu_ms, u.max_error_px));
         std::snprintf(
             buf, sizeof buf,
@@ -671,7 +683,8 @@ int run_systems_bench(const Options& o) {
                                               .wires = wires,
                                               .sample_errors = false,
                                               .error_samples = 0,
-                                              .after_frame = {}});
+                                              .after_frame = {},
+                                              .spline = spline});
                 wall[t - 1] = median(r.frame_wall_ms);
             }
             std::snprintf(buf, sizeof buf, "| %s | %.3f | %.3f | %.2fx |\n", name.c_str(), wall[0], wall[1],

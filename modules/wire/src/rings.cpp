@@ -23,8 +23,8 @@ double node_slope(const Curve& curve, std::size_t k) {
     const bool has_left = closed || k > 0;
     const bool has_right = closed || k + 1 < n;
     const double rk = curve.radius_m[k];
-    const double dl = has_left ? rk - curve.radius_m[(k + n - 1) % n] : 0.0;
-    const double dr = has_right ? curve.radius_m[(k + 1) % n] - rk : 0.0;
+    const double dl = has_left ? rk - curve.radius_m[k == 0 ? n - 1 : k - 1] : 0.0;
+    const double dr = has_right ? curve.radius_m[k + 1 == n ? 0 : k + 1] - rk : 0.0;
     if (!has_left) return dr;
     if (!has_right) return dl;
     if (dl * dr <= 0.0) return 0.0;  // local extremum: flat, so no overshoot
@@ -64,7 +64,7 @@ struct SegmentCoeffs {
             r1 = r2 = r3 = 0.0;
         } else {
             const std::size_t a = std::min<std::size_t>(seg, n - 1);
-            const std::size_t b = curve.closed ? (a + 1) % n : std::min(a + 1, n - 1);
+            const std::size_t b = curve.closed ? (a + 1 == n ? 0 : a + 1) : std::min(a + 1, n - 1);
             const double ra = curve.radius_m[a], rb = curve.radius_m[b];
             // Consecutive segments share a node: its slope is computed once.
             const double ma = a == slope_node ? slope : node_slope(curve, a);
