@@ -884,7 +884,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
 void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     const std::size_t n = curve.segment_count();
     out.segments = n;
-    out.sphere = curve_bounding_sphere(curve);
+    out.sphere = BoundingSphere{};  // curve_bounding_sphere(curve), from the level-0 boxes below
     out.radius_max_m = 0.0;
     for (const float r : curve.radius_m) out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
     out.wang_m_max = 0.0;
@@ -917,7 +917,10 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
         return Sphere{node.centre_m, node.radius_m};
     };
     // Level 0: one node per segment. A larger of two lengths is the root of the larger squared length (the
-    // root is monotone and correctly rounded: the same value, one root fewer).
+    // root is monotone and correctly rounded: the same value, one root fewer). The hull's distance to the chord:
+    // both inner control points against one reciprocal of the chord's squared length (a foot parameter off by a
+    // rounding is still a point of the chord, so the distance can only come out larger: still a bound).
+    glm::dvec3 wire_lo(std::numeric_limits<double>::infinity()), wire_hi(-std::numeric_limits<double>::infinity());
     for (std::size_t i = 0; i < n; ++i) {
         const CubicBezier& c = curve.segments[i];
         const glm::dvec3 m0 = c.b0 - 2.0 * c.b1 + c.b2, m1 = c.b1 - 2.0 * c.b2 + c.b3;
@@ -925,10 +928,22 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
         out.wang_m_max = std::max(out.wang_m_max, wang[i]);
         const glm::dvec3 lo = glm::min(glm::min(c.b0, c.b1), glm::min(c.b2, c.b3));
         const glm::dvec3 hi = glm::max(glm::max(c.b0, c.b1), glm::max(c.b2, c.b3));
-        const double hull = std::sqrt(std::max(distance2_to_chord(c.b1, c.b0, c.b3), distance2_to_chord(c.b2, c.b0, c.b3)));
+        wire_lo = glm::min(wire_lo, lo);
+        wire_hi = glm::max(wire_hi, hi);
+        const glm::dvec3 ab = c.b3 - c.b0, p1 = c.b1 - c.b0, p2 = c.b2 - c.b0;
+        const double len2 = glm::dot(ab, ab);
+        const double inv = len2 > 0.0 ? 1.0 / len2 : 0.0;
+        const glm::dvec3 v1 = p1 - std::clamp(glm::dot(p1, ab) * inv, 0.0, 1.0) * ab;
+        const glm::dvec3 v2 = p2 - std::clamp(glm::dot(p2, ab) * inv, 0.0, 1.0) * ab;
+        const double hull = std::sqrt(std::max(glm::dot(v1, v1), glm::dot(v2, v2)));
         double deviation = std::min(hull, 0.75 * wang[i]);
         if (!std::isfinite(deviation)) deviation = std::numeric_limits<double>::infinity();
         put(0, i, Sphere{0.5 * (lo + hi), 0.5 * glm::length(hi - lo) * (1.0 + 1e-12)}, deviation);
+    }
+    {  // curve_bounding_sphere(curve): the same box (min and max are exact, in any order), the same rounding
+        double radius = 0.0;
+        for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
+        out.sphere = {0.5 * (wire_lo + wire_hi), (0.5 * glm::length(wire_hi - wire_lo)) * (1.0 + 1e-12) + radius};
     }
     // Level l from level l - 1: a node of two children with chords A-M and M-B.
     for (std::size_t level = 1; level < levels; ++level) {
