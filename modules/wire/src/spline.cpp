@@ -346,11 +346,24 @@ const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std
         t[i] = lb > 1e-12 ? b * (1.0 / lb) : (out ? e_out : e_in);
     }
     if (!closed) k[0] = k[1], k[n - 1] = k[n - 2], t[0] = t[1], t[n - 1] = t[n - 2];  // constant extrapolation
-    const auto carry = [&](std::size_t from, std::size_t to) {  // Rodrigues rotation t[from] -> t[to] applied to k
-        const dvec3 axis = glm::cross(t[from], t[to]);
-        const double c = glm::dot(t[from], t[to]);
-        if (c <= -1.0 + 1e-12) return -k[from];  // reversal: any perpendicular axis; the sign is what matters
-        return k[from] * c + glm::cross(axis, k[from]) + axis * (glm::dot(axis, k[from]) / (1.0 + c));
+    // Rodrigues rotation t[j] -> t[j+1] per edge j (axis sin, cos, 1 / (1 + cos)), once per edge: node j+1 carries
+    // k[j] forwards with it, node j carries k[j+1] backwards with its inverse (axis negated, the same cosine).
+    struct EdgeTurn {
+        dvec3 axis;
+        double c, q;
+    };
+    thread_local std::vector<EdgeTurn> edge;
+    const std::size_t edges = closed ? n : n - 1;
+    edge.resize(edges);
+    for (std::size_t j = 0; j < edges; ++j) {
+        const dvec3& ta = t[j];
+        const dvec3& tb = t[j + 1 == n ? 0 : j + 1];
+        const double c = glm::dot(ta, tb);
+        edge[j] = EdgeTurn{glm::cross(ta, tb), c, c <= -1.0 + 1e-12 ? 0.0 : 1.0 / (1.0 + c)};
+    }
+    const auto carry = [&](const EdgeTurn& e, const dvec3& kv, double sense) {  // sense +1: forwards, -1: back
+        if (e.c <= -1.0 + 1e-12) return -kv;  // reversal: any perpendicular axis; the sign is what matters
+        return kv * e.c + sense * glm::cross(e.axis, kv) + e.axis * (glm::dot(e.axis, kv) * e.q);
     };
     for (std::size_t i = 0; i < n; ++i) {
         if (!interior(i)) continue;
@@ -359,7 +372,9 @@ const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std
         // What the neighbours predict at node i: their curvature vectors, carried to node i's tangent,
         // interpolated linearly in arc length.
         const dvec3 pred =
-            (hout * carry(i == 0 ? n - 1 : i - 1, i) + hin * carry(i + 1 == n ? 0 : i + 1, i)) * (1.0 / (hin + hout));
+            (hout * carry(edge[i == 0 ? n - 1 : i - 1], k[i == 0 ? n - 1 : i - 1], 1.0) +
+             hin * carry(edge[i], k[i + 1 == n ? 0 : i + 1], -1.0)) *
+            (1.0 / (hin + hout));
         const double lk = glm::length(k[i]), lp = glm::length(pred), sum = lk + lp;
         if (!(sum > 0.0) || !std::isfinite(sum)) continue;  // straight here and around: nothing to decide
         // The neighbours predict this turn (d <= kSpreadLo: g = 0 and straight = 0, the common case), decided
