@@ -47,10 +47,15 @@ struct Sample {
 
 enum class Mirrors : uint8_t { ok, split, degenerate };
 
-/// The two mirror normals of the double-reflection step a -> b, scaled by sqrt(2/c) so that each reflection is
-/// r - w (w.r). `split` (w valid) when the hairpin guard wants the step subdivided; `degenerate` (w invalid) when
-/// the tangent reverses at a repeated point or the second mirror vanishes.
-Mirrors mirrors(const Sample& a, const Sample& b, double noise, glm::dvec3& w1, glm::dvec3& w2) {
+/// The two mirrors of the double-reflection step a -> b: each reflection is r - f (v.r) v with f = 2 / |v|^2 (no
+/// normalization, so no square root). `split` (mirrors valid) when the hairpin guard wants the step subdivided;
+/// `degenerate` (invalid) when the tangent reverses at a repeated point or the second mirror vanishes.
+struct MirrorPair {
+    glm::dvec3 v1{}, v2{};
+    double f1 = 0.0, f2 = 0.0;
+};
+
+Mirrors mirrors(const Sample& a, const Sample& b, double noise, MirrorPair& m) {
     glm::dvec3 v1 = b.x - a.x;
     double c1 = glm::dot(v1, v1);
     // Below the rounding noise of the positions the chord has no direction: a repeated point. The reflection
@@ -62,14 +67,14 @@ Mirrors mirrors(const Sample& a, const Sample& b, double noise, glm::dvec3& w1, 
             return Mirrors::degenerate;
         }
     }
-    w1 = v1 * std::sqrt(2.0 / c1);
-    const glm::dvec3 tl = a.t - glm::dot(w1, a.t) * w1;  // t0 reflected: t0 - (2/c1)(v1.t0) v1
+    const double f1 = 2.0 / c1;
+    const glm::dvec3 tl = a.t - (f1 * glm::dot(v1, a.t)) * v1;  // t0 reflected
     const glm::dvec3 v2 = b.t - tl;
     const double c2 = glm::dot(v2, v2);
     if (c2 < 1e-20) {
         return Mirrors::degenerate;
     }
-    w2 = v2 * std::sqrt(2.0 / c2);
+    m = MirrorPair{v1, v2, f1, 2.0 / c2};
     // Hairpin guard. c2 ~ 0: the tangent turns "the wrong way" within the step (a loop), the second mirror is
     // ill-conditioned. A turn of more than 45 degrees in one step (a hairpin under coarse sampling): the
     // method's error grows with the turn per step. Either way the step is split at its parameter midpoint; at a
@@ -77,9 +82,9 @@ Mirrors mirrors(const Sample& a, const Sample& b, double noise, glm::dvec3& w1, 
     return (c2 < 0.1 || glm::dot(a.t, b.t) < kSplitCos) ? Mirrors::split : Mirrors::ok;
 }
 
-glm::dvec3 reflect_pair(const glm::dvec3& w1, const glm::dvec3& w2, glm::dvec3 r) {
-    r -= glm::dot(w1, r) * w1;
-    r -= glm::dot(w2, r) * w2;
+glm::dvec3 reflect_pair(const MirrorPair& m, glm::dvec3 r) {
+    r -= (m.f1 * glm::dot(m.v1, r)) * m.v1;
+    r -= (m.f2 * glm::dot(m.v2, r)) * m.v2;
     return r;
 }
 
@@ -108,8 +113,8 @@ public:
 private:
     glm::dvec3 reflect(uint32_t seg, double ta, const Sample& a, const glm::dvec3& r0, double tb, const Sample& b,
                        uint32_t depth) {
-        glm::dvec3 w1{}, w2{};
-        const Mirrors m = mirrors(a, b, noise(a, b), w1, w2);
+        MirrorPair mp;
+        const Mirrors m = mirrors(a, b, noise(a, b), mp);
         if (m != Mirrors::ok && depth < max_depth_ && in_.curve != nullptr && tb > ta) {
             if (depth == 0) {
                 ++stats_.subdivided_steps;
@@ -128,7 +133,7 @@ private:
             return orthonormalize(rotate_minimal(a.t, b.t, r0), b.t);
         }
         // Each reflection preserves length and the pair preserves handedness; re-project against rounding drift.
-        return orthonormalize(reflect_pair(w1, w2, r0), b.t);
+        return orthonormalize(reflect_pair(mp, r0), b.t);
     }
 
     const FrameInput& in_;
@@ -282,10 +287,10 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // boundary the interval crosses (LOD below the node resolution), so a span's rings get the frames that one
         // ring per segment would give them (no twist pop when spans merge or split), and the boundaries take the
         // same independent-per-step path as rings. A boundary's tangent is computed as a ring's at t = 0 is.
-        // Pass 1, independent per step: the product of the two reflections as one matrix,
-        // H2 H1 = I - w1 w1^T - w2 w2^T + (w2.w1) w2 w1^T; a NaN marks a step for the guarded path. Pass 2 then
-        // carries r by one matrix-vector product per step: the only serial dependency, and a short one (no square
-        // root, no division), which is what bounds the speed. Reflections keep |r| = 1 and r normal to t up to
+        // Pass 1, independent per step: the product of the two reflections as one matrix (no square root: the
+        // mirrors are not normalized), H2 H1 = I - f1 v1 v1^T - f2 v2 v2^T + f1 f2 (v2.v1) v2 v1^T; a NaN marks a
+        // step for the guarded path. Pass 2 then carries r by one matrix-vector product per step: the only serial
+        // dependency, and a short one (no square root, no division), which is what bounds the speed. Reflections keep |r| = 1 and r normal to t up to
         // rounding, which is removed every 64 steps (drift stays ~1e-15); the count runs over points, so a span's
         // rings are re-projected exactly where the node-resolution rings are. Pass 3: binormals.
         struct Point {
@@ -319,12 +324,12 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         for (std::size_t j = 1; j < m; ++j) {
             const Sample& a = points[j - 1].s;
             const Sample& b = points[j].s;
-            glm::dvec3 w1{}, w2{};
-            if (mirrors(a, b, transport.noise(a, b), w1, w2) == Mirrors::ok) {
-                const double k = glm::dot(w2, w1);
+            MirrorPair mp;
+            if (mirrors(a, b, transport.noise(a, b), mp) == Mirrors::ok) {
+                const double k = mp.f1 * glm::dot(mp.v2, mp.v1);
                 glm::dmat3 mat(1.0);
-                for (int c = 0; c < 3; ++c) {  // column c: e_c - w1 w1_c - w2 w2_c + k w2 w1_c
-                    mat[c] -= w1 * w1[c] + w2 * (w2[c] - k * w1[c]);
+                for (int c = 0; c < 3; ++c) {  // column c: e_c - f1 v1 v1_c - f2 v2 (v2_c - f1 (v2.v1) v1_c)
+                    mat[c] -= mp.v1 * (mp.f1 * mp.v1[c]) + mp.v2 * (mp.f2 * (mp.v2[c] - k * mp.v1[c]));
                 }
                 step_matrix[j] = mat;
             } else {
