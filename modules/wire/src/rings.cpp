@@ -40,8 +40,9 @@ struct SegmentCoeffs {
     glm::dvec3 d0, d1, d2;      // B'(t) = d0 + t (d1 + t d2)
     glm::dvec3 e0, e1;          // B''(t) = e0 + t e1
     double r0, r1, r2, r3;      // R(t) = r0 + t (r1 + t (r2 + t r3))
-    double u_scale;             // 1 / (2 pi stretch)
-    double u_per_m = 0.0;       // u_scale / r0 where the radius is constant along the segment (r1 = r2 = r3 = 0), else 0
+    double u_scale = 0.0;       // 1 / (2 pi stretch) (radius varying along the segment)
+    double u_per_m = 0.0;       // 1 / (2 pi stretch r0) (radius constant along the segment: r1 = r2 = r3 = 0)
+    bool constant_radius = false;
     double tiny_bound;          // >= tiny_speed() (1-norms instead of lengths): a faster speed is not tiny
     // `slope` is node `slope_node`'s radius slope (the end node of the last loaded segment).
     std::size_t slope_node = static_cast<std::size_t>(-1);
@@ -82,10 +83,16 @@ struct SegmentCoeffs {
         if (!(stretch > 0.0) || !std::isfinite(stretch)) {
             stretch = 1.0;
         }
-        u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
         // One radius along the whole segment (no per-node radii, the common case): u is length / (2 pi R stretch),
-        // so the quadrature needs no division per point.
-        u_per_m = r1 == 0.0 && r2 == 0.0 && r3 == 0.0 ? u_scale / std::max(r0, 1e-30) : 0.0;
+        // so the quadrature needs no division per point (and this one division per segment).
+        constant_radius = r1 == 0.0 && r2 == 0.0 && r3 == 0.0;
+        if (constant_radius) {
+            u_per_m = 1.0 / (2.0 * std::numbers::pi * stretch * std::max(r0, 1e-30));
+            u_scale = 0.0;
+        } else {
+            u_per_m = 0.0;
+            u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
+        }
         const auto norm1 = [](const glm::dvec3& v) { return std::abs(v.x) + std::abs(v.y) + std::abs(v.z); };
         tiny_bound = 1e-9 * (norm1(d0) + norm1(d1) + norm1(d2));
     }
@@ -110,7 +117,7 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     if (!(h > 0.0)) {
         return out;
     }
-    if (c.u_per_m > 0.0) {  // constant radius
+    if (c.constant_radius) {
         for (int k = 0; k < kGlPoints; ++k) out.length_m += (h * kGlW[k]) * glm::length(c.derivative(ta + h * kGlX[k]));
         out.u = out.length_m * c.u_per_m;
         return out;
