@@ -891,8 +891,10 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     out.levels = 0;
     static std::atomic<uint64_t> versions{0};  // unique over all curves: a state made for other bounds never matches
     out.version = versions.fetch_add(1, std::memory_order_relaxed) + 1;
-    out.data.clear();
-    if (n == 0) return;
+    if (n == 0) {
+        out.data.clear();
+        return;
+    }
     // Level widths and where each level starts (root first).
     uint32_t levels = 1;
     while (out.level_width(levels - 1) > 1) ++levels;
@@ -902,7 +904,9 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
         out.level_start[l] = static_cast<uint32_t>(nodes);
         nodes += out.level_width(l);
     }
-    out.data.assign(2 * levels + 5 * nodes + n, 0.0);
+    // Every entry is written below: a buffer of the right size (the same wire next frame, or a per-thread one for
+    // wires of equal length) is not cleared first.
+    if (out.data.size() != 2 * levels + 5 * nodes + n) out.data.assign(2 * levels + 5 * nodes + n, 0.0);
     double* wang = out.data.data() + 2 * levels + 5 * nodes;
     auto put = [&](std::size_t level, std::size_t j, const Sphere& sp, double deviation) {
         double* d = out.data.data() + 2 * levels + 5 * (out.level_start[level] + j);
