@@ -716,19 +716,7 @@ SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const L
 bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
                      const LodBounds& bounds, bool sphere_cull, bool use_bound) {
     const std::size_t n = curve.segment_count();
-    if (sphere_cull && bounds.sphere.radius_m >= 0.0) {
-        const ViewTransform tf(view);
-        // The centre and the hull's control points each reach view space with a rounding error of a few ulps of
-        // |point| + |eye|; far from the origin (5e11 m: ~1e-4 m) that exceeds the sphere's own slack and the
-        // sphere could cull a wire the hull test keeps. Inflate the sphere by a bound of both errors.
-        const double rounding = 64.0 * std::numeric_limits<double>::epsilon() *
-                                (glm::length(bounds.sphere.centre_m) + glm::length(view.eye_m));
-        if (PlaneTest(view, bounds.sphere.radius_m + rounding).outside(tf(bounds.sphere.centre_m)) != 0) {
-            bool changed = false;
-            mark_culled(lod, changed);
-            return changed;
-        }
-    }
+    if (sphere_cull && sphere_outside_view(bounds.sphere, view)) return cull_lod(lod);
     if (n == 0) {
         bool changed = false;
         mark_culled(lod, changed);
@@ -999,6 +987,23 @@ SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_
     b.k = std::sqrt(1.0 + a * a + c * c);
     b.eps_world_m = tolerance_or_default(tolerance_px) * b.z_lo_m / (view.focal_px * b.k);
     return b;
+}
+
+bool sphere_outside_view(const BoundingSphere& sphere, const LodView& view) {
+    if (!(sphere.radius_m >= 0.0)) return false;
+    const ViewTransform tf(view);
+    // The centre and the hull's control points each reach view space with a rounding error of a few ulps of
+    // |point| + |eye|; far from the origin (5e11 m: ~1e-4 m) that exceeds the sphere's own slack and the
+    // sphere could cull a wire the hull test keeps. Inflate the sphere by a bound of both errors.
+    const double rounding =
+        64.0 * std::numeric_limits<double>::epsilon() * (glm::length(sphere.centre_m) + glm::length(view.eye_m));
+    return PlaneTest(view, sphere.radius_m + rounding).outside(tf(sphere.centre_m)) != 0;
+}
+
+bool cull_lod(WireLod& lod) {
+    bool changed = false;
+    mark_culled(lod, changed);
+    return changed;
 }
 
 bool one_ring_per_segment(const LodBounds& bounds, const SphereScreenBound& b) {

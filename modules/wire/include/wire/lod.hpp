@@ -228,6 +228,16 @@ struct SphereScreenBound {
 [[nodiscard]] SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_m, const LodView& view,
                                                     double tolerance_px);
 
+/// The O(1) test update_lod() starts with: true if `sphere` (radius >= 0; false for an unknown one) lies
+/// entirely outside one frustum plane, after inflating it by a bound of the rounding of the view transform.
+/// update_lod() gives a wire whose sphere this culls the state cull_lod() gives, without any other work, so a
+/// caller may test this first and skip computing the wire's LodBounds.
+[[nodiscard]] bool sphere_outside_view(const BoundingSphere& sphere, const LodView& view);
+
+/// Puts `lod` in the state update_lod() leaves a culled wire in (visible false, counts and required empty, sides
+/// 0, coherence invalid); returns whether it was visible or had counts before.
+bool cull_lod(WireLod& lod);
+
 /// True if, by the bound, every segment of the wire needs exactly one ring: Wang's count is 1 for every segment
 /// when max M <= 4/3 eps_world (a strict margin is kept against rounding).
 [[nodiscard]] bool one_ring_per_segment(const LodBounds& bounds, const SphereScreenBound& b);

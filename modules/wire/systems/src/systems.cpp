@@ -67,11 +67,12 @@ struct CurveJob {
     WireCurve* curve;
     Status status;
     bool changed = false;
+    bool restored = false;  // a released curve rebuilt because the nodes are invalid
 };
 
 struct LodJob {
     const Style* style;
-    const WireCurve* curve;
+    WireCurve* curve;  // the LOD stage keeps or releases the wire's LodBounds and curve (see WireCurve)
     WireLodState* lod;
 };
 
@@ -112,6 +113,27 @@ void keep_rings(RingSet& built, WireRings& r) {
 /// Frees a vector's buffer (`v = {}` would only empty it: that is the initializer-list assignment).
 template <class T>
 void release(std::vector<T>& v) { std::vector<T>().swap(v); }
+
+/// Releases a culled moving wire's curve (see WireCurve): its next change rebuilds it anyway.
+void release_curve(WireCurve& c) {
+    release(c.curve.segments);
+    release(c.curve.source_node);
+    release(c.curve.radius_m);
+    release(c.curve.stretch);
+    release(c.lod_bounds.data);
+    c.lod_bounds_generation = 0;
+    c.released = true;
+}
+
+/// Rebuilds a released curve from the last valid nodes with the settings it was built with. It was built by
+/// build_curve from the same nodes and settings (the fast path), which is deterministic: the same curve, bit for
+/// bit. False (still released) if that fails, which cannot happen for nodes that built once.
+bool restore_curve(WireCurve& c, const SplineSettings& spline) {
+    if (!build_curve(c.previous_nodes, spline, c.curve).ok) return false;
+    c.released = false;
+    ++c.builds;
+    return true;
+}
 
 void release_rings(WireRings& r) {
     release(r.params);
@@ -165,6 +187,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         CurveJob& job = jobs[i];
         WireCurve& c = *job.curve;
         const SplineSettings spline = spline_of(*job.style);
+        const SplineSettings released_spline = c.spline;  // what a released curve was built with
         if (c.builds == 0 || !same_spline(spline, c.spline) || c.geomorph != pop_free || c.blend_s != job.style->blend_s) {
             c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
             c.spline = spline;
@@ -184,7 +207,13 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
             job.status = build_curve(nodes, spline, scratch);
             if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
-            if (job.status.ok) std::swap(c.curve, scratch);
+            if (job.status.ok) {
+                if (c.curve.segments.capacity() == 0) {
+                    c.curve = scratch;  // released (or new): one exact allocation, the thread keeps its buffer
+                } else {
+                    std::swap(c.curve, scratch);
+                }
+            }
             if (!c.multires_stale) {
                 // Re-priming rebuilds the pop-free state from previous_nodes: release it until then.
                 c.multires = MultiresCurve(
@@ -203,10 +232,19 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         ++c.builds;
         if (job.status.ok) {
             ++c.generation;
-            compute_lod_bounds(c.curve, c.lod_bounds);
-            c.bounds = c.lod_bounds.sphere;
+            // The LOD's O(1) cull test; its LodBounds are the LOD stage's (WireCurve::lod_bounds).
+            c.bounds = curve_bounding_sphere(c.curve);
             job.changed = true;
             c.previous_nodes = nodes;
+            c.released = false;
+        } else if (c.released) {
+            // Invalid nodes: the wire keeps its last valid curve, which was released. The multires path has
+            // already put it back (it shows its last state on failure); the fast path leaves it empty.
+            if (!c.curve.segments.empty()) {
+                c.released = false;
+            } else if (restore_curve(c, released_spline)) {
+                job.restored = true;
+            }
         }
         c.blending = job.status.ok && !c.multires_stale && c.multires.blending();
     });
@@ -230,6 +268,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         if (job.curve->blending) ctx.blending.push_back(job.entity);
     }
     ctx.stats.curves_built = jobs.size();
+    for (const CurveJob& job : jobs) ctx.stats.curves_restored += job.restored ? 1u : 0u;
     ctx.stats.wires = registry.storage<WireCurve>().size();
     ctx.stats.errors = registry.storage<WireError>().size();
 }
@@ -245,7 +284,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
     }
 
     std::vector<LodJob> jobs;
-    auto consider = [&](Entity e, const Style* style, const WireCurve* curve, WireLodState* lod) {
+    auto consider = [&](Entity e, const Style* style, WireCurve* curve, WireLodState* lod) {
         if (style == nullptr || curve == nullptr || lod == nullptr) return;
         if (lod->seen_curve == curve->generation && lod->seen_view == ctx.view_generation) return;
         jobs.push_back(LodJob{style, curve, lod});
@@ -269,18 +308,59 @@ void lod_system(Registry& registry, WireContext& ctx) {
 
     const uint64_t view_generation = ctx.view_generation;
     const LodSettings base = ctx.lod;
+    std::vector<unsigned char> outcome(jobs.size(), 0);  // 1: curve released, 2: curve restored
     parallel_over(jobs.size(), [&](std::size_t i) {
         LodJob& job = jobs[i];
         LodSettings settings = base;
         settings.max_sides = job.style->max_sides ? job.style->max_sides : kDefaultMaxSides;
         if (base.max_sides != 0) settings.max_sides = std::min(settings.max_sides, base.max_sides);
         WireLodState& s = *job.lod;
-        if (update_lod(job.curve->curve, ctx.view, settings, s.lod, job.curve->lod_bounds)) ++s.generation;
+        WireCurve& c = *job.curve;
+        // A released curve comes back when its sphere is not outside the view (the view turned to it).
+        if (c.released && !sphere_outside_view(c.bounds, ctx.view) && restore_curve(c, c.spline)) {
+            ++c.generation;
+            outcome[i] = 2;
+        }
+        const bool curve_changed = s.seen_curve != c.generation;  // since the last LOD update of this wire
+        bool changed = false;
+        if (c.released || sphere_outside_view(c.bounds, ctx.view)) {
+            // What update_lod gives a wire its sphere culls, without the LodBounds.
+            changed = cull_lod(s.lod);
+        } else if (curve_changed) {
+            // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
+            if (c.lod_bounds.data.capacity() != 0) release(c.lod_bounds.data);
+            c.lod_bounds_generation = 0;
+            thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
+            compute_lod_bounds(c.curve, scratch);
+            changed = update_lod(c.curve, ctx.view, settings, s.lod, scratch);
+        } else {
+            // Same curve, new camera: keep the bounds for the next camera (WireLod::Coherence reuses them).
+            if (c.lod_bounds_generation != c.generation) {
+                compute_lod_bounds(c.curve, c.lod_bounds);
+                c.lod_bounds_generation = c.generation;
+            }
+            changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
+        }
+        if (changed) ++s.generation;
         ++s.updates;
-        s.seen_curve = job.curve->generation;
+        s.seen_curve = c.generation;
         s.seen_view = view_generation;
+        if (!s.lod.visible) {
+            // Culled: the counts are rebuilt from scratch when it comes back (hysteresis restarts either way).
+            if (s.lod.counts.capacity() != 0) release(s.lod.counts);
+            if (s.lod.required.capacity() != 0) release(s.lod.required);
+            // Culled while moving: the next frame rebuilds the curve anyway (WireCurve).
+            if (curve_changed && !c.released && c.multires_stale && !c.blending && !c.curve.segments.empty()) {
+                release_curve(c);
+                outcome[i] = 1;
+            }
+        }
     });
     ctx.stats.lod_updates = jobs.size();
+    for (const unsigned char o : outcome) {
+        ctx.stats.curves_released += o == 1 ? 1u : 0u;
+        ctx.stats.curves_restored += o == 2 ? 1u : 0u;
+    }
 }
 
 void rings_system(Registry& registry, WireContext& ctx) {

@@ -35,14 +35,29 @@ struct Style {
 // ---- derived state, owned by the systems (read them, do not write them) ----
 
 /// Curve stage: the rendered curve (pop-free: blended while nodes appear or vanish) and its change counter.
+///
+/// Released while culled and moving: a wire the LOD stage culls in a frame its curve changed (it moves), that is
+/// on the fast path (multires_stale) and not blending, releases `curve` (`released` set; `bounds` and
+/// `previous_nodes` stay): its next change rebuilds the curve anyway. The LOD stage rebuilds a released curve
+/// from `previous_nodes` (bit for bit the released one) as soon as `bounds` is not outside the view, before it
+/// decides the wire, so the wire comes back as if it had never been released (generation advances, so rings and
+/// mesh are rebuilt); the curve stage rebuilds it likewise when the current nodes are invalid (the wire keeps its
+/// last valid curve). Readers of `curve` (tools, tests) see an empty curve only for a culled wire.
 struct WireCurve {
     MultiresCurve multires{MultiresSettings{}};  ///< pop-free state: blends nodes in and out over frames
-    Curve curve;                       ///< what is drawn; empty until the nodes were valid once
+    Curve curve;                       ///< what is drawn; empty until the nodes were valid once, or released
     SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
-    uint64_t generation = 0;           ///< +1 each time `curve` changes
-    BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test)
-    LodBounds lod_bounds{};            ///< of `curve`, recomputed with it (the LOD's per-wire bound and spans)
-    uint64_t builds = 0;               ///< times the curve stage ran for this wire (test/statistics counter)
+    uint64_t generation = 0;           ///< +1 each time `curve` changes (or is rebuilt after a release)
+    BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test); kept
+                                       ///< while released
+    /// The LOD's per-wire bound and spans of `curve` (lod.hpp), kept only for a wire whose curve did not change
+    /// since its last LOD update (a static wire that sees the camera move: WireLod::Coherence reuses them while
+    /// their version stands). A wire whose curve changed this frame gets them in per-thread scratch of the LOD
+    /// stage (computed only when its sphere is not outside the view) and keeps none.
+    LodBounds lod_bounds{};
+    uint64_t lod_bounds_generation = 0;  ///< `generation` lod_bounds were computed for (0: none kept)
+    uint64_t builds = 0;               ///< times the curve was built for this wire (test/statistics counter)
+    bool released = false;             ///< `curve` is released (culled and moving, see above)
     bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
     bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
     float blend_s = 0.0f;              ///< Style::blend_s the multires state was made with
