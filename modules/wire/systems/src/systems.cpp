@@ -533,44 +533,55 @@ bool wire_ring_set(Registry& registry, Entity wire, RingSet& out) {
     return true;
 }
 
+namespace {
+
+/// Adds one wire's memory to `m` (see WireMemory).
+void add_wire_memory(Registry& registry, Entity e, const WireCurve& c, WireMemory& m) {
+    std::size_t curve =
+        sizeof(WireCurve) + bytes_of(c.curve) + bytes_of(c.previous_nodes) + bytes_of(c.lod_bounds.data);
+    if (!c.multires_stale) {  // live pop-free state: target and rendered curves, one id per node of each
+        const Curve& t = c.multires.target();
+        curve += 2 * (bytes_of(t) + t.node_count() * sizeof(uint32_t));
+    }
+    std::size_t lod = 0, rings = 0, mesh = 0;
+    bool visible = false;
+    if (const WireLodState* l = registry.try_get<WireLodState>(e)) {
+        lod = sizeof(WireLodState) + bytes_of(l->lod.counts) + bytes_of(l->lod.required);
+        visible = l->lod.visible;
+    }
+    if (const WireRings* r = registry.try_get<WireRings>(e)) {
+        rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
+    }
+    if (const WireMesh* w = registry.try_get<WireMesh>(e)) {
+        mesh = sizeof(WireMesh) + bytes_of(w->mesh.vertices) + bytes_of(w->mesh.indices);
+    }
+    if (const Nodes* n = registry.try_get<Nodes>(e)) m.nodes_bytes += bytes_of(static_cast<const WireNodes&>(*n));
+    m.curve_bytes += curve;
+    m.lod_bytes += lod;
+    m.rings_bytes += rings;
+    m.mesh_bytes += mesh;
+    const std::size_t total = curve + lod + rings + mesh;
+    if (visible) {
+        ++m.visible_wires;
+        m.visible_bytes += total;
+    } else {
+        ++m.culled_wires;
+        m.culled_bytes += total;
+    }
+}
+
+}  // namespace
+
 WireMemory wire_memory(Registry& registry) {
     WireMemory m;
     auto& curves = registry.storage<WireCurve>();
-    for (std::size_t i = 0; i < curves.size(); ++i) {
-        const Entity e = curves.at(i);
-        const WireCurve& c = curves.at_position(i);
-        std::size_t curve =
-            sizeof(WireCurve) + bytes_of(c.curve) + bytes_of(c.previous_nodes) + bytes_of(c.lod_bounds.data);
-        if (!c.multires_stale) {  // live pop-free state: target and rendered curves, one id per node of each
-            const Curve& t = c.multires.target();
-            curve += 2 * (bytes_of(t) + t.node_count() * sizeof(uint32_t));
-        }
-        std::size_t lod = 0, rings = 0, mesh = 0;
-        bool visible = false;
-        if (const WireLodState* l = registry.try_get<WireLodState>(e)) {
-            lod = sizeof(WireLodState) + bytes_of(l->lod.counts) + bytes_of(l->lod.required);
-            visible = l->lod.visible;
-        }
-        if (const WireRings* r = registry.try_get<WireRings>(e)) {
-            rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
-        }
-        if (const WireMesh* w = registry.try_get<WireMesh>(e)) {
-            mesh = sizeof(WireMesh) + bytes_of(w->mesh.vertices) + bytes_of(w->mesh.indices);
-        }
-        if (const Nodes* n = registry.try_get<Nodes>(e)) m.nodes_bytes += bytes_of(static_cast<const WireNodes&>(*n));
-        m.curve_bytes += curve;
-        m.lod_bytes += lod;
-        m.rings_bytes += rings;
-        m.mesh_bytes += mesh;
-        const std::size_t total = curve + lod + rings + mesh;
-        if (visible) {
-            ++m.visible_wires;
-            m.visible_bytes += total;
-        } else {
-            ++m.culled_wires;
-            m.culled_bytes += total;
-        }
-    }
+    for (std::size_t i = 0; i < curves.size(); ++i) add_wire_memory(registry, curves.at(i), curves.at_position(i), m);
+    return m;
+}
+
+WireMemory wire_memory(Registry& registry, Entity wire) {
+    WireMemory m;
+    if (const WireCurve* c = registry.try_get<WireCurve>(wire)) add_wire_memory(registry, wire, *c, m);
     return m;
 }
 

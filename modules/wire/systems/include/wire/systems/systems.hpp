@@ -5,7 +5,9 @@
 ///                   a geomorph: pop-free curve (multires.hpp); bad nodes -> WireError, reported once,
 ///                   wire skipped
 ///   wire.lod        if the camera (or LOD settings) changed: every wire; otherwise only wires whose curve
-///                   changed: hull culling, per-segment ring counts, sides, hysteresis (lod.hpp)
+///                   changed: hull culling, per-segment ring counts, sides, hysteresis (lod.hpp); releases
+///                   the curve of a wire culled while moving and rebuilds it when the view turns to it
+///                   (WireCurve)
 ///   wire.rings      visible wires whose curve or counts changed: ring records, first normal carried over
 ///   wire.mesh       cpu_mesh path: visible wires whose rings or sides changed: TubeVertex + indices;
 ///                   gpu_rings path: nothing
@@ -73,7 +75,9 @@ bool wire_ring_set(engine::ecs::Registry& registry, engine::ecs::Entity wire, Ri
 
 /// Heap memory the wire systems hold for their own per-wire state: the capacity of the containers in WireCurve
 /// (curve, previous nodes, LOD bounds), WireLodState, WireRings and WireMesh, summed, plus the components' sizes,
-/// split by the wire's last LOD visibility. Nodes (the game's input) is reported apart. The multires state's
+/// split by the wire's last LOD visibility. What is kept: see WireCurve (a culled moving wire releases its curve,
+/// a moving wire keeps no LodBounds), WireRings (a culled moving wire releases its rings) and WireMesh; a culled
+/// wire keeps no LOD counts. Nodes (the game's input) is reported apart. The multires state's
 /// private buffers are estimated from its target curve (target and rendered curve, one id per node) while it is
 /// live; a released (stale) state holds nothing.
 struct WireMemory {
@@ -90,5 +94,7 @@ struct WireMemory {
 
 /// Sums the memory the wire systems hold for every wire of `registry` (see WireMemory); O(wires), no allocation.
 [[nodiscard]] WireMemory wire_memory(engine::ecs::Registry& registry);
+/// The same for one wire (all zero if it is not a wire).
+[[nodiscard]] WireMemory wire_memory(engine::ecs::Registry& registry, engine::ecs::Entity wire);
 
 }  // namespace wire::systems
