@@ -768,7 +768,14 @@ int run_systems_bench(const Options& o) {
               "| scene | path | visible | KiB / visible wire | culled | KiB / culled wire | mesh KiB / visible | "
               "nodes KiB / wire | systems MiB | process RSS MiB |\n"
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n" + memory_lines +
-              "\nProcess peak resident size (VmHWM) at the end of the bench: " + buf + " MiB.\n";
+              "\nProcess peak resident size (VmHWM) at the end of the bench: " + buf + " MiB.\n"
+              "\nPer wire the systems keep the curve (double Bezier segments), the last valid nodes (they re-prime "
+              "the pop-free state), the LOD state, the float ring records and, on cpu-mesh, the drawn mesh. A wire "
+              "culled while it moves keeps none of curve, LOD counts, rings or mesh (the next frame rebuilds them; "
+              "the curve comes back from the last valid nodes when the view turns to it); the LOD's span hierarchy "
+              "(LodBounds) is kept only by wires whose curve did not change since their last LOD update (static "
+              "wires: the coherence reuse). Aims (issue 18): <= 16 KB per visible and <= 4 KB per culled 64-node "
+              "wire on `swaying`.\n";
     }
     if (!scene_bytes.empty()) {
         md += "\n## Bytes uploaded per frame (median)\n\n| scene | gpu-rings streamed | gpu-rings retained | "
