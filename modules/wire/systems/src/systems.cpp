@@ -322,24 +322,30 @@ void lod_system(Registry& registry, WireContext& ctx) {
             outcome[i] = 2;
         }
         const bool curve_changed = s.seen_curve != c.generation;  // since the last LOD update of this wire
+        const bool kept_bounds = !curve_changed && c.lod_bounds_generation == c.generation;
         bool changed = false;
-        if (c.released || sphere_outside_view(c.bounds, ctx.view)) {
-            // What update_lod gives a wire its sphere culls, without the LodBounds.
+        if (kept_bounds) {
+            // Same curve, new camera: update_lod starts with the sphere test itself; the kept bounds let
+            // WireLod::Coherence answer the camera move.
+            changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
+        } else if (c.released || sphere_outside_view(c.bounds, ctx.view)) {
+            // What update_lod gives a wire its sphere culls, without computing the LodBounds.
             changed = cull_lod(s.lod);
         } else if (curve_changed) {
             // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
-            if (c.lod_bounds.data.capacity() != 0) release(c.lod_bounds.data);
-            c.lod_bounds_generation = 0;
             thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
             compute_lod_bounds(c.curve, scratch);
             changed = update_lod(c.curve, ctx.view, settings, s.lod, scratch);
         } else {
-            // Same curve, new camera: keep the bounds for the next camera (WireLod::Coherence reuses them).
-            if (c.lod_bounds_generation != c.generation) {
-                compute_lod_bounds(c.curve, c.lod_bounds);
-                c.lod_bounds_generation = c.generation;
-            }
+            // Same curve as the last LOD update, new camera: keep the bounds for the next camera.
+            compute_lod_bounds(c.curve, c.lod_bounds);
+            c.lod_bounds_generation = c.generation;
             changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
+        }
+        if ((curve_changed || !s.lod.visible) && c.lod_bounds.data.capacity() != 0) {
+            // Bounds of an older curve, or of a culled wire (recomputed, in O(segments), when it is in view again).
+            release(c.lod_bounds.data);
+            c.lod_bounds_generation = 0;
         }
         if (changed) ++s.generation;
         ++s.updates;

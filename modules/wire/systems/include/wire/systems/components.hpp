@@ -50,10 +50,10 @@ struct WireCurve {
     uint64_t generation = 0;           ///< +1 each time `curve` changes (or is rebuilt after a release)
     BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test); kept
                                        ///< while released
-    /// The LOD's per-wire bound and spans of `curve` (lod.hpp), kept only for a wire whose curve did not change
-    /// since its last LOD update (a static wire that sees the camera move: WireLod::Coherence reuses them while
-    /// their version stands). A wire whose curve changed this frame gets them in per-thread scratch of the LOD
-    /// stage (computed only when its sphere is not outside the view) and keeps none.
+    /// The LOD's per-wire bound and spans of `curve` (lod.hpp), kept only by a visible wire whose curve did not
+    /// change since its last LOD update (a static wire that sees the camera move: WireLod::Coherence reuses them
+    /// while their version stands). A wire whose curve changed this frame gets them in per-thread scratch of the
+    /// LOD stage and keeps none; a wire whose sphere is outside the view needs none; a culled wire releases them.
     LodBounds lod_bounds{};
     uint64_t lod_bounds_generation = 0;  ///< `generation` lod_bounds were computed for (0: none kept)
     uint64_t builds = 0;               ///< times the curve was built for this wire (test/statistics counter)
