@@ -160,7 +160,8 @@ public:
     [[nodiscard]] const std::vector<Rope>& ropes() const { return ropes_; }
     /// The nodes the wire systems currently hold for a cable.
     [[nodiscard]] const wire::WireNodes& cable_nodes(std::size_t cable) const;
-    /// The curve the wire systems draw for a cable (pop-free: blended while rope nodes appear or vanish).
+    /// The curve the wire systems draw for a cable (pop-free: blended while rope nodes appear or vanish). Empty
+    /// while a moving cable is culled (the systems release its curve until it is in view again: WireCurve).
     [[nodiscard]] const wire::Curve& cable_curve(std::size_t cable) const;
     /// Bent world position of an anchor of piece `piece` (anchor index as in anchors.json).
     [[nodiscard]] glm::dvec3 anchor_world(int piece, std::size_t anchor) const;
