@@ -6,6 +6,8 @@
 #include "wire/systems/api.hpp"
 #include "wire/systems/systems.hpp"
 
+#include "draw_bytes.hpp"
+
 #include "wire/spline.hpp"
 
 #include <engine/ecs/registry.hpp>
@@ -65,19 +67,7 @@ struct World {
 // Everything a draw item carries but its entity (spans by content).
 std::vector<unsigned char> item_bytes(const DrawItem& it) {
     std::vector<unsigned char> out;
-    auto put = [&](const void* p, std::size_t n) {
-        const auto* b = static_cast<const unsigned char*>(p);
-        out.insert(out.end(), b, b + n);
-    };
-    put(&it.origin_m, sizeof(it.origin_m));
-    put(&it.material, sizeof(it.material));
-    put(it.vertices.data(), it.vertices.size_bytes());
-    put(it.indices.data(), it.indices.size_bytes());
-    put(it.rings.data(), it.rings.size_bytes());
-    put(&it.sides, sizeof(it.sides));
-    put(&it.closed, sizeof(it.closed));
-    put(&it.caps, sizeof(it.caps));
-    put(&it.u_close, sizeof(it.u_close));
+    test::append_item_bytes(it, false, out);
     return out;
 }
 

@@ -4,6 +4,8 @@
 #include "wire/systems/api.hpp"
 #include "wire/systems/systems.hpp"
 
+#include "draw_bytes.hpp"
+
 #include "wire/multires.hpp"
 
 #include <engine/ecs/registry.hpp>
@@ -218,23 +220,9 @@ TEST(WireSystems, BadUpdateKeepsDrawingTheLastValidCurve) {
 // Flattens a DrawList into bytes (spans by content, not by address).
 std::vector<unsigned char> bytes_of(const DrawList& list) {
     std::vector<unsigned char> out;
-    auto put = [&](const void* p, std::size_t n) {
-        const auto* b = static_cast<const unsigned char*>(p);
-        out.insert(out.end(), b, b + n);
-    };
-    put(&list.path, sizeof(list.path));
-    for (const DrawItem& it : list.items) {
-        put(&it.origin_m, sizeof(it.origin_m));
-        put(&it.material, sizeof(it.material));
-        put(&it.wire_id, sizeof(it.wire_id));
-        put(it.vertices.data(), it.vertices.size_bytes());
-        put(it.indices.data(), it.indices.size_bytes());
-        put(it.rings.data(), it.rings.size_bytes());
-        put(&it.sides, sizeof(it.sides));
-        put(&it.closed, sizeof(it.closed));
-        put(&it.caps, sizeof(it.caps));
-        put(&it.u_close, sizeof(it.u_close));
-    }
+    out.insert(out.end(), reinterpret_cast<const unsigned char*>(&list.path),
+               reinterpret_cast<const unsigned char*>(&list.path) + sizeof(list.path));
+    for (const DrawItem& it : list.items) test::append_item_bytes(it, true, out);
     return out;
 }
 
