@@ -188,7 +188,9 @@ TubeCounts write_tube(std::span<const Ring> rings, bool closed, float u_close, c
         }
         const float ds = glm::length(rings[hi].centre_m - rings[i].centre_m) +
                          glm::length(rings[i].centre_m - rings[lo].centre_m);
-        return ds > 0.0f ? dr / ds : 0.0f;
+        // A cone steeper than 1e18 is a disc: clamped so that 1 + slope^2 stays finite (a radius jump of 1e38 m
+        // over a few centimetres overflowed it, and the normal became 0 * inf = NaN).
+        return ds > 0.0f ? std::clamp(dr / ds, -1e18f, 1e18f) : 0.0f;
     };
 
     for (std::size_t i = 0; i < ring_n; ++i) {

@@ -83,6 +83,23 @@ TEST(Tube, ConeNormalsTiltWithRadiusSlope) {
     for (const TubeVertex& v : flat.vertices) EXPECT_NEAR(v.normal.z, 0.0f, 1e-7f);
 }
 
+// Found by fuzz_wire_systems (corpus: regression_radius_jump): a node radius of 1.1e38 m next to 0.02 m a few
+// centimetres away. The slope dR/ds overflowed float, 1 + slope^2 with it, and the tilted normals became NaN. A
+// cone that steep is a disc: its side normals lie along the tangent, unit and finite.
+TEST(Tube, RadiusJumpBeyondFloatRangeKeepsNormalsFinite) {
+    for (const float big : {1e20f, 1e30f, 1.1e38f, 3.4e38f}) {
+        Curve c = polyline_curve({{0, 0, 0}, {0.05, 0, 0}, {0.1, 0, 0}}, 0.02f);
+        c.radius_m = {big, 0.02f, 0.02f};
+        const RingSet set = rings_for(c, 4);
+        TubeMesh mesh;
+        build_tube(set, TubeSettings{.sides = 8, .caps = false}, mesh);
+        for (const TubeVertex& v : mesh.vertices) {
+            ASSERT_TRUE(std::isfinite(v.normal.x) && std::isfinite(v.normal.y) && std::isfinite(v.normal.z)) << big;
+            EXPECT_NEAR(glm::length(v.normal), 1.0f, 1e-5f) << big;
+        }
+    }
+}
+
 TEST(Tube, WithoutCapsHasTwoOpenEnds) {
     const RingSet set = rings_for(helix_curve(1.0, 0.3, 1, 8), 2);
     TubeMesh mesh;
