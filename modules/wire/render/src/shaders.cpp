@@ -156,7 +156,7 @@ float slope_at(DrawData d, uint i, Ring ri) {
   float dr = ring_radius(d, hi) - ring_radius(d, lo);
   if (dr == 0.0) return 0.0;
   float ds = length(ring_centre(d, hi) - ri.centre_m) + length(ri.centre_m - ring_centre(d, lo));
-  return ds > 0.0 ? dr / ds : 0.0;
+  return ds > 0.0 ? clamp(dr / ds, -1e18, 1e18) : 0.0;  // as write_tube: 1 + slope^2 stays finite
 }
 
 // vid / m for m >= 4 without an integer division (software rasterizers run vector integer division one lane
