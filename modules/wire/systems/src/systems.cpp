@@ -68,6 +68,7 @@ struct CurveJob {
     Status status;
     bool changed = false;
     bool restored = false;  // a released curve rebuilt because the nodes are invalid
+    bool kept_released = false;  // a released curve rebuilt in the thread's buffer only (still outside the view)
 };
 
 struct LodJob {
@@ -90,6 +91,14 @@ struct MeshJob {
 };
 
 bool caps_of(const Style& style) { return style.caps && !style.closed; }
+
+/// A per-thread list of T (tag K tells two lists of one type apart), emptied, its capacity kept.
+template <class T, int K>
+std::vector<T>& reused() {
+    thread_local std::vector<T> v;
+    v.clear();
+    return v;
+}
 
 /// What a wire keeps of build_rings' output (see WireRings): the float records (swapped, so no copy and no
 /// allocation once both buffers are large enough), ring 0's frame, scalars.
@@ -165,13 +174,16 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     ctx.new_errors.clear();
     ctx.curve_changed.clear();
 
-    std::vector<Entity> work;
+    // Work lists: per-thread buffers reused frame after frame (no allocation per frame once they are large
+    // enough). A local reference is what the parallel lambdas capture: a thread_local named inside them would be
+    // the worker thread's own.
+    std::vector<Entity>& work = reused<Entity, 0>();
     for (const Entity e : registry.changed<Nodes>(since)) work.push_back(e);
     for (const Entity e : registry.changed<Style>(since)) work.push_back(e);
     for (const Entity e : ctx.blending) work.push_back(e);
     sort_unique(work);
 
-    std::vector<CurveJob> jobs;
+    std::vector<CurveJob>& jobs = reused<CurveJob, 0>();
     jobs.reserve(work.size());
     for (const Entity e : work) {
         if (!registry.valid(e)) continue;  // destroyed while blending
@@ -183,6 +195,9 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     }
 
     const bool pop_free = ctx.pop_free;
+    // The view the LOD stage will see (unless the camera changes in between: the LOD stage then restores what
+    // needs restoring). A released wire that moved and is still outside it stays released (below).
+    const LodView cull_view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
     parallel_over(jobs.size(), [&](std::size_t i) {
         CurveJob& job = jobs[i];
         WireCurve& c = *job.curve;
@@ -203,13 +218,20 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         // The first valid state has nothing to blend from: the multires would show its exact curve too (and is
         // primed from previous_nodes if the next state changes ids, as after any fast-path frame).
         const bool first = c.generation == 0;
+        bool stays_released = false;
+        BoundingSphere sphere{};
         if (!pop_free || same_ids || first) {
             // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
             job.status = build_curve(nodes, spline, scratch);
             if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
             if (job.status.ok) {
                 if (c.curve.segments.capacity() == 0) {
-                    c.curve = scratch;  // released (or new): one exact allocation, the thread keeps its buffer
+                    // Released (culled while moving) or new. A released wire still outside the view stays
+                    // released: the LOD stage culls it by its sphere, so the curve is never copied out of the
+                    // thread's buffer (no allocation and free per culled moving wire per frame).
+                    sphere = curve_bounding_sphere(scratch);
+                    stays_released = c.released && !c.blending && sphere_outside_view(sphere, cull_view);
+                    if (!stays_released) c.curve = scratch;  // one exact allocation, the thread keeps its buffer
                 } else {
                     std::swap(c.curve, scratch);
                 }
@@ -233,10 +255,11 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         if (job.status.ok) {
             ++c.generation;
             // The LOD's O(1) cull test; its LodBounds are the LOD stage's (WireCurve::lod_bounds).
-            c.bounds = curve_bounding_sphere(c.curve);
+            c.bounds = stays_released ? sphere : curve_bounding_sphere(c.curve);
             job.changed = true;
             c.previous_nodes = nodes;
-            c.released = false;
+            c.released = stays_released;
+            job.kept_released = stays_released;
         } else if (c.released) {
             // Invalid nodes: the wire keeps its last valid curve, which was released. The multires path has
             // already put it back (it shows its last state on failure); the fast path leaves it empty.
@@ -268,7 +291,10 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         if (job.curve->blending) ctx.blending.push_back(job.entity);
     }
     ctx.stats.curves_built = jobs.size();
-    for (const CurveJob& job : jobs) ctx.stats.curves_restored += job.restored ? 1u : 0u;
+    for (const CurveJob& job : jobs) {
+        ctx.stats.curves_restored += job.restored ? 1u : 0u;
+        ctx.stats.curves_released += job.kept_released ? 1u : 0u;
+    }
     ctx.stats.wires = registry.storage<WireCurve>().size();
     ctx.stats.errors = registry.storage<WireError>().size();
 }
@@ -283,7 +309,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
         ++ctx.view_generation;
     }
 
-    std::vector<LodJob> jobs;
+    std::vector<LodJob>& jobs = reused<LodJob, 0>();
     auto consider = [&](Entity e, const Style* style, WireCurve* curve, WireLodState* lod) {
         if (style == nullptr || curve == nullptr || lod == nullptr) return;
         if (lod->seen_curve == curve->generation && lod->seen_view == ctx.view_generation) return;
@@ -308,7 +334,8 @@ void lod_system(Registry& registry, WireContext& ctx) {
 
     const uint64_t view_generation = ctx.view_generation;
     const LodSettings base = ctx.lod;
-    std::vector<unsigned char> outcome(jobs.size(), 0);  // 1: curve released, 2: curve restored
+    std::vector<unsigned char>& outcome = reused<unsigned char, 0>();  // 1: curve released, 2: curve restored
+    outcome.assign(jobs.size(), 0);
     parallel_over(jobs.size(), [&](std::size_t i) {
         LodJob& job = jobs[i];
         LodSettings settings = base;
@@ -370,7 +397,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
 }
 
 void rings_system(Registry& registry, WireContext& ctx) {
-    std::vector<RingJob> jobs;
+    std::vector<RingJob>& jobs = reused<RingJob, 0>();
     auto& storage = registry.storage<WireRings>();
     for (std::size_t i = 0; i < storage.size(); ++i) {
         const Entity e = storage.at(i);
@@ -399,6 +426,11 @@ void rings_system(Registry& registry, WireContext& ctx) {
             settings.frames.previous_normal = r.rings.frames.front().r;
         }
         thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
+        // The float records are built straight into the wire's own buffer (lent to the scratch set for the build,
+        // taken back in keep_rings): each wire's and the thread's buffers keep their capacity, so a frame
+        // allocates only where a wire needs more rings than it ever had (a swap would pass buffers from wire
+        // to wire and keep reallocating).
+        std::swap(scratch.rings, r.rings.rings);
         build_rings(job.curve->curve, r.params, settings, scratch);
         r.frame_settings = settings.frames;
         keep_rings(scratch, r);
@@ -411,7 +443,7 @@ void rings_system(Registry& registry, WireContext& ctx) {
 
 void mesh_system(Registry& registry, WireContext& ctx) {
     if (ctx.path != UploadPath::cpu_mesh) return;
-    std::vector<MeshJob> jobs;
+    std::vector<MeshJob>& jobs = reused<MeshJob, 0>();
     auto& storage = registry.storage<WireMesh>();
     for (std::size_t i = 0; i < storage.size(); ++i) {
         const Entity e = storage.at(i);
@@ -463,7 +495,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
     list.path = ctx.path;
     list.items.clear();
 
-    std::vector<Entity> visible;
+    std::vector<Entity>& visible = reused<Entity, 1>();
     auto& lods = registry.storage<WireLodState>();
     for (std::size_t i = 0; i < lods.size(); ++i) {
         if (lods.at_position(i).lod.visible) {

@@ -22,7 +22,9 @@ struct FrameStats {
     std::size_t wires = 0;             ///< wire entities (with Nodes and Style)
     std::size_t curves_built = 0;      ///< curve stage runs (changed nodes/style, or an ongoing geomorph)
     std::size_t lod_updates = 0;       ///< update_lod runs (hull tests); 0 when nothing moved
-    std::size_t curves_released = 0;   ///< curves released by the LOD stage (culled while moving; WireCurve)
+    std::size_t curves_released = 0;   ///< culled moving wires holding no curve after this frame: released by the
+                                       ///< LOD stage, or rebuilt in the curve stage's per-thread buffer only
+                                       ///< (still outside the view; WireCurve)
     std::size_t curves_restored = 0;   ///< released curves rebuilt (the view turned to them, or invalid nodes)
     std::size_t visible_wires = 0;     ///< wires in the draw list (valid curve, inside the view)
     std::size_t culled_wires = 0;      ///< wires with a valid curve outside the view
