@@ -405,7 +405,7 @@ void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>
     thread_local std::vector<double> w;
     w.resize(n);
     // Log-uniform in g; most nodes are untensed (g = 0: expm1(0) = 0 exactly, so the calls are skipped).
-    const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
+    static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
     for (std::size_t i = 0; i < n; ++i) {
         const double wc = g[i] != 0.0 ? std::expm1(g[i] * log_max) : 0.0;
         const double ws = gs[i] != 0.0 ? std::expm1(gs[i] * log_straight) : 0.0;
