@@ -290,9 +290,10 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // Pass 1, independent per step: the product of the two reflections as one matrix (no square root: the
         // mirrors are not normalized), H2 H1 = I - f1 v1 v1^T - f2 v2 v2^T + f1 f2 (v2.v1) v2 v1^T; a NaN marks a
         // step for the guarded path. Pass 2 then carries r by one matrix-vector product per step: the only serial
-        // dependency, and a short one (no square root, no division), which is what bounds the speed. Reflections keep |r| = 1 and r normal to t up to
-        // rounding, which is removed every 64 steps (drift stays ~1e-15); the count runs over points, so a span's
-        // rings are re-projected exactly where the node-resolution rings are. Pass 3: binormals.
+        // dependency, and a short one (no square root, no division), which is what bounds the speed. Reflections
+        // keep |r| = 1 and r normal to t up to rounding, which is removed every 64 steps (drift stays ~1e-15); the
+        // count runs over points, so a span's rings are re-projected exactly where the node-resolution rings are.
+        // Pass 3: binormals.
         struct Point {
             Sample s;
             uint32_t seg;   // the segment a step from this point runs along
