@@ -282,14 +282,6 @@ double max_deviation_m(const Case& c, const Curve& curve, int samples_per_segmen
     return worst;
 }
 
-namespace {
-double distance_to_segment(const dvec3& p, const dvec3& a, const dvec3& b) {
-    const dvec3 d = b - a;
-    const double t = std::clamp(glm::dot(p - a, d) / std::max(glm::dot(d, d), 1e-300), 0.0, 1.0);
-    return glm::length(p - (a + t * d));
-}
-}  // namespace
-
 TautNumbers taut_numbers(const Case& c, const Curve& curve, int samples_per_segment) {
     TautNumbers t;
     const std::vector<dvec3>& x = c.nodes.positions;
@@ -311,11 +303,11 @@ TautNumbers taut_numbers(const Case& c, const Curve& curve, int samples_per_segm
                 const double from_corner = std::min(c.corner[a] ? glm::length(p - x[a]) : HUGE_VAL,
                                                     c.corner[b] ? glm::length(p - x[b]) : HUGE_VAL);
                 // Distance to the run's segment (not its infinite line): overshooting an end along the line counts.
-                if (from_corner > 0.05 * h) t.straight_rel = std::max(t.straight_rel, distance_to_segment(p, x[a], x[b]) / run);
+                if (from_corner > 0.05 * h) t.straight_rel = std::max(t.straight_rel, segment_distance(p, x[a], x[b]) / run);
                 if (near_corner) {
                     double poly = HUGE_VAL;
                     for (std::size_t j = (k > 0 ? k - 1 : 0); j <= std::min(k + 1, n - 2); ++j)
-                        poly = std::min(poly, distance_to_segment(p, x[j], x[j + 1]));
+                        poly = std::min(poly, segment_distance(p, x[j], x[j + 1]));
                     t.bulge_rel = std::max(t.bulge_rel, poly / h);
                 }
             }
