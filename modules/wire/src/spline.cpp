@@ -237,60 +237,6 @@ struct Tangents {
     std::vector<dvec3> t0, t1;
 };
 
-// C2 interpolating spline with chordal knots; tangents D per unit knot solved globally, then scaled by h.
-void c2_tangents(const Chords& ch, bool closed, Tangents& tg) {
-    const std::size_t segs = ch.d.size();
-    const std::size_t n = closed ? segs : segs + 1;  // nodes
-    const std::vector<dvec3>& s = ch.e;
-    std::vector<dvec3> D(n);
-    if (closed) {
-        std::vector<double> a(n), b(n, 2.0), c(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t kin = i == 0 ? segs - 1 : i - 1, kout = i;
-            const double hin = ch.len[kin], hout = ch.len[kout], sum = hin + hout;
-            a[i] = hout / sum, c[i] = hin / sum;
-            D[i] = 3.0 * (a[i] * s[kin] + c[i] * s[kout]);
-        }
-        thomas_cyclic(a, b, c, D);
-    } else if (n == 2) {
-        D[0] = D[1] = s[0];
-    } else if (n == 3) {  // not-a-knot on 3 nodes is the interpolating parabola
-        const double h0 = ch.len[0], h1 = ch.len[1], sum = h0 + h1;
-        D[0] = s[0] - h0 * (s[1] - s[0]) / sum;
-        D[1] = (h1 * s[0] + h0 * s[1]) / sum;
-        D[2] = s[1] + h1 * (s[1] - s[0]) / sum;
-    } else {
-        // Rows i = 0..n-1 normalized: lambda_i D[i-1] + 2 D[i] + mu_i D[i+1] = r_i; ends not-a-knot:
-        // row 0: b0 D0 + D1 = r0 with b0 = lambda_1, so row1 - row0 eliminates D0 exactly (pivot 1), and
-        // likewise at the far end. The reduced system on D[1..n-2] has unit diagonal.
-        const double h0 = ch.len[0], h1 = ch.len[1];
-        const double b0 = h1 / (h0 + h1);
-        const dvec3 r0 = (s[0] * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s[1]) / ((h0 + h1) * (h0 + h1));
-        const double hL = ch.len[segs - 1], hP = ch.len[segs - 2];
-        const double bl = hP / (hP + hL);
-        const dvec3 rl = (s[segs - 1] * (hP * (3.0 * hL + 2.0 * hP)) + (hL * hL) * s[segs - 2]) / ((hP + hL) * (hP + hL));
-        const std::size_t m = n - 2;
-        std::vector<double> a(m), b(m, 2.0), c(m);
-        std::vector<dvec3> r(m);
-        for (std::size_t j = 0; j < m; ++j) {
-            const std::size_t i = j + 1;
-            const double hin = ch.len[i - 1], hout = ch.len[i], sum = hin + hout;
-            a[j] = hout / sum, c[j] = hin / sum;
-            r[j] = 3.0 * (a[j] * s[i - 1] + c[j] * s[i]);
-        }
-        r[0] -= r0, b[0] -= 1.0, a[0] = 0.0;
-        r[m - 1] -= rl, b[m - 1] -= 1.0, c[m - 1] = 0.0;
-        thomas(a, b, c, r);
-        for (std::size_t j = 0; j < m; ++j) D[j + 1] = r[j];
-        D[0] = (r0 - D[1]) / b0;
-        D[n - 1] = (rl - D[n - 2]) / bl;
-    }
-    for (std::size_t k = 0; k < segs; ++k) {
-        tg.t0[k] = D[k] * ch.len[k];
-        tg.t1[k] = D[k + 1 == n ? 0 : k + 1] * ch.len[k];
-    }
-}
-
 // ---- automatic: the nu-spline under tension read from the nodes' turning pattern (DESIGN §4.1,
 // modules/wire/DESIGN.md "Automatic spline").
 
@@ -474,6 +420,14 @@ void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>
         tg.t0[k] = D[k] * ch.len[k];
         tg.t1[k] = D[k + 1 == n ? 0 : k + 1] * ch.len[k];
     }
+}
+
+// C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the automatic
+// spline's solve with no node tensed (w = 0 everywhere, ends purely not-a-knot), so the two share one solver.
+void c2_tangents(const Chords& ch, bool closed, Tangents& tg) {
+    thread_local std::vector<double> untensed;
+    untensed.assign(closed ? ch.d.size() : ch.d.size() + 1, 0.0);
+    automatic_tangents(ch, closed, untensed, untensed, tg);
 }
 
 }  // namespace
