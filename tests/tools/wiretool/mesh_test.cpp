@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tool_test.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,38 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct ToolRun {
-    int status = -1;
-    std::string err;
-};
+using wiretool_test::ToolRun;
 
-class WiretoolMesh : public ::testing::Test {
+class WiretoolMesh : public wiretool_test::ToolTest {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("wiretool_mesh_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::string write(const std::string& name, const std::string& text) const {
-        std::ofstream(path(name)) << text;
-        return path(name);
-    }
-    ToolRun run(const std::string& args) const {
-        const std::string err = path("stderr.txt");
-        const std::string cmd = std::string(WIRETOOL_PATH) + " " + args + " 2> " + err + " > /dev/null";
-        ToolRun r;
-        const int raw = std::system(cmd.c_str());
-        r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-        std::ifstream in(err);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        r.err = ss.str();
-        return r;
-    }
+    WiretoolMesh() : ToolTest("wiretool_mesh", "") {}
     static std::vector<std::vector<std::string>> read_csv(const std::string& file, std::string& header) {
         std::ifstream in(file);
         std::getline(in, header);
@@ -60,7 +35,6 @@ protected:
         }
         return rows;
     }
-    fs::path dir_;
 };
 
 /// A hanging cable: 12 nodes on y = cosh.

@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tool_test.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -34,10 +36,7 @@ namespace {
 constexpr int kFlightFrames = 16;
 constexpr double kFarthestM = 2000.0;
 
-struct ToolRun {
-    int status = -1;
-    std::string err;
-};
+using wiretool_test::ToolRun;
 
 /// Three wires inside a sphere of radius ~0.4 m around the origin: a hanging cable, a helix, a wavy run.
 json three_wires() {
@@ -74,34 +73,9 @@ json flight_scene() {
     return {{"frames", frames}};
 }
 
-class WiretoolView : public ::testing::Test {
+class WiretoolView : public wiretool_test::ToolTest {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("wiretool_view_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::string write(const std::string& name, const std::string& text) const {
-        std::ofstream(path(name)) << text;
-        return path(name);
-    }
-    ToolRun run(const std::string& args) const {
-        const std::string err = (dir_.parent_path() / (dir_.filename().string() + "_stderr.txt")).string();
-        const std::string cmd = std::string(WIRETOOL_PATH) + " view " + args + " 2> " + err + " > /dev/null";
-        ToolRun r;
-        const int raw = std::system(cmd.c_str());
-        r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-        std::ifstream in(err);
-        std::stringstream ss;
-        ss << in.rdbuf();
-        r.err = ss.str();
-        fs::remove(err);
-        return r;
-    }
+    WiretoolView() : ToolTest("wiretool_view", "view ") {}
     /// Files in the test directory (the inputs included), sorted.
     std::vector<std::string> listing() const {
         std::vector<std::string> names;
@@ -125,7 +99,6 @@ protected:
         }
         return rows;
     }
-    fs::path dir_;
 };
 
 // CSV columns.
