@@ -71,6 +71,13 @@ std::vector<double> ratios(const std::vector<std::vector<double>>& dev) {
     return r;
 }
 
+// The per-case ratio auto / chordal, as a distribution.
+void print_ratios(const std::vector<std::vector<double>>& dev) {
+    const Stats rs = stats(ratios(dev));
+    std::printf("  auto / chordal per case: mean %.3f median %.3f p90 %.3f max %.3f (#%zu)\n", rs.mean, rs.median,
+                rs.p90, rs.max, rs.worst);
+}
+
 }  // namespace
 
 TEST(WireCurveFamilies, CatenariesAutoBeatsChordalCatmullRomOnEveryCase) {
@@ -78,10 +85,7 @@ TEST(WireCurveFamilies, CatenariesAutoBeatsChordalCatmullRomOnEveryCase) {
     ASSERT_EQ(cases.size(), 300u);
     const auto dev = deviations(cases);
     print("catenary", "mm", 1e3, dev, cases);
-    const std::vector<double> r = ratios(dev);
-    const Stats rs = stats(r);
-    std::printf("  auto / chordal per case: mean %.3f median %.3f p90 %.3f max %.3f (#%zu)\n", rs.mean, rs.median,
-                rs.p90, rs.max, rs.worst);
+    print_ratios(dev);
     const Stats a = stats(dev[kAuto]), ch = stats(dev[kChordal]);
     EXPECT_LE(a.mean, 0.5 * ch.mean) << "family mean: auto " << a.mean << " m, chordal " << ch.mean << " m";
     for (std::size_t i = 0; i < cases.size(); ++i)
@@ -92,10 +96,7 @@ TEST(WireCurveFamilies, WrappedCablesAutoWithinThreeJsChordal) {
     const std::vector<Case> cases = wrapped(kSeed, 120);
     const auto dev = deviations(cases);
     print("wrapped (sheave/drum)", "mm", 1e3, dev, cases);
-    const std::vector<double> r = ratios(dev);
-    const Stats rs = stats(r);
-    std::printf("  auto / chordal per case: mean %.3f median %.3f p90 %.3f max %.3f (#%zu)\n", rs.mean, rs.median,
-                rs.p90, rs.max, rs.worst);
+    print_ratios(dev);
     const Stats a = stats(dev[kAuto]), ch = stats(dev[kChordal]);
     EXPECT_LE(a.mean, 0.8 * ch.mean) << "family mean: auto " << a.mean << " m, chordal " << ch.mean << " m";
     for (std::size_t i = 0; i < cases.size(); ++i)
@@ -106,10 +107,7 @@ TEST(WireCurveFamilies, HelicesReport) {
     const std::vector<Case> cases = helices(kSeed, 100);
     const auto dev = deviations(cases);
     print("helix", "mm", 1e3, dev, cases);
-    const std::vector<double> r = ratios(dev);
-    const Stats rs = stats(r);
-    std::printf("  auto / chordal per case: mean %.3f median %.3f p90 %.3f max %.3f (#%zu)\n", rs.mean, rs.median,
-                rs.p90, rs.max, rs.worst);
+    print_ratios(dev);
     // Report only (the issue asks for no bound); the family must at least build and stay finite.
     for (double d : dev[kAuto]) EXPECT_TRUE(std::isfinite(d));
 }
