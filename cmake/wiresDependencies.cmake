@@ -8,41 +8,24 @@
 # Sets wires_deps_missing to the list of what was not found (the caller turns it into an error).
 set(wires_deps_missing "")
 
-if(NOT TARGET wires_deps::epoxy)
-  find_path(WIRES_EPOXY_INCLUDE_DIR epoxy/gl.h)
-  find_library(WIRES_EPOXY_LIBRARY epoxy)
-  if(WIRES_EPOXY_INCLUDE_DIR AND WIRES_EPOXY_LIBRARY)
-    add_library(wires_deps::epoxy UNKNOWN IMPORTED)
-    set_target_properties(wires_deps::epoxy PROPERTIES
-      IMPORTED_LOCATION "${WIRES_EPOXY_LIBRARY}"
-      INTERFACE_INCLUDE_DIRECTORIES "${WIRES_EPOXY_INCLUDE_DIR}")
-  else()
-    list(APPEND wires_deps_missing "libepoxy (Debian: libepoxy-dev)")
+# wires_deps::<name> from a header (found with the given path suffix, may be empty) and a library; on failure
+# `what` goes into wires_deps_missing. The cache variables are WIRES_<NAME>_INCLUDE_DIR and WIRES_<NAME>_LIBRARY.
+macro(wires_import_dependency name header suffix library what)
+  string(TOUPPER "${name}" _wires_upper)
+  if(NOT TARGET wires_deps::${name})
+    find_path(WIRES_${_wires_upper}_INCLUDE_DIR ${header} PATH_SUFFIXES ${suffix})
+    find_library(WIRES_${_wires_upper}_LIBRARY ${library})
+    if(WIRES_${_wires_upper}_INCLUDE_DIR AND WIRES_${_wires_upper}_LIBRARY)
+      add_library(wires_deps::${name} UNKNOWN IMPORTED)
+      set_target_properties(wires_deps::${name} PROPERTIES
+        IMPORTED_LOCATION "${WIRES_${_wires_upper}_LIBRARY}"
+        INTERFACE_INCLUDE_DIRECTORIES "${WIRES_${_wires_upper}_INCLUDE_DIR}")
+    else()
+      list(APPEND wires_deps_missing "${what}")
+    endif()
   endif()
-endif()
+endmacro()
 
-if(NOT TARGET wires_deps::stb)
-  find_path(WIRES_STB_INCLUDE_DIR stb_image.h PATH_SUFFIXES stb)
-  find_library(WIRES_STB_LIBRARY stb)
-  if(WIRES_STB_INCLUDE_DIR AND WIRES_STB_LIBRARY)
-    add_library(wires_deps::stb UNKNOWN IMPORTED)
-    set_target_properties(wires_deps::stb PROPERTIES
-      IMPORTED_LOCATION "${WIRES_STB_LIBRARY}"
-      INTERFACE_INCLUDE_DIRECTORIES "${WIRES_STB_INCLUDE_DIR}")
-  else()
-    list(APPEND wires_deps_missing "stb (Debian: libstb-dev)")
-  endif()
-endif()
-
-if(NOT TARGET wires_deps::opensubdiv)
-  find_path(WIRES_OSD_INCLUDE_DIR opensubdiv/far/topologyRefiner.h)
-  find_library(WIRES_OSD_CPU_LIBRARY osdCPU)
-  if(WIRES_OSD_INCLUDE_DIR AND WIRES_OSD_CPU_LIBRARY)
-    add_library(wires_deps::opensubdiv UNKNOWN IMPORTED)
-    set_target_properties(wires_deps::opensubdiv PROPERTIES
-      IMPORTED_LOCATION "${WIRES_OSD_CPU_LIBRARY}"
-      INTERFACE_INCLUDE_DIRECTORIES "${WIRES_OSD_INCLUDE_DIR}")
-  else()
-    list(APPEND wires_deps_missing "OpenSubdiv (Debian: libosd-dev)")
-  endif()
-endif()
+wires_import_dependency(epoxy epoxy/gl.h "" epoxy "libepoxy (Debian: libepoxy-dev)")
+wires_import_dependency(stb stb_image.h stb stb "stb (Debian: libstb-dev)")
+wires_import_dependency(opensubdiv opensubdiv/far/topologyRefiner.h "" osdCPU "OpenSubdiv (Debian: libosd-dev)")
