@@ -219,7 +219,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         // primed from previous_nodes if the next state changes ids, as after any fast-path frame).
         const bool first = c.generation == 0;
         bool stays_released = false;
-        BoundingSphere sphere{};
+        BoundingSphere sphere{};  // of the new curve, once computed (radius >= 0)
         if (!pop_free || same_ids || first) {
             // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
             job.status = build_curve(nodes, spline, scratch);
@@ -255,7 +255,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         if (job.status.ok) {
             ++c.generation;
             // The LOD's O(1) cull test; its LodBounds are the LOD stage's (WireCurve::lod_bounds).
-            c.bounds = stays_released ? sphere : curve_bounding_sphere(c.curve);
+            c.bounds = sphere.radius_m >= 0.0 ? sphere : curve_bounding_sphere(c.curve);
             job.changed = true;
             c.previous_nodes = nodes;
             c.released = stays_released;
