@@ -104,7 +104,20 @@ void row(const char* what, const char* unit, double offset, const std::vector<do
 }  // namespace
 
 int main(int argc, char** argv) {
-    const int per_family = argc > 1 ? std::max(1, std::atoi(argv[1])) : 60;
+    int per_family = 60;
+    if (argc > 1) {
+        const std::string arg = argv[1];
+        char* end = nullptr;
+        const long v = std::strtol(arg.c_str(), &end, 10);
+        if (arg == "-h" || arg == "--help" || end == arg.c_str() || *end != '\0' || v < 1 || v > 100000 || argc > 2) {
+            std::fprintf(arg == "-h" || arg == "--help" ? stdout : stderr,
+                         "Usage: example_float_precision [cases_per_family=60]  (1..100000)\n"
+                         "Which stages of the moving path need double: random family wires 0-1e8 m from the origin, "
+                         "curve input stored in float, ring stage in float; distribution per stage and offset.\n");
+            return arg == "-h" || arg == "--help" ? 0 : 2;
+        }
+        per_family = static_cast<int>(v);
+    }
     constexpr uint64_t kSeed = 20261124;
     std::vector<wire::families::Case> cases = wire::families::catenaries(kSeed, per_family);
     for (auto& c : wire::families::helices(kSeed, per_family)) cases.push_back(std::move(c));
