@@ -1,5 +1,6 @@
 // Rotation-minimizing frames by double reflection, hairpin subdivision, closed-loop holonomy removal; baselines.
 #include "wire/frames.hpp"
+#include "wire/detail/simd.hpp"
 
 #include <glm/mat3x3.hpp>
 
@@ -17,6 +18,9 @@ namespace {
 constexpr double kSplitCos = 0.70710678118654752;
 
 double max_abs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
+/// The largest of three magnitudes (no NaN; equal values are equal), without a branch.
+double max3(double a, double b, double c) { return std::max(std::max(a, b), c); }
 
 /// r made orthogonal to unit t and normalized; `fallback` (also made orthogonal) if r is (nearly) parallel to t.
 glm::dvec3 orthonormalize(const glm::dvec3& r, const glm::dvec3& t) {
@@ -80,6 +84,81 @@ Mirrors mirrors(const Sample& a, const Sample& b, double noise, MirrorPair& m) {
     // method's error grows with the turn per step. Either way the step is split at its parameter midpoint; at a
     // cusp only the half containing it keeps splitting, so the cost is O(depth), not O(2^depth).
     return (c2 < 0.1 || glm::dot(a.t, b.t) < kSplitCos) ? Mirrors::split : Mirrors::ok;
+}
+
+/// Unit tangents at t = 0 of `count` consecutive segments (12 doubles each from `c`, b0 to b3): B'(0) = 3 (b1 - b0)
+/// times the reciprocal of its length, the operations build_rings uses for a ring at t = 0 (so a crossed boundary
+/// and a ring there carry the same tangent). ok[b] = 0 where the derivative is below the segment's rounding noise:
+/// the caller takes unit_tangent()'s one-sided limits there. Separate restrict outputs: the loop vectorizes.
+WIRE_VECTOR_CLONES void boundary_tangents(const double* __restrict c, std::size_t count, double* __restrict tx, double* __restrict ty,
+                       double* __restrict tz, double* __restrict ok) {
+    for (std::size_t b = 0; b < count; ++b) {
+        const double* s = c + 12 * b;  // b0 = s[0..2], b1 = s[3..5], b2 = s[6..8], b3 = s[9..11]
+        const double dx = 3.0 * (s[3] - s[0]), dy = 3.0 * (s[4] - s[1]), dz = 3.0 * (s[5] - s[2]);
+        const double speed = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const double extent = max3(max3(std::abs(s[3] - s[0]), std::abs(s[4] - s[1]), std::abs(s[5] - s[2])),
+                                   max3(std::abs(s[6] - s[0]), std::abs(s[7] - s[1]), std::abs(s[8] - s[2])),
+                                   max3(std::abs(s[9] - s[0]), std::abs(s[10] - s[1]), std::abs(s[11] - s[2])));
+        const double inv = 1.0 / speed;
+        tx[b] = dx * inv;
+        ty[b] = dy * inv;
+        tz[b] = dz * inv;
+        const double tiny = 1e-10 * extent + 1e-15 * max3(std::abs(s[0]), std::abs(s[1]), std::abs(s[2])) + 1e-300;
+        ok[b] = speed > tiny ? 1.0 : 0.0;
+    }
+}
+
+/// The double-reflection step from point q - 1 to point q (positions x, y, z relative to the rings' origin, unit
+/// tangents tx, ty, tz) for q = 1 .. m - 1, as one matrix (column-major entries e00 .. e22: e<column><row>), with the
+/// operations mirrors() and the step's matrix take, branch-free so the loop vectorizes. special[q] = 1 where
+/// mirrors() would not answer ok (repeated point with reversing tangent, vanishing or ill-conditioned second
+/// mirror, a turn over 45 degrees) or the matrix is not a number: the guarded path takes those steps.
+WIRE_VECTOR_CLONES void step_matrices(const double* __restrict x, const double* __restrict y, const double* __restrict z,
+                   const double* __restrict tx, const double* __restrict ty, const double* __restrict tz, std::size_t m,
+                   double origin_noise, double* __restrict e00, double* __restrict e01, double* __restrict e02,
+                   double* __restrict e10, double* __restrict e11, double* __restrict e12, double* __restrict e20,
+                   double* __restrict e21, double* __restrict e22, double* __restrict special) {
+    for (std::size_t q = 1; q < m; ++q) {
+        const double ax = x[q - 1], ay = y[q - 1], az = z[q - 1];
+        const double bx = x[q], by = y[q], bz = z[q];
+        const double atx = tx[q - 1], aty = ty[q - 1], atz = tz[q - 1];
+        const double btx = tx[q], bty = ty[q], btz = tz[q];
+        // Transporter::noise()
+        const double noise = origin_noise + 1e-13 * (max3(std::abs(ax), std::abs(ay), std::abs(az)) +
+                                                     max3(std::abs(bx), std::abs(by), std::abs(bz)));
+        double v1x = bx - ax, v1y = by - ay, v1z = bz - az;
+        double c1 = v1x * v1x + v1y * v1y + v1z * v1z;
+        const bool repeated = c1 <= noise * noise * 64.0;
+        const double sx = atx + btx, sy = aty + bty, sz = atz + btz;
+        const double cs = sx * sx + sy * sy + sz * sz;
+        v1x = repeated ? sx : v1x;
+        v1y = repeated ? sy : v1y;
+        v1z = repeated ? sz : v1z;
+        c1 = repeated ? cs : c1;
+        const double f1 = 2.0 / c1;
+        const double d1 = f1 * (v1x * atx + v1y * aty + v1z * atz);
+        const double v2x = btx - (atx - d1 * v1x), v2y = bty - (aty - d1 * v1y), v2z = btz - (atz - d1 * v1z);
+        const double c2 = v2x * v2x + v2y * v2y + v2z * v2z;
+        const double f2 = 2.0 / c2;
+        const double k = f1 * (v2x * v1x + v2y * v1y + v2z * v1z);
+        // Column c: e_c - f1 v1 v1_c - f2 v2 (v2_c - k v1_c), k = f1 (v2.v1).
+        const double g1x = f1 * v1x, g2x = f2 * (v2x - k * v1x);
+        const double g1y = f1 * v1y, g2y = f2 * (v2y - k * v1y);
+        const double g1z = f1 * v1z, g2z = f2 * (v2z - k * v1z);
+        const double m00 = 1.0 - (v1x * g1x + v2x * g2x);
+        e00[q] = m00;
+        e01[q] = 0.0 - (v1y * g1x + v2y * g2x);
+        e02[q] = 0.0 - (v1z * g1x + v2z * g2x);
+        e10[q] = 0.0 - (v1x * g1y + v2x * g2y);
+        e11[q] = 1.0 - (v1y * g1y + v2y * g2y);
+        e12[q] = 0.0 - (v1z * g1y + v2z * g2y);
+        e20[q] = 0.0 - (v1x * g1z + v2x * g2z);
+        e21[q] = 0.0 - (v1y * g1z + v2y * g2z);
+        e22[q] = 1.0 - (v1z * g1z + v2z * g2z);
+        const bool not_ok = (repeated & (cs < 1e-20)) | (c2 < 1e-20) | (c2 < 0.1) |
+                            ((atx * btx + aty * bty + atz * btz) < kSplitCos) | (m00 != m00);
+        special[q] = not_ok ? 1.0 : 0.0;
+    }
 }
 
 glm::dvec3 reflect_pair(const MirrorPair& m, glm::dvec3 r) {
@@ -189,18 +268,6 @@ glm::dvec3 unit_tangent(const CubicBezier& c, double t, bool* degenerate) {
     return glm::dvec3(0.0);
 }
 
-namespace {
-/// Unit tangent at t = 0, computed as build_rings computes a ring's there (B'(0) = 3 (b1 - b0), times the
-/// reciprocal of its length), so a crossed boundary and a ring at the same point carry the same tangent; where the
-/// derivative vanishes, unit_tangent()'s one-sided limits.
-glm::dvec3 boundary_tangent(const CubicBezier& c) {
-    const glm::dvec3 d = 3.0 * (c.b1 - c.b0);
-    const double speed = std::sqrt(glm::dot(d, d));
-    const double extent = std::max({max_abs(c.b1 - c.b0), max_abs(c.b2 - c.b0), max_abs(c.b3 - c.b0)});
-    if (speed > 1e-10 * extent + 1e-15 * max_abs(c.b0) + 1e-300) return d * (1.0 / speed);
-    return unit_tangent(c, 0.0);
-}
-}  // namespace
 
 FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, std::span<Frame> out) {
     FrameStats stats;
@@ -288,69 +355,105 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // ring per segment would give them (no twist pop when spans merge or split), and the boundaries take the
         // same independent-per-step path as rings. A boundary's tangent is computed as a ring's at t = 0 is.
         // Pass 1, independent per step: the product of the two reflections as one matrix (no square root: the
-        // mirrors are not normalized), H2 H1 = I - f1 v1 v1^T - f2 v2 v2^T + f1 f2 (v2.v1) v2 v1^T; a NaN marks a
+        // mirrors are not normalized), H2 H1 = I - f1 v1 v1^T - f2 v2 v2^T + f1 f2 (v2.v1) v2 v1^T; a flag marks a
         // step for the guarded path. Pass 2 then carries r by one matrix-vector product per step: the only serial
         // dependency, and a short one (no square root, no division), which is what bounds the speed. Reflections
         // keep |r| = 1 and r normal to t up to rounding, which is removed every 64 steps (drift stays ~1e-15); the
         // count runs over points, so a span's rings are re-projected exactly where the node-resolution rings are.
         // Pass 3: binormals.
-        struct Point {
-            Sample s;
-            uint32_t seg;   // the segment a step from this point runs along
-            double ta;      // ... from this parameter
-            int64_t ring;   // ring index, or -1 for a crossed boundary
+        const CubicBezier* const segs = in.curve != nullptr ? in.curve->segments.data() : nullptr;
+        // The points, in structure-of-arrays scratch (grows once per thread, then reused): position, tangent, the
+        // segment and parameter a step from the point runs along, and the ring index (-1: a crossed boundary).
+        std::size_t m = n;
+        std::size_t first_crossed = n_seg, last_crossed = 0;  // boundary range whose tangents are needed
+        for (std::size_t i = 1; i < n; ++i) {
+            const RingParam& pa = in.params[i - 1];
+            const RingParam& pb = in.params[i];
+            if (crosses(pa, pb, false)) {
+                const std::size_t end = boundary_end(pb, false);
+                m += end - (pa.segment + 1);
+                first_crossed = std::min<std::size_t>(first_crossed, pa.segment + 1);
+                last_crossed = std::max(last_crossed, end);
+            }
+        }
+        thread_local std::vector<double> soa;
+        thread_local std::vector<uint32_t> point_seg;
+        thread_local std::vector<double> point_ta;
+        thread_local std::vector<int64_t> point_ring;
+        const std::size_t nb = last_crossed > first_crossed ? last_crossed - first_crossed : 0;
+        soa.resize(16 * m + 4 * nb);
+        point_seg.resize(m);
+        point_ta.resize(m);
+        point_ring.resize(m);
+        double* const px = soa.data();
+        double* const py = px + m;
+        double* const pz = py + m;
+        double* const ptx = pz + m;
+        double* const pty = ptx + m;
+        double* const ptz = pty + m;
+        double* const mat = ptz + m;      // 9 arrays: the step matrix into point j, column-major entries
+        double* const special = mat + 9 * m;  // nonzero: the step into j takes the guarded path
+        // Boundary tangents of the crossed range: B'(0) = 3 (b1 - b0) times the reciprocal of its length, the same
+        // operations as build_rings uses for a ring at t = 0 (a crossed boundary and a ring there carry the same
+        // tangent), in a pass the compiler vectorizes; a vanishing derivative (flag 0) takes unit_tangent()'s
+        // one-sided limits below.
+        double* const btan = special + m;  // 4 arrays: x, y, z, ok
+        static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
+        if (nb != 0) boundary_tangents(&segs[first_crossed].b0.x, nb, btan, btan + nb, btan + 2 * nb, btan + 3 * nb);
+        std::size_t j = 0;
+        auto put = [&](const glm::dvec3& x, const glm::dvec3& t, uint32_t seg, double ta, int64_t ring) {
+            px[j] = x.x;
+            py[j] = x.y;
+            pz[j] = x.z;
+            ptx[j] = t.x;
+            pty[j] = t.y;
+            ptz[j] = t.z;
+            point_seg[j] = seg;
+            point_ta[j] = ta;
+            point_ring[j] = ring;
+            ++j;
         };
-        thread_local std::vector<Point> points;  // grows once per thread, then reused
-        points.clear();
-        points.push_back(Point{{in.centre_m[0], out[0].t}, in.params[0].segment, in.params[0].t, 0});
+        put(in.centre_m[0], out[0].t, in.params[0].segment, in.params[0].t, 0);
         for (std::size_t i = 1; i < n; ++i) {
             const RingParam& pa = in.params[i - 1];
             const RingParam& pb = in.params[i];
             if (crosses(pa, pb, false)) {
                 glm::dvec3 cur_t = out[i - 1].t;
                 for (std::size_t k = static_cast<std::size_t>(pa.segment) + 1; k < boundary_end(pb, false); ++k) {
-                    const CubicBezier& c = in.curve->segments[k];
-                    glm::dvec3 t = boundary_tangent(c);
+                    const CubicBezier& c = segs[k];
+                    const std::size_t b = k - first_crossed;
+                    glm::dvec3 t = btan[3 * nb + b] != 0.0 ? glm::dvec3(btan[b], btan[nb + b], btan[2 * nb + b])
+                                                           : unit_tangent(c, 0.0);
                     if (t == glm::dvec3(0.0)) t = cur_t;
-                    points.push_back(Point{{c.b0 - in.origin_m, t}, static_cast<uint32_t>(k), 0.0, -1});
+                    put(c.b0 - in.origin_m, t, static_cast<uint32_t>(k), 0.0, -1);
                     cur_t = t;
                 }
             }
-            points.push_back(Point{{in.centre_m[i], out[i].t}, pb.segment, pb.t, static_cast<int64_t>(i)});
+            put(in.centre_m[i], out[i].t, pb.segment, pb.t, static_cast<int64_t>(i));
         }
-        const std::size_t m = points.size();
-        thread_local std::vector<glm::dmat3> step_matrix;
-        step_matrix.resize(m);
-        constexpr double kSpecial = std::numeric_limits<double>::quiet_NaN();
-        for (std::size_t j = 1; j < m; ++j) {
-            const Sample& a = points[j - 1].s;
-            const Sample& b = points[j].s;
-            MirrorPair mp;
-            if (mirrors(a, b, transport.noise(a, b), mp) == Mirrors::ok) {
-                const double k = mp.f1 * glm::dot(mp.v2, mp.v1);
-                glm::dmat3 mat(1.0);
-                for (int c = 0; c < 3; ++c) {  // column c: e_c - f1 v1 v1_c - f2 v2 (v2_c - f1 (v2.v1) v1_c)
-                    mat[c] -= mp.v1 * (mp.f1 * mp.v1[c]) + mp.v2 * (mp.f2 * (mp.v2[c] - k * mp.v1[c]));
-                }
-                step_matrix[j] = mat;
-            } else {
-                step_matrix[j][0][0] = kSpecial;
-            }
-        }
+        assert(j == m);
+        // Pass 1: mirrors() and the step matrix of every step, branch-free (selects), vectorized; a step mirrors()
+        // would not call ok is flagged for the guarded path.
+        step_matrices(px, py, pz, ptx, pty, ptz, m, 1e-13 * max_abs(in.origin_m), mat, mat + m, mat + 2 * m,
+                      mat + 3 * m, mat + 4 * m, mat + 5 * m, mat + 6 * m, mat + 7 * m, mat + 8 * m, special);
+        // Pass 2: carry r, one matrix-vector product per step (the serial part); guarded steps through Transporter.
         glm::dvec3 r = r0;
-        for (std::size_t j = 1; j < m; ++j) {
-            const Point& a = points[j - 1];
-            const Point& b = points[j];
-            if (std::isnan(step_matrix[j][0][0])) {
-                const double tb = b.seg == a.seg ? b.ta : 1.0;
-                r = transport.step(a.seg, a.ta, a.s, glm::normalize(r), tb, b.s);
+        for (std::size_t q = 1; q < m; ++q) {
+            const Sample b{{px[q], py[q], pz[q]}, {ptx[q], pty[q], ptz[q]}};
+            if (special[q] != 0.0) {
+                const Sample a{{px[q - 1], py[q - 1], pz[q - 1]}, {ptx[q - 1], pty[q - 1], ptz[q - 1]}};
+                const double tb = point_seg[q] == point_seg[q - 1] ? point_ta[q] : 1.0;
+                r = transport.step(point_seg[q - 1], point_ta[q - 1], a, glm::normalize(r), tb, b);
             } else {
-                r = step_matrix[j] * r;
-                if ((j & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
-                    r = orthonormalize(r, b.s.t);
+                const double* e = mat + q;
+                r = glm::dvec3(e[0] * r.x + e[3 * m] * r.y + e[6 * m] * r.z,
+                               e[m] * r.x + e[4 * m] * r.y + e[7 * m] * r.z,
+                               e[2 * m] * r.x + e[5 * m] * r.y + e[8 * m] * r.z);
+                if ((q & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
+                    r = orthonormalize(r, b.t);
                 }
             }
-            if (b.ring >= 0) out[static_cast<std::size_t>(b.ring)].r = r;
+            if (point_ring[q] >= 0) out[static_cast<std::size_t>(point_ring[q])].r = r;
         }
         for (std::size_t i = 1; i < n; ++i) {
             out[i].s = glm::cross(out[i].t, out[i].r);

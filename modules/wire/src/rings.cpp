@@ -1,10 +1,14 @@
 // Ring records: centres, frames, radius, stretch-aware texture u, fold detection.
 #include "wire/rings.hpp"
 
+#include "wire/detail/simd.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <vector>
 
 namespace wire {
 namespace {
@@ -133,6 +137,63 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     return out;
 }
 
+/// One radius on every node (or none): every segment is a constant-radius one (SegmentCoeffs: both node slopes
+/// 0, so r1 = r2 = r3 = 0 exactly).
+bool uniform_radius(const Curve& curve) {
+    const std::size_t n = curve.radius_m.size();
+    for (std::size_t k = 1; k < n; ++k) {
+        if (curve.radius_m[k] != curve.radius_m[0]) return false;
+    }
+    return true;
+}
+
+/// integrate()'s length over t in [0, 1] for n segments whose derivative coefficients d0, d1, d2 (x, y, z each) are
+/// the 9 arrays of n in `d`: the same operations in the same order.
+WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict d, std::size_t n, double* __restrict length_m) {
+    for (std::size_t k = 0; k < n; ++k) {
+        double len = 0.0;
+        for (int q = 0; q < kGlPoints; ++q) {
+            const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
+            const double x = d[0 * n + k] + t * (d[3 * n + k] + t * d[6 * n + k]);
+            const double y = d[1 * n + k] + t * (d[4 * n + k] + t * d[7 * n + k]);
+            const double z = d[2 * n + k] + t * (d[5 * n + k] + t * d[8 * n + k]);
+            len += (1.0 * kGlW[q]) * std::sqrt(x * x + y * y + z * z);
+        }
+        length_m[k] = len;
+    }
+}
+
+/// integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for every segment k of a uniform_radius() curve, bit for bit (the
+/// same operations in the same order), in two passes the compiler vectorizes: the derivative's power-basis
+/// coefficients into structure-of-arrays scratch, then the three Gauss points' speeds. A wire whose LOD puts
+/// fewer rings than nodes crosses most segments whole; this is their arc length and u.
+void whole_segment_integrals(const Curve& curve, std::vector<double>& length_m, std::vector<double>& u) {
+    const std::size_t n = curve.segment_count();
+    thread_local std::vector<double> coeff;  // d0, d1, d2 (x, y, z each): 9 arrays of n
+    coeff.resize(9 * n);
+    length_m.resize(n);
+    u.resize(n);
+    double* const d = coeff.data();
+    const CubicBezier* const seg = curve.segments.data();
+    for (std::size_t k = 0; k < n; ++k) {
+        const CubicBezier& c = seg[k];
+        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
+            d[(0 + a) * n + k] = 3.0 * (c.b1[a] - c.b0[a]);
+            d[(3 + a) * n + k] = 2.0 * (3.0 * (c.b2[a] - 2.0 * c.b1[a] + c.b0[a]));
+            d[(6 + a) * n + k] = 3.0 * (c.b3[a] - 3.0 * c.b2[a] + 3.0 * c.b1[a] - c.b0[a]);
+        }
+    }
+    const double r0 = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
+    const double r_safe = std::max(r0, 1e-30);
+    const std::size_t n_stretch = std::min(curve.stretch.size(), n);
+    gauss_whole_lengths(d, n, length_m.data());
+    for (std::size_t k = 0; k < n; ++k) {
+        double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
+        stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
+        u[k] = length_m[k] * (1.0 / (2.0 * std::numbers::pi * stretch * r_safe));
+    }
+}
+
 }  // namespace
 
 double radius_at(const Curve& curve, uint32_t segment, double t) {
@@ -168,6 +229,10 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         }
     };
     SegmentCoeffs crossed = seg;  // segments an interval crosses without a ring (LOD below node resolution)
+    // Whole segments (crossed ones, and a ring at t = 0 whose next ring is on a later segment): from one table.
+    thread_local std::vector<double> whole_length_m, whole_u;
+    const bool table = uniform_radius(curve);
+    if (table) whole_segment_integrals(curve, whole_length_m, whole_u);
     double s = 0.0;
     double u = settings.u_start;
     for (std::size_t i = 0; i < n; ++i) {
@@ -210,10 +275,16 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             const bool wrap = i + 1 == n;
             const RingParam b = wrap ? params[0] : params[i + 1];
             const double tb = (!wrap && b.segment == p.segment) ? b.t : 1.0;
-            Interval iv = integrate(seg, p.t, tb);
+            Interval iv = table && p.t == 0.0 && tb == 1.0 ? Interval{whole_length_m[p.segment], whole_u[p.segment]}
+                                                           : integrate(seg, p.t, tb);
             if (wrap || b.segment != p.segment) {
                 const std::size_t end = wrap ? curve.segment_count() : b.segment;
                 for (std::size_t k = p.segment + 1; k < end; ++k) {  // crossed segments, whole
+                    if (table) {
+                        iv.length_m += whole_length_m[k];
+                        iv.u += whole_u[k];
+                        continue;
+                    }
                     crossed.load(curve, static_cast<uint32_t>(k));  // one object: shared node slopes reused
                     const Interval ik = integrate(crossed, 0.0, 1.0);
                     iv.length_m += ik.length_m;
