@@ -1,6 +1,6 @@
 // Rotation-minimizing frames by double reflection, hairpin subdivision, closed-loop holonomy removal; baselines.
 #include "wire/frames.hpp"
-#include "wire/detail/simd.hpp"
+#include "wire/detail/segment_soa.hpp"
 
 #include <glm/mat3x3.hpp>
 
@@ -84,28 +84,6 @@ Mirrors mirrors(const Sample& a, const Sample& b, double noise, MirrorPair& m) {
     // method's error grows with the turn per step. Either way the step is split at its parameter midpoint; at a
     // cusp only the half containing it keeps splitting, so the cost is O(depth), not O(2^depth).
     return (c2 < 0.1 || glm::dot(a.t, b.t) < kSplitCos) ? Mirrors::split : Mirrors::ok;
-}
-
-/// Unit tangents at t = 0 of `count` consecutive segments (12 doubles each from `c`, b0 to b3): B'(0) = 3 (b1 - b0)
-/// times the reciprocal of its length, the operations build_rings uses for a ring at t = 0 (so a crossed boundary
-/// and a ring there carry the same tangent). ok[b] = 0 where the derivative is below the segment's rounding noise:
-/// the caller takes unit_tangent()'s one-sided limits there. Separate restrict outputs: the loop vectorizes.
-WIRE_VECTOR_CLONES void boundary_tangents(const double* __restrict c, std::size_t count, double* __restrict tx, double* __restrict ty,
-                       double* __restrict tz, double* __restrict ok) {
-    for (std::size_t b = 0; b < count; ++b) {
-        const double* s = c + 12 * b;  // b0 = s[0..2], b1 = s[3..5], b2 = s[6..8], b3 = s[9..11]
-        const double dx = 3.0 * (s[3] - s[0]), dy = 3.0 * (s[4] - s[1]), dz = 3.0 * (s[5] - s[2]);
-        const double speed = std::sqrt(dx * dx + dy * dy + dz * dz);
-        const double extent = max3(max3(std::abs(s[3] - s[0]), std::abs(s[4] - s[1]), std::abs(s[5] - s[2])),
-                                   max3(std::abs(s[6] - s[0]), std::abs(s[7] - s[1]), std::abs(s[8] - s[2])),
-                                   max3(std::abs(s[9] - s[0]), std::abs(s[10] - s[1]), std::abs(s[11] - s[2])));
-        const double inv = 1.0 / speed;
-        tx[b] = dx * inv;
-        ty[b] = dy * inv;
-        tz[b] = dz * inv;
-        const double tiny = 1e-10 * extent + 1e-15 * max3(std::abs(s[0]), std::abs(s[1]), std::abs(s[2])) + 1e-300;
-        ok[b] = speed > tiny ? 1.0 : 0.0;
-    }
 }
 
 /// The double-reflection step from point q - 1 to point q (positions x, y, z relative to the rings' origin, unit
@@ -223,6 +201,45 @@ private:
 };
 
 }  // namespace
+
+namespace detail {
+namespace {
+WIRE_VECTOR_CLONES void boundary_tangents_kernel(const double* __restrict b, std::size_t n, double* __restrict tx,
+                                                 double* __restrict ty, double* __restrict tz,
+                                                 double* __restrict ok) {
+    const double* b0x = b;
+    const double* b0y = b + n;
+    const double* b0z = b + 2 * n;
+    const double* b1x = b + 3 * n;
+    const double* b1y = b + 4 * n;
+    const double* b1z = b + 5 * n;
+    const double* b2x = b + 6 * n;
+    const double* b2y = b + 7 * n;
+    const double* b2z = b + 8 * n;
+    const double* b3x = b + 9 * n;
+    const double* b3y = b + 10 * n;
+    const double* b3z = b + 11 * n;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double dx = 3.0 * (b1x[k] - b0x[k]), dy = 3.0 * (b1y[k] - b0y[k]), dz = 3.0 * (b1z[k] - b0z[k]);
+        const double speed = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const double extent =
+            max3(max3(std::abs(b1x[k] - b0x[k]), std::abs(b1y[k] - b0y[k]), std::abs(b1z[k] - b0z[k])),
+                 max3(std::abs(b2x[k] - b0x[k]), std::abs(b2y[k] - b0y[k]), std::abs(b2z[k] - b0z[k])),
+                 max3(std::abs(b3x[k] - b0x[k]), std::abs(b3y[k] - b0y[k]), std::abs(b3z[k] - b0z[k])));
+        const double inv = 1.0 / speed;
+        tx[k] = dx * inv;
+        ty[k] = dy * inv;
+        tz[k] = dz * inv;
+        const double tiny = 1e-10 * extent + 1e-15 * max3(std::abs(b0x[k]), std::abs(b0y[k]), std::abs(b0z[k])) + 1e-300;
+        ok[k] = speed > tiny ? 1.0 : 0.0;
+    }
+}
+}  // namespace
+
+void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty, double* tz, double* ok) {
+    boundary_tangents_kernel(soa, n, tx, ty, tz, ok);
+}
+}  // namespace detail
 
 glm::dvec3 seed_normal(const glm::dvec3& t) {
     const glm::dvec3 a = glm::abs(t);
@@ -398,8 +415,18 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // tangent), in a pass the compiler vectorizes; a vanishing derivative (flag 0) takes unit_tangent()'s
         // one-sided limits below.
         double* const btan = special + m;  // 4 arrays: x, y, z, ok
-        static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
-        if (nb != 0) boundary_tangents(&segs[first_crossed].b0.x, nb, btan, btan + nb, btan + 2 * nb, btan + 3 * nb);
+        // Boundary tangents of the crossed range: build_rings's (every segment's), or computed here.
+        const double* bt = btan;
+        std::size_t bt_stride = nb;
+        if (nb != 0 && in.boundary_tangent.size() == 4 * n_seg) {
+            bt = in.boundary_tangent.data() + first_crossed;
+            bt_stride = n_seg;
+        } else if (nb != 0) {
+            thread_local std::vector<double> transposed;
+            transposed.resize(12 * nb);
+            detail::transpose_segments(segs + first_crossed, nb, transposed.data());
+            detail::boundary_tangents(transposed.data(), nb, btan, btan + nb, btan + 2 * nb, btan + 3 * nb);
+        }
         std::size_t j = 0;
         auto put = [&](const glm::dvec3& x, const glm::dvec3& t, uint32_t seg, double ta, int64_t ring) {
             px[j] = x.x;
@@ -422,7 +449,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                 for (std::size_t k = static_cast<std::size_t>(pa.segment) + 1; k < boundary_end(pb, false); ++k) {
                     const CubicBezier& c = segs[k];
                     const std::size_t b = k - first_crossed;
-                    glm::dvec3 t = btan[3 * nb + b] != 0.0 ? glm::dvec3(btan[b], btan[nb + b], btan[2 * nb + b])
+                    glm::dvec3 t = bt[3 * bt_stride + b] != 0.0 ? glm::dvec3(bt[b], bt[bt_stride + b], bt[2 * bt_stride + b])
                                                            : unit_tangent(c, 0.0);
                     if (t == glm::dvec3(0.0)) t = cur_t;
                     put(c.b0 - in.origin_m, t, static_cast<uint32_t>(k), 0.0, -1);

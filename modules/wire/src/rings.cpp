@@ -1,7 +1,7 @@
 // Ring records: centres, frames, radius, stretch-aware texture u, fold detection.
 #include "wire/rings.hpp"
 
-#include "wire/detail/simd.hpp"
+#include "wire/detail/segment_soa.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -137,6 +137,29 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     return out;
 }
 
+/// integrate()'s length over t in [0, 1] for n segments laid out by detail::transpose_segments(): SegmentCoeffs's
+/// derivative coefficients and the three Gauss points, the same operations in the same order.
+WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n, double* __restrict length_m) {
+    for (std::size_t k = 0; k < n; ++k) {
+        double d0[3], d1[3], d2[3];
+        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
+            const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
+            d0[a] = 3.0 * (p1 - p0);
+            d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
+            d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
+        }
+        double len = 0.0;
+        for (int q = 0; q < kGlPoints; ++q) {
+            const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
+            const double x = d0[0] + t * (d1[0] + t * d2[0]);
+            const double y = d0[1] + t * (d1[1] + t * d2[1]);
+            const double z = d0[2] + t * (d1[2] + t * d2[2]);
+            len += (1.0 * kGlW[q]) * std::sqrt(x * x + y * y + z * z);
+        }
+        length_m[k] = len;
+    }
+}
+
 /// One radius on every node (or none): every segment is a constant-radius one (SegmentCoeffs: both node slopes
 /// 0, so r1 = r2 = r3 = 0 exactly).
 bool uniform_radius(const Curve& curve) {
@@ -147,52 +170,37 @@ bool uniform_radius(const Curve& curve) {
     return true;
 }
 
-/// integrate()'s length over t in [0, 1] for n segments whose derivative coefficients d0, d1, d2 (x, y, z each) are
-/// the 9 arrays of n in `d`: the same operations in the same order.
-WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict d, std::size_t n, double* __restrict length_m) {
-    for (std::size_t k = 0; k < n; ++k) {
-        double len = 0.0;
-        for (int q = 0; q < kGlPoints; ++q) {
-            const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
-            const double x = d[0 * n + k] + t * (d[3 * n + k] + t * d[6 * n + k]);
-            const double y = d[1 * n + k] + t * (d[4 * n + k] + t * d[7 * n + k]);
-            const double z = d[2 * n + k] + t * (d[5 * n + k] + t * d[8 * n + k]);
-            len += (1.0 * kGlW[q]) * std::sqrt(x * x + y * y + z * z);
+/// Per-segment tables of a uniform_radius() curve, from one structure-of-arrays copy of its segments, in passes
+/// the compiler vectorizes: integrate(SegmentCoeffs(curve, k), 0.0, 1.0) of every segment k bit for bit (a wire
+/// whose LOD puts fewer rings than nodes crosses most segments whole: this is their arc length and u), and the
+/// unit tangent at every segment's start (the frames carry the normal through the boundaries an interval crosses).
+struct SegmentTables {
+    std::vector<double> soa;       // detail::transpose_segments()
+    std::vector<double> length_m;  // per segment
+    std::vector<double> u;         // per segment
+    std::vector<double> tangent;   // 4 arrays of segment_count(): FrameInput::boundary_tangent
+    void build(const Curve& curve, bool with_tangents) {
+        const std::size_t n = curve.segment_count();
+        soa.resize(12 * n);
+        length_m.resize(n);
+        u.resize(n);
+        tangent.resize(with_tangents ? 4 * n : 0);
+        detail::transpose_segments(curve.segments.data(), n, soa.data());
+        gauss_whole_lengths(soa.data(), n, length_m.data());
+        const double r0 = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
+        const double r_safe = std::max(r0, 1e-30);
+        const std::size_t n_stretch = std::min(curve.stretch.size(), n);
+        for (std::size_t k = 0; k < n; ++k) {  // SegmentCoeffs::load's u_per_m, integrate()'s u
+            double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
+            stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
+            u[k] = length_m[k] * (1.0 / (2.0 * std::numbers::pi * stretch * r_safe));
         }
-        length_m[k] = len;
-    }
-}
-
-/// integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for every segment k of a uniform_radius() curve, bit for bit (the
-/// same operations in the same order), in two passes the compiler vectorizes: the derivative's power-basis
-/// coefficients into structure-of-arrays scratch, then the three Gauss points' speeds. A wire whose LOD puts
-/// fewer rings than nodes crosses most segments whole; this is their arc length and u.
-void whole_segment_integrals(const Curve& curve, std::vector<double>& length_m, std::vector<double>& u) {
-    const std::size_t n = curve.segment_count();
-    thread_local std::vector<double> coeff;  // d0, d1, d2 (x, y, z each): 9 arrays of n
-    coeff.resize(9 * n);
-    length_m.resize(n);
-    u.resize(n);
-    double* const d = coeff.data();
-    const CubicBezier* const seg = curve.segments.data();
-    for (std::size_t k = 0; k < n; ++k) {
-        const CubicBezier& c = seg[k];
-        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
-            d[(0 + a) * n + k] = 3.0 * (c.b1[a] - c.b0[a]);
-            d[(3 + a) * n + k] = 2.0 * (3.0 * (c.b2[a] - 2.0 * c.b1[a] + c.b0[a]));
-            d[(6 + a) * n + k] = 3.0 * (c.b3[a] - 3.0 * c.b2[a] + 3.0 * c.b1[a] - c.b0[a]);
+        if (with_tangents) {
+            detail::boundary_tangents(soa.data(), n, tangent.data(), tangent.data() + n, tangent.data() + 2 * n,
+                                      tangent.data() + 3 * n);
         }
     }
-    const double r0 = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
-    const double r_safe = std::max(r0, 1e-30);
-    const std::size_t n_stretch = std::min(curve.stretch.size(), n);
-    gauss_whole_lengths(d, n, length_m.data());
-    for (std::size_t k = 0; k < n; ++k) {
-        double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
-        stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
-        u[k] = length_m[k] * (1.0 / (2.0 * std::numbers::pi * stretch * r_safe));
-    }
-}
+};
 
 }  // namespace
 
@@ -230,9 +238,18 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     };
     SegmentCoeffs crossed = seg;  // segments an interval crosses without a ring (LOD below node resolution)
     // Whole segments (crossed ones, and a ring at t = 0 whose next ring is on a later segment): from one table.
-    thread_local std::vector<double> whole_length_m, whole_u;
+    thread_local SegmentTables tables;  // grows once per thread, then reused
     const bool table = uniform_radius(curve);
-    if (table) whole_segment_integrals(curve, whole_length_m, whole_u);
+    if (table) {
+        // Boundary tangents only where some interval crosses a segment boundary (LOD below node resolution).
+        bool crossing = curve.closed && params.back().segment + 1 < curve.segment_count();
+        for (std::size_t i = 1; i < n && !crossing; ++i) {
+            crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
+        }
+        tables.build(curve, crossing);
+    }
+    const std::vector<double>& whole_length_m = tables.length_m;
+    const std::vector<double>& whole_u = tables.u;
     double s = 0.0;
     double u = settings.u_start;
     for (std::size_t i = 0; i < n; ++i) {
@@ -304,7 +321,10 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     }
     out.length_m = s;
 
-    const FrameInput in{&curve, params, out.origin_m, out.centre_m, out.tangent_scratch, out.arc_length_m};
+    const FrameInput in{&curve,           params,
+                        out.origin_m,     out.centre_m,
+                        out.tangent_scratch, out.arc_length_m,
+                        std::span<const double>(table ? tables.tangent.data() : nullptr, table ? tables.tangent.size() : 0)};
     out.frame_stats = compute_frames(in, settings.frames, out.frames);
 
     for (std::size_t i = 0; i < n; ++i) {

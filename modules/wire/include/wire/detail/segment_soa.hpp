@@ -1,0 +1,42 @@
+// Internal: the ring stage's per-segment kernels over structure-of-arrays copies of a curve's segments.
+#pragma once
+
+#include "wire/curve.hpp"
+
+#include <cstddef>
+
+/// On x86-64 with GCC: the function is compiled for AVX-512, AVX2 and the baseline (SSE2), and the loader picks the
+/// widest one the CPU has (an ifunc: one indirect call per call). Only for loops written so the compiler vectorizes
+/// them. Every clone gives the same results, bit for bit: wire_core is compiled with -ffp-contract=off (no fused
+/// multiply-add changes a rounding) and these loops use only correctly rounded operations (+, -, *, /, sqrt, min,
+/// max, comparisons). Elsewhere (Clang, sanitizers, other CPUs): one plain function.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(WIRE_NO_VECTOR_CLONES) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define WIRE_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define WIRE_VECTOR_CLONES
+#endif
+
+namespace wire::detail {
+
+/// Segments' control points as 12 arrays of `n` (b0.x, b0.y, b0.z, b1.x, ... b3.z): the layout the per-segment
+/// loops vectorize over (an array of 96-byte Bezier records is a gather the compiler does not vectorize).
+inline void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
+    for (std::size_t k = 0; k < n; ++k) {
+        const CubicBezier& c = segments[k];
+        const glm::dvec3* p[4] = {&c.b0, &c.b1, &c.b2, &c.b3};
+        for (int j = 0; j < 4; ++j) {
+            out[(3 * j + 0) * n + k] = p[j]->x;
+            out[(3 * j + 1) * n + k] = p[j]->y;
+            out[(3 * j + 2) * n + k] = p[j]->z;
+        }
+    }
+}
+
+/// Unit tangents at t = 0 of `n` segments given as transpose_segments() lays them out: B'(0) = 3 (b1 - b0) times
+/// the reciprocal of its length, the operations build_rings uses for a ring at t = 0 (a crossed segment boundary
+/// and a ring there carry the same tangent). ok[k] = 0 where that derivative is below the segment's rounding noise
+/// (the caller takes unit_tangent()'s one-sided limits there). In frames.cpp.
+void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty, double* tz, double* ok);
+
+}  // namespace wire::detail
