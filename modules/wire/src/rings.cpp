@@ -241,8 +241,9 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     thread_local SegmentTables tables;  // grows once per thread, then reused
     const bool table = uniform_radius(curve);
     if (table) {
-        // Boundary tangents only where some interval crosses a segment boundary (LOD below node resolution).
-        bool crossing = curve.closed && params.back().segment + 1 < curve.segment_count();
+        // Boundary tangents only where some interval crosses a segment boundary (LOD below node resolution; the
+        // closed wire's wrap step computes its own).
+        bool crossing = false;
         for (std::size_t i = 1; i < n && !crossing; ++i) {
             crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
         }
