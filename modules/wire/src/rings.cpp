@@ -137,31 +137,46 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     return out;
 }
 
-/// integrate()'s length over t in [0, 1] for n segments laid out by detail::transpose_segments(): SegmentCoeffs's
-/// derivative coefficients and the three Gauss points, the same operations in the same order.
-WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n, double* __restrict length_m) {
+/// SegmentCoeffs's derivative coefficients d0, d1, d2 (component a) of segment k of n laid out by
+/// detail::transpose_segments(), the same expressions.
+inline void derivative_coeffs(const double* __restrict b, std::size_t n, std::size_t k, double d0[3], double d1[3],
+                              double d2[3]) {
+    for (int a = 0; a < 3; ++a) {
+        const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
+        d0[a] = 3.0 * (p1 - p0);
+        d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
+        d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
+    }
+}
+
+/// integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for the n segments laid out by detail::transpose_segments(): the
+/// same operations in the same order. constant[k] != 0: a constant-radius segment, u = length u_per_m[k]; else u
+/// integrates speed / radius (the segment's radius polynomial r0 + t (r1 + t (r2 + t r3))), times u_scale[k].
+WIRE_VECTOR_CLONES void gauss_whole_segments(const double* __restrict b, std::size_t n,
+                                             const double* __restrict constant, const double* __restrict u_per_m, const double* __restrict u_scale,
+                                             const double* __restrict r0, const double* __restrict r1,
+                                             const double* __restrict r2, const double* __restrict r3,
+                                             double* __restrict length_m, double* __restrict u) {
     for (std::size_t k = 0; k < n; ++k) {
         double d0[3], d1[3], d2[3];
-        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
-            const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
-            d0[a] = 3.0 * (p1 - p0);
-            d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
-            d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
-        }
-        double len = 0.0;
+        derivative_coeffs(b, n, k, d0, d1, d2);
+        double len = 0.0, u_varying = 0.0;
         for (int q = 0; q < kGlPoints; ++q) {
             const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
             const double x = d0[0] + t * (d1[0] + t * d2[0]);
             const double y = d0[1] + t * (d1[1] + t * d2[1]);
             const double z = d0[2] + t * (d1[2] + t * d2[2]);
-            len += (1.0 * kGlW[q]) * std::sqrt(x * x + y * y + z * z);
+            const double w = 1.0 * kGlW[q];
+            const double speed = std::sqrt(x * x + y * y + z * z);
+            len += w * speed;
+            u_varying += w * speed / std::max(r0[k] + t * (r1[k] + t * (r2[k] + t * r3[k])), 1e-30);
         }
         length_m[k] = len;
+        u[k] = constant[k] != 0.0 ? len * u_per_m[k] : u_varying * u_scale[k];
     }
 }
 
-/// One radius on every node (or none): every segment is a constant-radius one (SegmentCoeffs: both node slopes
-/// 0, so r1 = r2 = r3 = 0 exactly).
+/// One radius on every node (or none).
 bool uniform_radius(const Curve& curve) {
     const std::size_t n = curve.radius_m.size();
     for (std::size_t k = 1; k < n; ++k) {
@@ -170,31 +185,62 @@ bool uniform_radius(const Curve& curve) {
     return true;
 }
 
-/// Per-segment tables of a uniform_radius() curve, from one structure-of-arrays copy of its segments, in passes
-/// the compiler vectorizes: integrate(SegmentCoeffs(curve, k), 0.0, 1.0) of every segment k bit for bit (a wire
-/// whose LOD puts fewer rings than nodes crosses most segments whole: this is their arc length and u), and the
-/// unit tangent at every segment's start (the frames carry the normal through the boundaries an interval crosses).
+/// Per-segment tables of a wire, from one structure-of-arrays copy of its segments, in passes the compiler
+/// vectorizes: integrate(SegmentCoeffs(curve, k), 0.0, 1.0) of every segment k bit for bit (a wire whose LOD puts
+/// fewer rings than nodes crosses most segments whole: this is their arc length and u), and, when asked, the unit
+/// tangent at every segment's start (the frames carry the normal through the boundaries an interval crosses).
 struct SegmentTables {
     std::vector<double> soa;       // detail::transpose_segments()
     std::vector<double> length_m;  // per segment
     std::vector<double> u;         // per segment
     std::vector<double> tangent;   // 4 arrays of segment_count(): FrameInput::boundary_tangent
+    std::vector<double> radius;    // 7 arrays of segment_count(): constant, u_per_m, u_scale, r0, r1, r2, r3
     void build(const Curve& curve, bool with_tangents) {
         const std::size_t n = curve.segment_count();
         soa.resize(12 * n);
         length_m.resize(n);
         u.resize(n);
+        radius.resize(7 * n);
         tangent.resize(with_tangents ? 4 * n : 0);
         detail::transpose_segments(curve.segments.data(), n, soa.data());
-        gauss_whole_lengths(soa.data(), n, length_m.data());
-        const double r0 = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
-        const double r_safe = std::max(r0, 1e-30);
-        const std::size_t n_stretch = std::min(curve.stretch.size(), n);
-        for (std::size_t k = 0; k < n; ++k) {  // SegmentCoeffs::load's u_per_m, integrate()'s u
-            double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
-            stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
-            u[k] = length_m[k] * (1.0 / (2.0 * std::numbers::pi * stretch * r_safe));
+        double* const constant = radius.data();
+        double* const u_per_m = constant + n;
+        double* const u_scale = u_per_m + n;
+        double* const r0 = u_scale + n;
+        double* const r1 = r0 + n;
+        double* const r2 = r1 + n;
+        double* const r3 = r2 + n;
+        if (uniform_radius(curve)) {
+            // One radius (or none): every segment is constant-radius (both node slopes 0, so r1 = r2 = r3 = 0
+            // exactly); SegmentCoeffs::load's u_per_m without its per-segment slope work.
+            const double r = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
+            const double r_safe = std::max(r, 1e-30);
+            const std::size_t n_stretch = std::min(curve.stretch.size(), n);
+            for (std::size_t k = 0; k < n; ++k) {
+                double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
+                stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
+                constant[k] = 1.0;
+                u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * stretch * r_safe);
+                u_scale[k] = 0.0;
+                r0[k] = r;
+                r1[k] = r2[k] = r3[k] = 0.0;
+            }
+        } else {
+            // SegmentCoeffs::load's radius polynomial and texture scale, segment by segment (the node slopes are
+            // branchy: this loop stays scalar; the quadrature is the vector part).
+            SegmentCoeffs c(curve, 0);
+            for (std::size_t k = 0; k < n; ++k) {
+                if (k != 0) c.load(curve, static_cast<uint32_t>(k));
+                constant[k] = c.constant_radius ? 1.0 : 0.0;
+                u_per_m[k] = c.u_per_m;
+                u_scale[k] = c.u_scale;
+                r0[k] = c.r0;
+                r1[k] = c.r1;
+                r2[k] = c.r2;
+                r3[k] = c.r3;
+            }
         }
+        gauss_whole_segments(soa.data(), n, constant, u_per_m, u_scale, r0, r1, r2, r3, length_m.data(), u.data());
         if (with_tangents) {
             detail::boundary_tangents(soa.data(), n, tangent.data(), tangent.data() + n, tangent.data() + 2 * n,
                                       tangent.data() + 3 * n);
@@ -236,19 +282,15 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             seg_index = i;
         }
     };
-    SegmentCoeffs crossed = seg;  // segments an interval crosses without a ring (LOD below node resolution)
     // Whole segments (crossed ones, and a ring at t = 0 whose next ring is on a later segment): from one table.
     thread_local SegmentTables tables;  // grows once per thread, then reused
-    const bool table = uniform_radius(curve);
-    if (table) {
-        // Boundary tangents only where some interval crosses a segment boundary (LOD below node resolution; the
-        // closed wire's wrap step computes its own).
-        bool crossing = false;
-        for (std::size_t i = 1; i < n && !crossing; ++i) {
-            crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
-        }
-        tables.build(curve, crossing);
+    // Boundary tangents only where some interval crosses a segment boundary (LOD below node resolution; the closed
+    // wire's wrap step computes its own).
+    bool crossing = false;
+    for (std::size_t i = 1; i < n && !crossing; ++i) {
+        crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
     }
+    tables.build(curve, crossing);
     const std::vector<double>& whole_length_m = tables.length_m;
     const std::vector<double>& whole_u = tables.u;
     double s = 0.0;
@@ -293,20 +335,13 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             const bool wrap = i + 1 == n;
             const RingParam b = wrap ? params[0] : params[i + 1];
             const double tb = (!wrap && b.segment == p.segment) ? b.t : 1.0;
-            Interval iv = table && p.t == 0.0 && tb == 1.0 ? Interval{whole_length_m[p.segment], whole_u[p.segment]}
-                                                           : integrate(seg, p.t, tb);
+            Interval iv = p.t == 0.0 && tb == 1.0 ? Interval{whole_length_m[p.segment], whole_u[p.segment]}
+                                                  : integrate(seg, p.t, tb);
             if (wrap || b.segment != p.segment) {
                 const std::size_t end = wrap ? curve.segment_count() : b.segment;
                 for (std::size_t k = p.segment + 1; k < end; ++k) {  // crossed segments, whole
-                    if (table) {
-                        iv.length_m += whole_length_m[k];
-                        iv.u += whole_u[k];
-                        continue;
-                    }
-                    crossed.load(curve, static_cast<uint32_t>(k));  // one object: shared node slopes reused
-                    const Interval ik = integrate(crossed, 0.0, 1.0);
-                    iv.length_m += ik.length_m;
-                    iv.u += ik.u;
+                    iv.length_m += whole_length_m[k];
+                    iv.u += whole_u[k];
                 }
             }
             if (!wrap && b.segment != p.segment && b.t > 0.0) {  // custom params: the next segment's part too
@@ -325,7 +360,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     const FrameInput in{&curve,           params,
                         out.origin_m,     out.centre_m,
                         out.tangent_scratch, out.arc_length_m,
-                        std::span<const double>(table ? tables.tangent.data() : nullptr, table ? tables.tangent.size() : 0)};
+                        tables.tangent};
     out.frame_stats = compute_frames(in, settings.frames, out.frames);
 
     for (std::size_t i = 0; i < n; ++i) {
