@@ -54,7 +54,20 @@ struct SegmentCoeffs {
 
     SegmentCoeffs(const Curve& curve, uint32_t seg) { load(curve, seg); }
     void load(const Curve& curve, uint32_t seg) {
-        const CubicBezier& c = curve.segments[seg];
+        load_geometry(curve.segments[seg]);
+        load_radius(curve, seg);
+    }
+    /// The radius polynomial and texture scale as load() computes them (SegmentTables keeps them per segment).
+    void load_radius(double c0, double c1, double c2, double c3, double scale, double per_m, bool constant) {
+        r0 = c0;
+        r1 = c1;
+        r2 = c2;
+        r3 = c3;
+        u_scale = scale;
+        u_per_m = per_m;
+        constant_radius = constant;
+    }
+    void load_geometry(const CubicBezier& c) {
         p0 = c.b0;
         p1 = 3.0 * (c.b1 - c.b0);
         p2 = 3.0 * (c.b2 - 2.0 * c.b1 + c.b0);
@@ -64,6 +77,10 @@ struct SegmentCoeffs {
         d2 = 3.0 * p3;
         e0 = d1;
         e1 = 2.0 * d2;
+        const auto norm1 = [](const glm::dvec3& v) { return std::abs(v.x) + std::abs(v.y) + std::abs(v.z); };
+        tiny_bound = 1e-9 * (norm1(d0) + norm1(d1) + norm1(d2));
+    }
+    void load_radius(const Curve& curve, uint32_t seg) {
         const std::size_t n = curve.radius_m.size();
         if (n == 0) {
             r0 = 1.0;
@@ -97,8 +114,6 @@ struct SegmentCoeffs {
             u_per_m = 0.0;
             u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
         }
-        const auto norm1 = [](const glm::dvec3& v) { return std::abs(v.x) + std::abs(v.y) + std::abs(v.z); };
-        tiny_bound = 1e-9 * (norm1(d0) + norm1(d1) + norm1(d2));
     }
     [[nodiscard]] glm::dvec3 position(double t) const { return p0 + t * (p1 + t * (p2 + t * p3)); }
     [[nodiscard]] glm::dvec3 derivative(double t) const { return d0 + t * (d1 + t * d2); }
@@ -246,6 +261,12 @@ struct SegmentTables {
                                       tangent.data() + 3 * n);
         }
     }
+    /// Segment k's radius polynomial and texture scale into c, as SegmentCoeffs::load() computes them.
+    void load_radius(std::size_t k, SegmentCoeffs& c) const {
+        const std::size_t n = length_m.size();
+        const double* r = radius.data();
+        c.load_radius(r[3 * n + k], r[4 * n + k], r[5 * n + k], r[6 * n + k], r[2 * n + k], r[n + k], r[k] != 0.0);
+    }
 };
 
 }  // namespace
@@ -274,14 +295,6 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     }
 
     out.origin_m = position(curve.segments[params[0].segment], params[0].t);
-    SegmentCoeffs seg(curve, params[0].segment);
-    uint32_t seg_index = params[0].segment;
-    auto use_segment = [&](uint32_t i) {
-        if (i != seg_index) {
-            seg.load(curve, i);
-            seg_index = i;
-        }
-    };
     // Whole segments (crossed ones, and a ring at t = 0 whose next ring is on a later segment): from one table.
     thread_local SegmentTables tables;  // grows once per thread, then reused
     // Boundary tangents only where some interval crosses a segment boundary (LOD below node resolution; the closed
@@ -291,6 +304,15 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
     }
     tables.build(curve, crossing);
+    SegmentCoeffs seg(curve, params[0].segment);
+    uint32_t seg_index = params[0].segment;
+    auto use_segment = [&](uint32_t i) {  // the radius polynomial from the table: no node slopes again
+        if (i != seg_index) {
+            seg.load_geometry(curve.segments[i]);
+            tables.load_radius(i, seg);
+            seg_index = i;
+        }
+    };
     const std::vector<double>& whole_length_m = tables.length_m;
     const std::vector<double>& whole_u = tables.u;
     double s = 0.0;
