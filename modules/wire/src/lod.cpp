@@ -12,6 +12,10 @@
 #include <limits>
 #include <numbers>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace wire {
 namespace {
 
@@ -255,35 +259,6 @@ void mark_culled(WireLod& lod, bool& changed) {
     lod.coherence.valid = false;
 }
 
-/// Squared distance from p to the chord a-b (distance_to_chord() is its root).
-double distance2_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
-    const glm::dvec3 ab = b - a;
-    const double len2 = glm::dot(ab, ab);
-    const double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-    const glm::dvec3 v = p - (a + t * ab);
-    return glm::dot(v, v);
-}
-
-double distance_to_chord(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
-    return std::sqrt(distance2_to_chord(p, a, b));
-}
-
-struct Sphere {
-    glm::dvec3 c;
-    double r;
-};
-
-// Smallest sphere enclosing two spheres.
-Sphere merge_spheres(const Sphere& a, const Sphere& b) {
-    const glm::dvec3 d = b.c - a.c;
-    const double dist = glm::length(d);
-    if (dist + b.r <= a.r) return a;
-    if (dist + a.r <= b.r) return b;
-    const double r = 0.5 * (dist + a.r + b.r);
-    return {a.c + d * ((r - a.r) / dist),
-            r * (1.0 + 1e-12)};  // rounding of the centre must not leave a point out
-}
-
 // Per-update working memory of one thread (grows once, then reused).
 struct Scratch {
     std::vector<double> x, y, z;  // view-space control points, 4 per segment (structure of arrays)
@@ -333,9 +308,9 @@ public:
         if (e - s > 1 && closed_ && 3 * (e - s) > b_.segments) {
             return std::numeric_limits<double>::infinity();  // a loop keeps >= 3 intervals
         }
-        const double* nd = b_.node_data(level, j);
-        const glm::dvec3 p(nd[0], nd[1], nd[2]);
-        const double r = nd[3];
+        const SpanNode node = b_.node(level, j);
+        const glm::dvec3 p = node.centre_m;
+        const double r = node.radius_m;
         const glm::dmat3& m = tf_.rotation;
         const double z = -((m[0][2] * p.x + m[1][2] * p.y + m[2][2] * p.z) + tf_.translation.z);
         if (!inside_) {
@@ -355,9 +330,9 @@ public:
                 const double a = (std::abs(q.x) + r) / (z - r), b = (std::abs(q.y) + r) / (z - r);
                 k = std::sqrt(1.0 + a * a + b * b);
             }
-            return nd[4] * c_ * k / std::max(z - r, view_.near_m);
+            return node.deviation_m * c_ * k / std::max(z - r, view_.near_m);
         }
-        return nd[4] * c_ * k_ / std::max(z - r, view_.near_m);
+        return node.deviation_m * c_ * k_ / std::max(z - r, view_.near_m);
     }
 
     // Smallest factor by which any ratio decided so far may change before crossing a threshold (1 or the new
@@ -663,10 +638,10 @@ SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const L
     unsigned wire_outside = 63u;
     wire_z = std::numeric_limits<double>::infinity();
     uint32_t visible = 0, clamped = 0;
+    const double* d0 = b.level_data(0);  // level 0: centre x, y, z and radius of each segment's sphere
     for (std::size_t i = 0; i < n; ++i) {
-        const double* nd = b.node_data(0, i);
-        const glm::dvec3 q = tf(glm::dvec3(nd[0], nd[1], nd[2]));
-        const double r0 = nd[3], ri = r0 + radius;
+        const glm::dvec3 q = tf(glm::dvec3(d0[i], d0[n + i], d0[2 * n + i]));
+        const double r0 = d0[3 * n + i], ri = r0 + radius;
         const double l = q.x + q.z * tx, rt = q.z * tx - q.x, bt = q.y + q.z * ty, tp = q.z * ty - q.y;
         const double ne = q.z - view.near_m, fa = view.far_m - q.z;
         const double rx = ri * sx, ry = ri * sy;
@@ -869,6 +844,270 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
 
 }  // namespace
 
+namespace {
+
+// Working memory of compute_lod_bounds (one per thread, grows once): the level-0 boxes and the chord end points of
+// the nodes of two adjacent levels (structure of arrays).
+struct BoundsScratch {
+    std::vector<double> boxes;    // 6 n: lo x, y, z, hi x, y, z of every segment
+    std::vector<double> ends[2];  // 6 arrays of a level's width: first point x, y, z, last point x, y, z
+};
+BoundsScratch& bounds_scratch() {
+    thread_local BoundsScratch s;
+    return s;
+}
+
+// std::min, std::max by value, as they compare (glm::min and glm::max too).
+inline double min_of(double x, double y) { return y < x ? y : x; }
+inline double max_of(double x, double y) { return x < y ? y : x; }
+
+// Lanes for the span hierarchy's kernels: the kernels are written once over a lane type, L1 (one double, the
+// scalar code) or L2 (two doubles in an SSE2 register), so every lane does exactly the scalar arithmetic (each
+// operation is the IEEE one, correctly rounded, no fused multiply-add): results are bit-identical whichever runs.
+// min_of / max_of / select keep the scalar comparisons' operand order (minpd(a, b) is a < b ? a : b), so NaN and
+// signed zeros come out as in the scalar code.
+struct L1 {
+    double v;
+    static L1 splat(double x) { return {x}; }
+};
+struct M1 {
+    bool v;
+};
+inline L1 operator+(L1 a, L1 b) { return {a.v + b.v}; }
+inline L1 operator-(L1 a, L1 b) { return {a.v - b.v}; }
+inline L1 operator*(L1 a, L1 b) { return {a.v * b.v}; }
+inline L1 operator/(L1 a, L1 b) { return {a.v / b.v}; }
+inline M1 operator<(L1 a, L1 b) { return {a.v < b.v}; }
+inline M1 operator<=(L1 a, L1 b) { return {a.v <= b.v}; }
+inline L1 sqrt_of(L1 a) { return {std::sqrt(a.v)}; }
+inline L1 abs_of(L1 a) { return {std::abs(a.v)}; }
+inline L1 min_of(L1 x, L1 y) { return {min_of(x.v, y.v)}; }
+inline L1 max_of(L1 x, L1 y) { return {max_of(x.v, y.v)}; }
+inline L1 select(M1 m, L1 a, L1 b) { return {m.v ? a.v : b.v}; }
+#if defined(__SSE2__)
+struct L2 {
+    __m128d v;
+    static L2 splat(double x) { return {_mm_set1_pd(x)}; }
+};
+struct M2 {
+    __m128d v;
+};
+inline L2 operator+(L2 a, L2 b) { return {_mm_add_pd(a.v, b.v)}; }
+inline L2 operator-(L2 a, L2 b) { return {_mm_sub_pd(a.v, b.v)}; }
+inline L2 operator*(L2 a, L2 b) { return {_mm_mul_pd(a.v, b.v)}; }
+inline L2 operator/(L2 a, L2 b) { return {_mm_div_pd(a.v, b.v)}; }
+inline M2 operator<(L2 a, L2 b) { return {_mm_cmplt_pd(a.v, b.v)}; }
+inline M2 operator<=(L2 a, L2 b) { return {_mm_cmple_pd(a.v, b.v)}; }
+inline L2 sqrt_of(L2 a) { return {_mm_sqrt_pd(a.v)}; }
+inline L2 abs_of(L2 a) { return {_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)}; }
+inline L2 min_of(L2 x, L2 y) { return {_mm_min_pd(y.v, x.v)}; }  // y < x ? y : x
+inline L2 max_of(L2 x, L2 y) { return {_mm_max_pd(y.v, x.v)}; }  // y > x ? y : x, i.e. x < y ? y : x
+inline L2 select(M2 m, L2 a, L2 b) { return {_mm_or_pd(_mm_and_pd(m.v, a.v), _mm_andnot_pd(m.v, b.v))}; }
+#endif
+
+// Level 0 of the span hierarchy for one segment per lane: x, y, z of its four control points in; Wang's M, the
+// box (lo, hi), the sphere (centre c, radius r) and the deviation out. A larger of two lengths is the root of the
+// larger squared length (the root is monotone and correctly rounded: the same value, one root fewer). The hull's
+// distance to the chord: both inner control points against one reciprocal of the chord's squared length (a foot
+// parameter off by a rounding is still a point of the chord, so the distance can only come out larger: still a
+// bound). Branch-free: a value a case does not need is computed and selected away.
+template <class L>
+struct Level0 {
+    L wang, lo[3], hi[3], c[3], r, deviation;
+    Level0(const L (&x)[4], const L (&y)[4], const L (&z)[4]) {
+        const L two = L::splat(2.0), zero = L::splat(0.0), one = L::splat(1.0), half = L::splat(0.5);
+        const L m0x = (x[0] - two * x[1]) + x[2], m0y = (y[0] - two * y[1]) + y[2], m0z = (z[0] - two * z[1]) + z[2];
+        const L m1x = (x[1] - two * x[2]) + x[3], m1y = (y[1] - two * y[2]) + y[3], m1z = (z[1] - two * z[2]) + z[3];
+        wang = sqrt_of(max_of((m0x * m0x + m0y * m0y) + m0z * m0z, (m1x * m1x + m1y * m1y) + m1z * m1z));
+        const L* p[3] = {x, y, z};
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = min_of(min_of(p[k][0], p[k][1]), min_of(p[k][2], p[k][3]));
+            hi[k] = max_of(max_of(p[k][0], p[k][1]), max_of(p[k][2], p[k][3]));
+        }
+        const L abx = x[3] - x[0], aby = y[3] - y[0], abz = z[3] - z[0];
+        const L p1x = x[1] - x[0], p1y = y[1] - y[0], p1z = z[1] - z[0];
+        const L p2x = x[2] - x[0], p2y = y[2] - y[0], p2z = z[2] - z[0];
+        const L len2 = (abx * abx + aby * aby) + abz * abz;
+        const L inv = select(zero < len2, one / len2, zero);
+        // std::clamp(t, 0, 1) is std::min(std::max(t, 0), 1)
+        const L t1 = min_of(max_of(((p1x * abx + p1y * aby) + p1z * abz) * inv, zero), one);
+        const L t2 = min_of(max_of(((p2x * abx + p2y * aby) + p2z * abz) * inv, zero), one);
+        const L v1x = p1x - t1 * abx, v1y = p1y - t1 * aby, v1z = p1z - t1 * abz;
+        const L v2x = p2x - t2 * abx, v2y = p2y - t2 * aby, v2z = p2z - t2 * abz;
+        const L hull = sqrt_of(max_of((v1x * v1x + v1y * v1y) + v1z * v1z, (v2x * v2x + v2y * v2y) + v2z * v2z));
+        const L d = min_of(hull, L::splat(0.75) * wang);
+        // Not finite (NaN too): infinity.
+        deviation = select(abs_of(d) <= L::splat(std::numeric_limits<double>::max()), d,
+                           L::splat(std::numeric_limits<double>::infinity()));
+        for (int k = 0; k < 3; ++k) c[k] = half * (lo[k] + hi[k]);
+        const L sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
+        r = half * sqrt_of((sx * sx + sy * sy) + sz * sz) * L::splat(1.0 + 1e-12);
+    }
+};
+
+// A node of level l >= 1 from its two children (one pair per lane): chords A-M and M-B give the deviation
+// max(d_left, d_right) + dist(M, A-B); the sphere is the smallest around the children's (merge of two spheres:
+// one of them when it holds the other, else the one through both, its radius rounded up by a relative hair so
+// rounding in the centre cannot leave a point out).
+template <class L>
+struct Merge {
+    L c[3], r, deviation;
+    Merge(const L (&a)[3], const L (&m)[3], const L (&b)[3], const L (&lc)[3], L lr, L ld, const L (&rc)[3], L rr,
+          L rd) {
+        const L zero = L::splat(0.0), one = L::splat(1.0);
+        // distance_to_chord(M, A, B)
+        const L abx = b[0] - a[0], aby = b[1] - a[1], abz = b[2] - a[2];
+        const L qx = m[0] - a[0], qy = m[1] - a[1], qz = m[2] - a[2];
+        const L len2 = (abx * abx + aby * aby) + abz * abz;
+        const L t = select(zero < len2, min_of(max_of(((qx * abx + qy * aby) + qz * abz) / len2, zero), one), zero);
+        const L vx = m[0] - (a[0] + t * abx), vy = m[1] - (a[1] + t * aby), vz = m[2] - (a[2] + t * abz);
+        deviation = max_of(ld, rd) + sqrt_of((vx * vx + vy * vy) + vz * vz);
+        // merge_spheres(left, right)
+        const L dx = rc[0] - lc[0], dy = rc[1] - lc[1], dz = rc[2] - lc[2];
+        const L dist = sqrt_of((dx * dx + dy * dy) + dz * dz);
+        const L rad = L::splat(0.5) * ((dist + lr) + rr);
+        const L s = (rad - lr) / dist;
+        const auto take_left = dist + rr <= lr;
+        const auto take_right = dist + lr <= rr;
+        const L d[3] = {dx, dy, dz};
+        for (int k = 0; k < 3; ++k) c[k] = select(take_left, lc[k], select(take_right, rc[k], lc[k] + d[k] * s));
+        r = select(take_left, lr, select(take_right, rr, rad * L::splat(1.0 + 1e-12)));
+    }
+};
+
+// Level 0 for segments [i0, n): node's 5 arrays, wang, box's 6 arrays, chord ends (6 arrays: b0, b3).
+void span_level0(const CubicBezier* seg, std::size_t n, double* node, double* wang, double* box, double* ends) {
+    std::size_t i = 0;
+    auto store1 = [&](std::size_t at, const Level0<L1>& q) {
+        wang[at] = q.wang.v;
+        for (int k = 0; k < 3; ++k) {
+            node[k * n + at] = q.c[k].v;
+            box[k * n + at] = q.lo[k].v;
+            box[(3 + k) * n + at] = q.hi[k].v;
+        }
+        node[3 * n + at] = q.r.v;
+        node[4 * n + at] = q.deviation.v;
+    };
+#if defined(__SSE2__)
+    for (; i + 2 <= n; i += 2) {
+        const CubicBezier &c0 = seg[i], &c1 = seg[i + 1];
+        const L2 x[4] = {{_mm_set_pd(c1.b0.x, c0.b0.x)}, {_mm_set_pd(c1.b1.x, c0.b1.x)},
+                         {_mm_set_pd(c1.b2.x, c0.b2.x)}, {_mm_set_pd(c1.b3.x, c0.b3.x)}};
+        const L2 y[4] = {{_mm_set_pd(c1.b0.y, c0.b0.y)}, {_mm_set_pd(c1.b1.y, c0.b1.y)},
+                         {_mm_set_pd(c1.b2.y, c0.b2.y)}, {_mm_set_pd(c1.b3.y, c0.b3.y)}};
+        const L2 z[4] = {{_mm_set_pd(c1.b0.z, c0.b0.z)}, {_mm_set_pd(c1.b1.z, c0.b1.z)},
+                         {_mm_set_pd(c1.b2.z, c0.b2.z)}, {_mm_set_pd(c1.b3.z, c0.b3.z)}};
+        const Level0<L2> q(x, y, z);
+        _mm_storeu_pd(wang + i, q.wang.v);
+        for (int k = 0; k < 3; ++k) {
+            _mm_storeu_pd(node + k * n + i, q.c[k].v);
+            _mm_storeu_pd(box + k * n + i, q.lo[k].v);
+            _mm_storeu_pd(box + (3 + k) * n + i, q.hi[k].v);
+        }
+        _mm_storeu_pd(node + 3 * n + i, q.r.v);
+        _mm_storeu_pd(node + 4 * n + i, q.deviation.v);
+        _mm_storeu_pd(ends + i, x[0].v);
+        _mm_storeu_pd(ends + n + i, y[0].v);
+        _mm_storeu_pd(ends + 2 * n + i, z[0].v);
+        _mm_storeu_pd(ends + 3 * n + i, x[3].v);
+        _mm_storeu_pd(ends + 4 * n + i, y[3].v);
+        _mm_storeu_pd(ends + 5 * n + i, z[3].v);
+    }
+#endif
+    for (; i < n; ++i) {
+        const CubicBezier& c = seg[i];
+        const L1 x[4] = {{c.b0.x}, {c.b1.x}, {c.b2.x}, {c.b3.x}};
+        const L1 y[4] = {{c.b0.y}, {c.b1.y}, {c.b2.y}, {c.b3.y}};
+        const L1 z[4] = {{c.b0.z}, {c.b1.z}, {c.b2.z}, {c.b3.z}};
+        store1(i, Level0<L1>(x, y, z));
+        ends[i] = c.b0.x, ends[n + i] = c.b0.y, ends[2 * n + i] = c.b0.z;
+        ends[3 * n + i] = c.b3.x, ends[4 * n + i] = c.b3.y, ends[5 * n + i] = c.b3.z;
+    }
+}
+
+// Level l from level l - 1 (child: 5 arrays of cw nodes, e: their chord ends, 6 arrays of cw; parent: 5 arrays of
+// w nodes, f: their chord ends): a parent's chord runs from its left child's first point to its right child's last.
+void span_merge_level(const double* child, const double* e, std::size_t cw, double* parent, double* f,
+                      std::size_t w) {
+    const std::size_t pairs = cw / 2;
+    std::size_t j = 0;
+#if defined(__SSE2__)
+    // Lanes j, j + 1: left children 2j, 2j + 2 and right children 2j + 1, 2j + 3 (two loads, unpacked).
+    auto left = [](const double* a, std::size_t j) {
+        return L2{_mm_unpacklo_pd(_mm_loadu_pd(a + 2 * j), _mm_loadu_pd(a + 2 * j + 2))};
+    };
+    auto right = [](const double* a, std::size_t j) {
+        return L2{_mm_unpackhi_pd(_mm_loadu_pd(a + 2 * j), _mm_loadu_pd(a + 2 * j + 2))};
+    };
+    for (; j + 2 <= pairs; j += 2) {
+        const L2 a[3] = {left(e, j), left(e + cw, j), left(e + 2 * cw, j)};
+        const L2 m[3] = {right(e, j), right(e + cw, j), right(e + 2 * cw, j)};
+        const L2 b[3] = {right(e + 3 * cw, j), right(e + 4 * cw, j), right(e + 5 * cw, j)};
+        const L2 lc[3] = {left(child, j), left(child + cw, j), left(child + 2 * cw, j)};
+        const L2 rc[3] = {right(child, j), right(child + cw, j), right(child + 2 * cw, j)};
+        const Merge<L2> q(a, m, b, lc, left(child + 3 * cw, j), left(child + 4 * cw, j), rc,
+                          right(child + 3 * cw, j), right(child + 4 * cw, j));
+        for (int k = 0; k < 3; ++k) {
+            _mm_storeu_pd(parent + k * w + j, q.c[k].v);
+            _mm_storeu_pd(f + k * w + j, a[k].v);
+            _mm_storeu_pd(f + (3 + k) * w + j, b[k].v);
+        }
+        _mm_storeu_pd(parent + 3 * w + j, q.r.v);
+        _mm_storeu_pd(parent + 4 * w + j, q.deviation.v);
+    }
+#endif
+    for (; j < pairs; ++j) {
+        const std::size_t l = 2 * j, r = 2 * j + 1;
+        const L1 a[3] = {{e[l]}, {e[cw + l]}, {e[2 * cw + l]}};
+        const L1 m[3] = {{e[r]}, {e[cw + r]}, {e[2 * cw + r]}};
+        const L1 b[3] = {{e[3 * cw + r]}, {e[4 * cw + r]}, {e[5 * cw + r]}};
+        const L1 lc[3] = {{child[l]}, {child[cw + l]}, {child[2 * cw + l]}};
+        const L1 rc[3] = {{child[r]}, {child[cw + r]}, {child[2 * cw + r]}};
+        const Merge<L1> q(a, m, b, lc, {child[3 * cw + l]}, {child[4 * cw + l]}, rc, {child[3 * cw + r]},
+                          {child[4 * cw + r]});
+        for (int k = 0; k < 3; ++k) {
+            parent[k * w + j] = q.c[k].v;
+            f[k * w + j] = a[k].v;
+            f[(3 + k) * w + j] = b[k].v;
+        }
+        parent[3 * w + j] = q.r.v;
+        parent[4 * w + j] = q.deviation.v;
+    }
+    if (pairs < w) {  // an odd child count: the last node is its only child
+        const std::size_t l = cw - 1;
+        for (int k = 0; k < 5; ++k) parent[k * w + pairs] = child[k * cw + l];
+        for (int k = 0; k < 6; ++k) f[k * w + pairs] = e[k * cw + l];
+    }
+}
+
+// Smallest and largest of v[0..w) as std::min / std::max in sequence give them, for values that are never -0
+// (a deviation is a sum of square roots): four lanes, a NaN skipped as the sequence skips it.
+void deviation_range(const double* v, std::size_t w, double& lo_out, double& hi_out) {
+    double lo[4], hi[4];
+    for (int k = 0; k < 4; ++k) {
+        lo[k] = std::numeric_limits<double>::infinity();
+        hi[k] = 0.0;
+    }
+    std::size_t j = 0;
+    for (; j + 4 <= w; j += 4)
+        for (int k = 0; k < 4; ++k) {
+            lo[k] = min_of(lo[k], v[j + k]);
+            hi[k] = max_of(hi[k], v[j + k]);
+        }
+    for (; j < w; ++j) {
+        lo[0] = min_of(lo[0], v[j]);
+        hi[0] = max_of(hi[0], v[j]);
+    }
+    for (int k = 1; k < 4; ++k) {
+        lo[0] = min_of(lo[0], lo[k]);
+        hi[0] = max_of(hi[0], hi[k]);
+    }
+    lo_out = lo[0];
+    hi_out = hi[0];
+}
+
+}  // namespace
+
 void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     const std::size_t n = curve.segment_count();
     out.segments = n;
@@ -896,75 +1135,38 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     // wires of equal length) is not cleared first.
     if (out.data.size() != 2 * levels + 5 * nodes + n) out.data.assign(2 * levels + 5 * nodes + n, 0.0);
     double* wang = out.data.data() + 2 * levels + 5 * nodes;
-    auto put = [&](std::size_t level, std::size_t j, const Sphere& sp, double deviation) {
-        double* d = out.data.data() + 2 * levels + 5 * (out.level_start[level] + j);
-        d[0] = sp.c.x;
-        d[1] = sp.c.y;
-        d[2] = sp.c.z;
-        d[3] = sp.r;
-        d[4] = deviation;
-    };
-    auto sphere_of = [&](std::size_t level, std::size_t j) {
-        const SpanNode node = out.node(level, j);
-        return Sphere{node.centre_m, node.radius_m};
-    };
-    // Level 0: one node per segment. A larger of two lengths is the root of the larger squared length (the
-    // root is monotone and correctly rounded: the same value, one root fewer). The hull's distance to the chord:
-    // both inner control points against one reciprocal of the chord's squared length (a foot parameter off by a
-    // rounding is still a point of the chord, so the distance can only come out larger: still a bound).
-    glm::dvec3 wire_lo(std::numeric_limits<double>::infinity()), wire_hi(-std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < n; ++i) {
-        const CubicBezier& c = curve.segments[i];
-        const glm::dvec3 m0 = c.b0 - 2.0 * c.b1 + c.b2, m1 = c.b1 - 2.0 * c.b2 + c.b3;
-        wang[i] = std::sqrt(std::max(glm::dot(m0, m0), glm::dot(m1, m1)));
-        out.wang_m_max = std::max(out.wang_m_max, wang[i]);
-        const glm::dvec3 lo = glm::min(glm::min(c.b0, c.b1), glm::min(c.b2, c.b3));
-        const glm::dvec3 hi = glm::max(glm::max(c.b0, c.b1), glm::max(c.b2, c.b3));
-        wire_lo = glm::min(wire_lo, lo);
-        wire_hi = glm::max(wire_hi, hi);
-        const glm::dvec3 ab = c.b3 - c.b0, p1 = c.b1 - c.b0, p2 = c.b2 - c.b0;
-        const double len2 = glm::dot(ab, ab);
-        const double inv = len2 > 0.0 ? 1.0 / len2 : 0.0;
-        const glm::dvec3 v1 = p1 - std::clamp(glm::dot(p1, ab) * inv, 0.0, 1.0) * ab;
-        const glm::dvec3 v2 = p2 - std::clamp(glm::dot(p2, ab) * inv, 0.0, 1.0) * ab;
-        const double hull = std::sqrt(std::max(glm::dot(v1, v1), glm::dot(v2, v2)));
-        double deviation = std::min(hull, 0.75 * wang[i]);
-        if (!std::isfinite(deviation)) deviation = std::numeric_limits<double>::infinity();
-        put(0, i, Sphere{0.5 * (lo + hi), 0.5 * glm::length(hi - lo) * (1.0 + 1e-12)}, deviation);
+    BoundsScratch& sc = bounds_scratch();
+    if (sc.boxes.size() < 6 * n) {
+        sc.boxes.resize(6 * n);
+        sc.ends[0].resize(6 * n);
+        sc.ends[1].resize(6 * n);
     }
-    {  // curve_bounding_sphere(curve): the same box (min and max are exact, in any order), the same rounding
+    span_level0(curve.segments.data(), n, out.level_data(0), wang, sc.boxes.data(), sc.ends[0].data());
+    {
+        // The wire's box and the largest M, in segment order (a min or max over equal values may differ in the
+        // sign of a zero: the order of curve_bounding_sphere() is kept).
+        const double* b = sc.boxes.data();
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        double m_max = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            lo = {min_of(lo.x, b[i]), min_of(lo.y, b[n + i]), min_of(lo.z, b[2 * n + i])};
+            hi = {max_of(hi.x, b[3 * n + i]), max_of(hi.y, b[4 * n + i]), max_of(hi.z, b[5 * n + i])};
+            m_max = max_of(m_max, wang[i]);
+        }
+        out.wang_m_max = m_max;
+        // curve_bounding_sphere(curve): the same box (the same minima and maxima), the same rounding.
         double radius = 0.0;
         for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
-        out.sphere = {0.5 * (wire_lo + wire_hi), (0.5 * glm::length(wire_hi - wire_lo)) * (1.0 + 1e-12) + radius};
+        out.sphere = {0.5 * (lo + hi), (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
     }
-    // Level l from level l - 1: a node of two children with chords A-M and M-B.
+    // Levels 1 and up, each from the one below; the chord ends alternate between two buffers.
     for (std::size_t level = 1; level < levels; ++level) {
-        const std::size_t width = out.level_width(level - 1);
-        for (std::size_t j = 0; j < out.level_width(level); ++j) {
-            const SpanNode left = out.node(level - 1, 2 * j);
-            if (2 * j + 1 >= width) {
-                put(level, j, sphere_of(level - 1, 2 * j), left.deviation_m);
-                continue;
-            }
-            const SpanNode right = out.node(level - 1, 2 * j + 1);
-            const std::size_t s = j << level;
-            const std::size_t mid = s + (std::size_t{1} << (level - 1));
-            const std::size_t e = std::min((j + 1) << level, n);
-            const double deviation =
-                std::max(left.deviation_m, right.deviation_m) +
-                distance_to_chord(curve.segments[mid].b0, curve.segments[s].b0, curve.segments[e - 1].b3);
-            put(level, j, merge_spheres(sphere_of(level - 1, 2 * j), sphere_of(level - 1, 2 * j + 1)), deviation);
-        }
+        span_merge_level(out.level_data(level - 1), sc.ends[(level - 1) & 1].data(), out.level_width(level - 1),
+                         out.level_data(level), sc.ends[level & 1].data(), out.level_width(level));
     }
-    for (std::size_t l = 0; l < levels; ++l) {
-        double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
-        for (std::size_t j = 0; j < out.level_width(l); ++j) {
-            lo = std::min(lo, out.node(l, j).deviation_m);
-            hi = std::max(hi, out.node(l, j).deviation_m);
-        }
-        out.data[2 * l] = lo;
-        out.data[2 * l + 1] = hi;
-    }
+    for (std::size_t l = 0; l < levels; ++l)
+        deviation_range(out.level_data(l) + 4 * out.level_width(l), out.level_width(l), out.data[2 * l],
+                        out.data[2 * l + 1]);
 }
 
 SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_m, const LodView& view,

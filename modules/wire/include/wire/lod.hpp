@@ -194,17 +194,25 @@ struct LodBounds {
     uint32_t levels = 0;                        ///< hierarchy levels (0 for an empty curve)
     uint64_t version = 0;                       ///< new (unique) each time compute_lod_bounds() fills it
     std::array<uint32_t, 34> level_start{};     ///< index of node 0 of each level (root level first in memory)
-    std::vector<double> data;                   ///< per level (min, max) deviation; nodes; Wang's M per segment
+    /// Per level (min, max) deviation; per level (root first) five arrays of level_width() values: centre x,
+    /// centre y, centre z, radius, deviation (structure of arrays: built and read by vectorized loops); Wang's M
+    /// per segment.
+    std::vector<double> data;
 
     [[nodiscard]] std::size_t level_width(std::size_t level) const {
         return (segments + (std::size_t{1} << level) - 1) >> level;
     }
-    [[nodiscard]] const double* node_data(std::size_t level, std::size_t j) const {
-        return data.data() + 2 * levels + 5 * (level_start[level] + j);
+    /// The five arrays of a level, one after the other (field f of node j at [f * level_width(level) + j]).
+    [[nodiscard]] const double* level_data(std::size_t level) const {
+        return data.data() + 2 * levels + 5 * std::size_t{level_start[level]};
+    }
+    [[nodiscard]] double* level_data(std::size_t level) {
+        return data.data() + 2 * levels + 5 * std::size_t{level_start[level]};
     }
     [[nodiscard]] SpanNode node(std::size_t level, std::size_t j) const {
-        const double* d = node_data(level, j);
-        return {{d[0], d[1], d[2]}, d[3], d[4]};
+        const double* d = level_data(level);
+        const std::size_t w = level_width(level);
+        return {{d[j], d[w + j], d[2 * w + j]}, d[3 * w + j], d[4 * w + j]};
     }
     [[nodiscard]] double level_deviation_min(std::size_t level) const { return data[2 * level]; }
     [[nodiscard]] double level_deviation_max(std::size_t level) const { return data[2 * level + 1]; }
