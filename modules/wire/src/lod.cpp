@@ -15,6 +15,10 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(WIRE_LOD_NO_AVX2)
+#define WIRE_LOD_AVX2 1
+#include <immintrin.h>
+#endif
 
 namespace wire {
 namespace {
@@ -861,14 +865,22 @@ BoundsScratch& bounds_scratch() {
 inline double min_of(double x, double y) { return y < x ? y : x; }
 inline double max_of(double x, double y) { return x < y ? y : x; }
 
-// Lanes for the span hierarchy's kernels: the kernels are written once over a lane type, L1 (one double, the
-// scalar code) or L2 (two doubles in an SSE2 register), so every lane does exactly the scalar arithmetic (each
-// operation is the IEEE one, correctly rounded, no fused multiply-add): results are bit-identical whichever runs.
-// min_of / max_of / select keep the scalar comparisons' operand order (minpd(a, b) is a < b ? a : b), so NaN and
-// signed zeros come out as in the scalar code.
+// Lanes for the span hierarchy's kernels (lod_span_kernels.inl): the kernels are written once over a lane type,
+// L1 (one double: the scalar code), L2 (two doubles in an SSE2 register) or L4 (four in an AVX register, where
+// the CPU has AVX2), so every lane does exactly the scalar arithmetic (each operation the IEEE one, correctly
+// rounded, no fused multiply-add): results are bit-identical whichever runs. min_of / max_of / select keep the
+// scalar comparisons' operand order (minpd(a, b) is a < b ? a : b), so NaN and signed zeros come out as in the
+// scalar code. Besides arithmetic a lane type loads and stores `width` consecutive doubles, gathers them
+// `stride` apart, and splits 2 width consecutive ones into the even and the odd ones.
 struct L1 {
+    static constexpr std::size_t width = 1;
     double v;
     static L1 splat(double x) { return {x}; }
+    static L1 load(const double* p) { return {*p}; }
+    static L1 strided(const double* p, std::size_t) { return {*p}; }
+    static L1 evens(const double* p) { return {p[0]}; }
+    static L1 odds(const double* p) { return {p[1]}; }
+    void store(double* p) const { *p = v; }
 };
 struct M1 {
     bool v;
@@ -884,10 +896,17 @@ inline L1 abs_of(L1 a) { return {std::abs(a.v)}; }
 inline L1 min_of(L1 x, L1 y) { return {min_of(x.v, y.v)}; }
 inline L1 max_of(L1 x, L1 y) { return {max_of(x.v, y.v)}; }
 inline L1 select(M1 m, L1 a, L1 b) { return {m.v ? a.v : b.v}; }
+
 #if defined(__SSE2__)
 struct L2 {
+    static constexpr std::size_t width = 2;
     __m128d v;
     static L2 splat(double x) { return {_mm_set1_pd(x)}; }
+    static L2 load(const double* p) { return {_mm_loadu_pd(p)}; }
+    static L2 strided(const double* p, std::size_t s) { return {_mm_set_pd(p[s], p[0])}; }
+    static L2 evens(const double* p) { return {_mm_unpacklo_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
+    static L2 odds(const double* p) { return {_mm_unpackhi_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
+    void store(double* p) const { _mm_storeu_pd(p, v); }
 };
 struct M2 {
     __m128d v;
@@ -903,181 +922,69 @@ inline L2 abs_of(L2 a) { return {_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)}; }
 inline L2 min_of(L2 x, L2 y) { return {_mm_min_pd(y.v, x.v)}; }  // y < x ? y : x
 inline L2 max_of(L2 x, L2 y) { return {_mm_max_pd(y.v, x.v)}; }  // y > x ? y : x, i.e. x < y ? y : x
 inline L2 select(M2 m, L2 a, L2 b) { return {_mm_or_pd(_mm_and_pd(m.v, a.v), _mm_andnot_pd(m.v, b.v))}; }
+namespace span_sse2 {
+using W = L2;
+#include "lod_span_kernels.inl"
+}  // namespace span_sse2
+#else
+namespace span_sse2 {
+using W = L1;
+#include "lod_span_kernels.inl"
+}  // namespace span_sse2
 #endif
 
-// Level 0 of the span hierarchy for one segment per lane: x, y, z of its four control points in; Wang's M, the
-// box (lo, hi), the sphere (centre c, radius r) and the deviation out. A larger of two lengths is the root of the
-// larger squared length (the root is monotone and correctly rounded: the same value, one root fewer). The hull's
-// distance to the chord: both inner control points against one reciprocal of the chord's squared length (a foot
-// parameter off by a rounding is still a point of the chord, so the distance can only come out larger: still a
-// bound). Branch-free: a value a case does not need is computed and selected away.
-template <class L>
-struct Level0 {
-    L wang, lo[3], hi[3], c[3], r, deviation;
-    Level0(const L (&x)[4], const L (&y)[4], const L (&z)[4]) {
-        const L two = L::splat(2.0), zero = L::splat(0.0), one = L::splat(1.0), half = L::splat(0.5);
-        const L m0x = (x[0] - two * x[1]) + x[2], m0y = (y[0] - two * y[1]) + y[2], m0z = (z[0] - two * z[1]) + z[2];
-        const L m1x = (x[1] - two * x[2]) + x[3], m1y = (y[1] - two * y[2]) + y[3], m1z = (z[1] - two * z[2]) + z[3];
-        wang = sqrt_of(max_of((m0x * m0x + m0y * m0y) + m0z * m0z, (m1x * m1x + m1y * m1y) + m1z * m1z));
-        const L* p[3] = {x, y, z};
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = min_of(min_of(p[k][0], p[k][1]), min_of(p[k][2], p[k][3]));
-            hi[k] = max_of(max_of(p[k][0], p[k][1]), max_of(p[k][2], p[k][3]));
-        }
-        const L abx = x[3] - x[0], aby = y[3] - y[0], abz = z[3] - z[0];
-        const L p1x = x[1] - x[0], p1y = y[1] - y[0], p1z = z[1] - z[0];
-        const L p2x = x[2] - x[0], p2y = y[2] - y[0], p2z = z[2] - z[0];
-        const L len2 = (abx * abx + aby * aby) + abz * abz;
-        const L inv = select(zero < len2, one / len2, zero);
-        // std::clamp(t, 0, 1) is std::min(std::max(t, 0), 1)
-        const L t1 = min_of(max_of(((p1x * abx + p1y * aby) + p1z * abz) * inv, zero), one);
-        const L t2 = min_of(max_of(((p2x * abx + p2y * aby) + p2z * abz) * inv, zero), one);
-        const L v1x = p1x - t1 * abx, v1y = p1y - t1 * aby, v1z = p1z - t1 * abz;
-        const L v2x = p2x - t2 * abx, v2y = p2y - t2 * aby, v2z = p2z - t2 * abz;
-        const L hull = sqrt_of(max_of((v1x * v1x + v1y * v1y) + v1z * v1z, (v2x * v2x + v2y * v2y) + v2z * v2z));
-        const L d = min_of(hull, L::splat(0.75) * wang);
-        // Not finite (NaN too): infinity.
-        deviation = select(abs_of(d) <= L::splat(std::numeric_limits<double>::max()), d,
-                           L::splat(std::numeric_limits<double>::infinity()));
-        for (int k = 0; k < 3; ++k) c[k] = half * (lo[k] + hi[k]);
-        const L sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
-        r = half * sqrt_of((sx * sx + sy * sy) + sz * sz) * L::splat(1.0 + 1e-12);
+#if defined(WIRE_LOD_AVX2)
+// The same kernels four lanes wide, compiled for AVX2 (no FMA: the arithmetic stays the scalar code's) and chosen
+// at run time where the CPU has it.
+#pragma GCC push_options
+#pragma GCC target("avx2")
+struct L4 {
+    static constexpr std::size_t width = 4;
+    __m256d v;
+    static L4 splat(double x) { return {_mm256_set1_pd(x)}; }
+    static L4 load(const double* p) { return {_mm256_loadu_pd(p)}; }
+    static L4 strided(const double* p, std::size_t s) { return {_mm256_set_pd(p[3 * s], p[2 * s], p[s], p[0])}; }
+    // unpacklo of p0..3 and p4..7 is p0 p4 p2 p6; lanes (0, 2, 1, 3) of it are p0 p2 p4 p6.
+    static L4 evens(const double* p) {
+        return {_mm256_permute4x64_pd(_mm256_unpacklo_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
     }
+    static L4 odds(const double* p) {
+        return {_mm256_permute4x64_pd(_mm256_unpackhi_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
+    }
+    void store(double* p) const { _mm256_storeu_pd(p, v); }
 };
-
-// A node of level l >= 1 from its two children (one pair per lane): chords A-M and M-B give the deviation
-// max(d_left, d_right) + dist(M, A-B); the sphere is the smallest around the children's (merge of two spheres:
-// one of them when it holds the other, else the one through both, its radius rounded up by a relative hair so
-// rounding in the centre cannot leave a point out).
-template <class L>
-struct Merge {
-    L c[3], r, deviation;
-    Merge(const L (&a)[3], const L (&m)[3], const L (&b)[3], const L (&lc)[3], L lr, L ld, const L (&rc)[3], L rr,
-          L rd) {
-        const L zero = L::splat(0.0), one = L::splat(1.0);
-        // distance_to_chord(M, A, B)
-        const L abx = b[0] - a[0], aby = b[1] - a[1], abz = b[2] - a[2];
-        const L qx = m[0] - a[0], qy = m[1] - a[1], qz = m[2] - a[2];
-        const L len2 = (abx * abx + aby * aby) + abz * abz;
-        const L t = select(zero < len2, min_of(max_of(((qx * abx + qy * aby) + qz * abz) / len2, zero), one), zero);
-        const L vx = m[0] - (a[0] + t * abx), vy = m[1] - (a[1] + t * aby), vz = m[2] - (a[2] + t * abz);
-        deviation = max_of(ld, rd) + sqrt_of((vx * vx + vy * vy) + vz * vz);
-        // merge_spheres(left, right)
-        const L dx = rc[0] - lc[0], dy = rc[1] - lc[1], dz = rc[2] - lc[2];
-        const L dist = sqrt_of((dx * dx + dy * dy) + dz * dz);
-        const L rad = L::splat(0.5) * ((dist + lr) + rr);
-        const L s = (rad - lr) / dist;
-        const auto take_left = dist + rr <= lr;
-        const auto take_right = dist + lr <= rr;
-        const L d[3] = {dx, dy, dz};
-        for (int k = 0; k < 3; ++k) c[k] = select(take_left, lc[k], select(take_right, rc[k], lc[k] + d[k] * s));
-        r = select(take_left, lr, select(take_right, rr, rad * L::splat(1.0 + 1e-12)));
-    }
+struct M4 {
+    __m256d v;
 };
-
-// Level 0 for segments [i0, n): node's 5 arrays, wang, box's 6 arrays, chord ends (6 arrays: b0, b3).
-void span_level0(const CubicBezier* seg, std::size_t n, double* node, double* wang, double* box, double* ends) {
-    std::size_t i = 0;
-    auto store1 = [&](std::size_t at, const Level0<L1>& q) {
-        wang[at] = q.wang.v;
-        for (int k = 0; k < 3; ++k) {
-            node[k * n + at] = q.c[k].v;
-            box[k * n + at] = q.lo[k].v;
-            box[(3 + k) * n + at] = q.hi[k].v;
-        }
-        node[3 * n + at] = q.r.v;
-        node[4 * n + at] = q.deviation.v;
-    };
-#if defined(__SSE2__)
-    for (; i + 2 <= n; i += 2) {
-        const CubicBezier &c0 = seg[i], &c1 = seg[i + 1];
-        const L2 x[4] = {{_mm_set_pd(c1.b0.x, c0.b0.x)}, {_mm_set_pd(c1.b1.x, c0.b1.x)},
-                         {_mm_set_pd(c1.b2.x, c0.b2.x)}, {_mm_set_pd(c1.b3.x, c0.b3.x)}};
-        const L2 y[4] = {{_mm_set_pd(c1.b0.y, c0.b0.y)}, {_mm_set_pd(c1.b1.y, c0.b1.y)},
-                         {_mm_set_pd(c1.b2.y, c0.b2.y)}, {_mm_set_pd(c1.b3.y, c0.b3.y)}};
-        const L2 z[4] = {{_mm_set_pd(c1.b0.z, c0.b0.z)}, {_mm_set_pd(c1.b1.z, c0.b1.z)},
-                         {_mm_set_pd(c1.b2.z, c0.b2.z)}, {_mm_set_pd(c1.b3.z, c0.b3.z)}};
-        const Level0<L2> q(x, y, z);
-        _mm_storeu_pd(wang + i, q.wang.v);
-        for (int k = 0; k < 3; ++k) {
-            _mm_storeu_pd(node + k * n + i, q.c[k].v);
-            _mm_storeu_pd(box + k * n + i, q.lo[k].v);
-            _mm_storeu_pd(box + (3 + k) * n + i, q.hi[k].v);
-        }
-        _mm_storeu_pd(node + 3 * n + i, q.r.v);
-        _mm_storeu_pd(node + 4 * n + i, q.deviation.v);
-        _mm_storeu_pd(ends + i, x[0].v);
-        _mm_storeu_pd(ends + n + i, y[0].v);
-        _mm_storeu_pd(ends + 2 * n + i, z[0].v);
-        _mm_storeu_pd(ends + 3 * n + i, x[3].v);
-        _mm_storeu_pd(ends + 4 * n + i, y[3].v);
-        _mm_storeu_pd(ends + 5 * n + i, z[3].v);
-    }
+inline L4 operator+(L4 a, L4 b) { return {_mm256_add_pd(a.v, b.v)}; }
+inline L4 operator-(L4 a, L4 b) { return {_mm256_sub_pd(a.v, b.v)}; }
+inline L4 operator*(L4 a, L4 b) { return {_mm256_mul_pd(a.v, b.v)}; }
+inline L4 operator/(L4 a, L4 b) { return {_mm256_div_pd(a.v, b.v)}; }
+inline M4 operator<(L4 a, L4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_LT_OQ)}; }
+inline M4 operator<=(L4 a, L4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_LE_OQ)}; }
+inline L4 sqrt_of(L4 a) { return {_mm256_sqrt_pd(a.v)}; }
+inline L4 abs_of(L4 a) { return {_mm256_andnot_pd(_mm256_set1_pd(-0.0), a.v)}; }
+inline L4 min_of(L4 x, L4 y) { return {_mm256_min_pd(y.v, x.v)}; }
+inline L4 max_of(L4 x, L4 y) { return {_mm256_max_pd(y.v, x.v)}; }
+inline L4 select(M4 m, L4 a, L4 b) { return {_mm256_blendv_pd(b.v, a.v, m.v)}; }
+namespace span_avx2 {
+using W = L4;
+#include "lod_span_kernels.inl"
+}  // namespace span_avx2
+#pragma GCC pop_options
 #endif
-    for (; i < n; ++i) {
-        const CubicBezier& c = seg[i];
-        const L1 x[4] = {{c.b0.x}, {c.b1.x}, {c.b2.x}, {c.b3.x}};
-        const L1 y[4] = {{c.b0.y}, {c.b1.y}, {c.b2.y}, {c.b3.y}};
-        const L1 z[4] = {{c.b0.z}, {c.b1.z}, {c.b2.z}, {c.b3.z}};
-        store1(i, Level0<L1>(x, y, z));
-        ends[i] = c.b0.x, ends[n + i] = c.b0.y, ends[2 * n + i] = c.b0.z;
-        ends[3 * n + i] = c.b3.x, ends[4 * n + i] = c.b3.y, ends[5 * n + i] = c.b3.z;
-    }
-}
 
-// Level l from level l - 1 (child: 5 arrays of cw nodes, e: their chord ends, 6 arrays of cw; parent: 5 arrays of
-// w nodes, f: their chord ends): a parent's chord runs from its left child's first point to its right child's last.
-void span_merge_level(const double* child, const double* e, std::size_t cw, double* parent, double* f,
-                      std::size_t w) {
-    const std::size_t pairs = cw / 2;
-    std::size_t j = 0;
-#if defined(__SSE2__)
-    // Lanes j, j + 1: left children 2j, 2j + 2 and right children 2j + 1, 2j + 3 (two loads, unpacked).
-    auto left = [](const double* a, std::size_t j) {
-        return L2{_mm_unpacklo_pd(_mm_loadu_pd(a + 2 * j), _mm_loadu_pd(a + 2 * j + 2))};
-    };
-    auto right = [](const double* a, std::size_t j) {
-        return L2{_mm_unpackhi_pd(_mm_loadu_pd(a + 2 * j), _mm_loadu_pd(a + 2 * j + 2))};
-    };
-    for (; j + 2 <= pairs; j += 2) {
-        const L2 a[3] = {left(e, j), left(e + cw, j), left(e + 2 * cw, j)};
-        const L2 m[3] = {right(e, j), right(e + cw, j), right(e + 2 * cw, j)};
-        const L2 b[3] = {right(e + 3 * cw, j), right(e + 4 * cw, j), right(e + 5 * cw, j)};
-        const L2 lc[3] = {left(child, j), left(child + cw, j), left(child + 2 * cw, j)};
-        const L2 rc[3] = {right(child, j), right(child + cw, j), right(child + 2 * cw, j)};
-        const Merge<L2> q(a, m, b, lc, left(child + 3 * cw, j), left(child + 4 * cw, j), rc,
-                          right(child + 3 * cw, j), right(child + 4 * cw, j));
-        for (int k = 0; k < 3; ++k) {
-            _mm_storeu_pd(parent + k * w + j, q.c[k].v);
-            _mm_storeu_pd(f + k * w + j, a[k].v);
-            _mm_storeu_pd(f + (3 + k) * w + j, b[k].v);
-        }
-        _mm_storeu_pd(parent + 3 * w + j, q.r.v);
-        _mm_storeu_pd(parent + 4 * w + j, q.deviation.v);
-    }
+// The span kernels for this CPU.
+struct SpanKernels {
+    void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*);
+    void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t);
+};
+SpanKernels span_kernels() {
+#if defined(WIRE_LOD_AVX2)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2")) return {span_avx2::span_level0, span_avx2::span_merge_level};
 #endif
-    for (; j < pairs; ++j) {
-        const std::size_t l = 2 * j, r = 2 * j + 1;
-        const L1 a[3] = {{e[l]}, {e[cw + l]}, {e[2 * cw + l]}};
-        const L1 m[3] = {{e[r]}, {e[cw + r]}, {e[2 * cw + r]}};
-        const L1 b[3] = {{e[3 * cw + r]}, {e[4 * cw + r]}, {e[5 * cw + r]}};
-        const L1 lc[3] = {{child[l]}, {child[cw + l]}, {child[2 * cw + l]}};
-        const L1 rc[3] = {{child[r]}, {child[cw + r]}, {child[2 * cw + r]}};
-        const Merge<L1> q(a, m, b, lc, {child[3 * cw + l]}, {child[4 * cw + l]}, rc, {child[3 * cw + r]},
-                          {child[4 * cw + r]});
-        for (int k = 0; k < 3; ++k) {
-            parent[k * w + j] = q.c[k].v;
-            f[k * w + j] = a[k].v;
-            f[(3 + k) * w + j] = b[k].v;
-        }
-        parent[3 * w + j] = q.r.v;
-        parent[4 * w + j] = q.deviation.v;
-    }
-    if (pairs < w) {  // an odd child count: the last node is its only child
-        const std::size_t l = cw - 1;
-        for (int k = 0; k < 5; ++k) parent[k * w + pairs] = child[k * cw + l];
-        for (int k = 0; k < 6; ++k) f[k * w + pairs] = e[k * cw + l];
-    }
+    return {span_sse2::span_level0, span_sse2::span_merge_level};
 }
 
 // Smallest and largest of v[0..w) as std::min / std::max in sequence give them, for values that are never -0
@@ -1104,6 +1011,29 @@ void deviation_range(const double* v, std::size_t w, double& lo_out, double& hi_
     }
     lo_out = lo[0];
     hi_out = hi[0];
+}
+
+// std::min (std::max) of init and v[0..n) in sequence, which keeps the first of equal values: in four lanes,
+// exact unless the result is a zero (the one value with two encodings, -0 and +0: then in sequence).
+template <bool Max>
+double ordered_extreme(const double* v, std::size_t n, double init) {
+    auto pick = [](double acc, double x) { return Max ? max_of(acc, x) : min_of(acc, x); };
+    double acc[4] = {init, init, init, init};
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (int k = 0; k < 4; ++k) acc[k] = pick(acc[k], v[i + k]);
+    for (; i < n; ++i) acc[0] = pick(acc[0], v[i]);
+    const double r = pick(pick(acc[0], acc[1]), pick(acc[2], acc[3]));
+    if (r != 0.0) return r;
+    double seq = init;
+    for (i = 0; i < n; ++i) seq = pick(seq, v[i]);
+    return seq;
+}
+double ordered_min(const double* v, std::size_t n) {
+    return ordered_extreme<false>(v, n, std::numeric_limits<double>::infinity());
+}
+double ordered_max(const double* v, std::size_t n) {
+    return ordered_extreme<true>(v, n, -std::numeric_limits<double>::infinity());
 }
 
 }  // namespace
@@ -1141,27 +1071,22 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
         sc.ends[0].resize(6 * n);
         sc.ends[1].resize(6 * n);
     }
-    span_level0(curve.segments.data(), n, out.level_data(0), wang, sc.boxes.data(), sc.ends[0].data());
+    static const SpanKernels kernels = span_kernels();
+    kernels.level0(curve.segments.data(), n, out.level_data(0), wang, sc.boxes.data(), sc.ends[0].data());
     {
-        // The wire's box and the largest M, in segment order (a min or max over equal values may differ in the
-        // sign of a zero: the order of curve_bounding_sphere() is kept).
+        // The wire's box and the largest M (M is never -0: a root of a sum of squares).
         const double* b = sc.boxes.data();
-        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-        double m_max = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            lo = {min_of(lo.x, b[i]), min_of(lo.y, b[n + i]), min_of(lo.z, b[2 * n + i])};
-            hi = {max_of(hi.x, b[3 * n + i]), max_of(hi.y, b[4 * n + i]), max_of(hi.z, b[5 * n + i])};
-            m_max = max_of(m_max, wang[i]);
-        }
-        out.wang_m_max = m_max;
+        const glm::dvec3 lo(ordered_min(b, n), ordered_min(b + n, n), ordered_min(b + 2 * n, n));
+        const glm::dvec3 hi(ordered_max(b + 3 * n, n), ordered_max(b + 4 * n, n), ordered_max(b + 5 * n, n));
+        double unused = 0.0;
+        deviation_range(wang, n, unused, out.wang_m_max);
         // curve_bounding_sphere(curve): the same box (the same minima and maxima), the same rounding.
-        double radius = 0.0;
-        for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
+        const double radius = out.radius_max_m;
         out.sphere = {0.5 * (lo + hi), (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
     }
     // Levels 1 and up, each from the one below; the chord ends alternate between two buffers.
     for (std::size_t level = 1; level < levels; ++level) {
-        span_merge_level(out.level_data(level - 1), sc.ends[(level - 1) & 1].data(), out.level_width(level - 1),
+        kernels.merge_level(out.level_data(level - 1), sc.ends[(level - 1) & 1].data(), out.level_width(level - 1),
                          out.level_data(level), sc.ends[level & 1].data(), out.level_width(level));
     }
     for (std::size_t l = 0; l < levels; ++l)

@@ -1,0 +1,141 @@
+// The span hierarchy's kernels (compute_lod_bounds), included by lod.cpp once per lane width: W is the wide lane
+// type (L1, L2 or L4 of lod.cpp), L1 does the tail. Not a header: no include guard, no namespace of its own.
+
+// Level 0 of the span hierarchy for one segment per lane: x, y, z of its four control points in; Wang's M, the
+// box (lo, hi), the sphere (centre c, radius r) and the deviation out. A larger of two lengths is the root of the
+// larger squared length (the root is monotone and correctly rounded: the same value, one root fewer). The hull's
+// distance to the chord: both inner control points against one reciprocal of the chord's squared length (a foot
+// parameter off by a rounding is still a point of the chord, so the distance can only come out larger: still a
+// bound). Branch-free: a value a case does not need is computed and selected away.
+template <class L>
+struct Level0 {
+    L wang, lo[3], hi[3], c[3], r, deviation;
+    Level0(const L (&x)[4], const L (&y)[4], const L (&z)[4]) {
+        const L two = L::splat(2.0), zero = L::splat(0.0), one = L::splat(1.0), half = L::splat(0.5);
+        const L m0x = (x[0] - two * x[1]) + x[2], m0y = (y[0] - two * y[1]) + y[2], m0z = (z[0] - two * z[1]) + z[2];
+        const L m1x = (x[1] - two * x[2]) + x[3], m1y = (y[1] - two * y[2]) + y[3], m1z = (z[1] - two * z[2]) + z[3];
+        wang = sqrt_of(max_of((m0x * m0x + m0y * m0y) + m0z * m0z, (m1x * m1x + m1y * m1y) + m1z * m1z));
+        const L* p[3] = {x, y, z};
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = min_of(min_of(p[k][0], p[k][1]), min_of(p[k][2], p[k][3]));
+            hi[k] = max_of(max_of(p[k][0], p[k][1]), max_of(p[k][2], p[k][3]));
+        }
+        const L abx = x[3] - x[0], aby = y[3] - y[0], abz = z[3] - z[0];
+        const L p1x = x[1] - x[0], p1y = y[1] - y[0], p1z = z[1] - z[0];
+        const L p2x = x[2] - x[0], p2y = y[2] - y[0], p2z = z[2] - z[0];
+        const L len2 = (abx * abx + aby * aby) + abz * abz;
+        const L inv = select(zero < len2, one / len2, zero);
+        // std::clamp(t, 0, 1) is std::min(std::max(t, 0), 1)
+        const L t1 = min_of(max_of(((p1x * abx + p1y * aby) + p1z * abz) * inv, zero), one);
+        const L t2 = min_of(max_of(((p2x * abx + p2y * aby) + p2z * abz) * inv, zero), one);
+        const L v1x = p1x - t1 * abx, v1y = p1y - t1 * aby, v1z = p1z - t1 * abz;
+        const L v2x = p2x - t2 * abx, v2y = p2y - t2 * aby, v2z = p2z - t2 * abz;
+        const L hull = sqrt_of(max_of((v1x * v1x + v1y * v1y) + v1z * v1z, (v2x * v2x + v2y * v2y) + v2z * v2z));
+        const L d = min_of(hull, L::splat(0.75) * wang);
+        // Not finite (NaN too): infinity.
+        deviation = select(abs_of(d) <= L::splat(std::numeric_limits<double>::max()), d,
+                           L::splat(std::numeric_limits<double>::infinity()));
+        for (int k = 0; k < 3; ++k) c[k] = half * (lo[k] + hi[k]);
+        const L sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
+        r = half * sqrt_of((sx * sx + sy * sy) + sz * sz) * L::splat(1.0 + 1e-12);
+    }
+};
+
+// A node of level l >= 1 from its two children (one pair per lane): chords A-M and M-B give the deviation
+// max(d_left, d_right) + dist(M, A-B); the sphere is the smallest around the children's (merge of two spheres:
+// one of them when it holds the other, else the one through both, its radius rounded up by a relative hair so
+// rounding in the centre cannot leave a point out).
+template <class L>
+struct Merge {
+    L c[3], r, deviation;
+    Merge(const L (&a)[3], const L (&m)[3], const L (&b)[3], const L (&lc)[3], L lr, L ld, const L (&rc)[3], L rr,
+          L rd) {
+        const L zero = L::splat(0.0), one = L::splat(1.0);
+        // distance_to_chord(M, A, B)
+        const L abx = b[0] - a[0], aby = b[1] - a[1], abz = b[2] - a[2];
+        const L qx = m[0] - a[0], qy = m[1] - a[1], qz = m[2] - a[2];
+        const L len2 = (abx * abx + aby * aby) + abz * abz;
+        const L t = select(zero < len2, min_of(max_of(((qx * abx + qy * aby) + qz * abz) / len2, zero), one), zero);
+        const L vx = m[0] - (a[0] + t * abx), vy = m[1] - (a[1] + t * aby), vz = m[2] - (a[2] + t * abz);
+        deviation = max_of(ld, rd) + sqrt_of((vx * vx + vy * vy) + vz * vz);
+        // merge_spheres(left, right)
+        const L dx = rc[0] - lc[0], dy = rc[1] - lc[1], dz = rc[2] - lc[2];
+        const L dist = sqrt_of((dx * dx + dy * dy) + dz * dz);
+        const L rad = L::splat(0.5) * ((dist + lr) + rr);
+        const L s = (rad - lr) / dist;
+        const auto take_left = dist + rr <= lr;
+        const auto take_right = dist + lr <= rr;
+        const L d[3] = {dx, dy, dz};
+        for (int k = 0; k < 3; ++k) c[k] = select(take_left, lc[k], select(take_right, rc[k], lc[k] + d[k] * s));
+        r = select(take_left, lr, select(take_right, rr, rad * L::splat(1.0 + 1e-12)));
+    }
+};
+
+// Level 0: every segment's node (5 arrays: centre x, y, z, radius, deviation), Wang's M, box (6 arrays: lo, hi) and
+// chord ends (6 arrays: b0, b3), W::width segments at a time, the rest one by one.
+inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, double* wang, double* box,
+                        double* ends) {
+    constexpr std::size_t stride = sizeof(CubicBezier) / sizeof(double);
+    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
+    auto run = [&]<class L>(std::size_t i, L) {
+        const double* p = &seg[i].b0.x;  // b0 x y z, b1 x y z, b2 ..., b3 ...
+        L x[4], y[4], z[4];
+        for (int k = 0; k < 4; ++k) {
+            x[k] = L::strided(p + 3 * k, stride);
+            y[k] = L::strided(p + 3 * k + 1, stride);
+            z[k] = L::strided(p + 3 * k + 2, stride);
+        }
+        const Level0<L> q(x, y, z);
+        q.wang.store(wang + i);
+        for (int k = 0; k < 3; ++k) {
+            q.c[k].store(node + k * n + i);
+            q.lo[k].store(box + k * n + i);
+            q.hi[k].store(box + (3 + k) * n + i);
+        }
+        q.r.store(node + 3 * n + i);
+        q.deviation.store(node + 4 * n + i);
+        x[0].store(ends + i);
+        y[0].store(ends + n + i);
+        z[0].store(ends + 2 * n + i);
+        x[3].store(ends + 3 * n + i);
+        y[3].store(ends + 4 * n + i);
+        z[3].store(ends + 5 * n + i);
+    };
+    std::size_t i = 0;
+    for (; i + W::width <= n; i += W::width) run(i, W{});
+    for (; i < n; ++i) run(i, L1{});
+}
+
+// Level l from level l - 1 (child: 5 arrays of cw nodes, e: their chord ends, 6 arrays of cw; parent: 5 arrays of
+// w nodes, f: their chord ends): a parent's chord runs from its left child's first point to its right child's
+// last. W::width parents at a time (their left children are the even nodes of 2 W::width children, their right
+// ones the odd nodes), the rest one by one; an odd child count leaves the last child alone in its parent.
+inline void span_merge_level(const double* child, const double* e, std::size_t cw, double* parent, double* f,
+                             std::size_t w) {
+    const std::size_t pairs = cw / 2;
+    auto run = [&]<class L>(std::size_t j, L) {
+        const std::size_t at = 2 * j;
+        const L a[3] = {L::evens(e + at), L::evens(e + cw + at), L::evens(e + 2 * cw + at)};
+        const L m[3] = {L::odds(e + at), L::odds(e + cw + at), L::odds(e + 2 * cw + at)};
+        const L b[3] = {L::odds(e + 3 * cw + at), L::odds(e + 4 * cw + at), L::odds(e + 5 * cw + at)};
+        const L lc[3] = {L::evens(child + at), L::evens(child + cw + at), L::evens(child + 2 * cw + at)};
+        const L rc[3] = {L::odds(child + at), L::odds(child + cw + at), L::odds(child + 2 * cw + at)};
+        const Merge<L> q(a, m, b, lc, L::evens(child + 3 * cw + at), L::evens(child + 4 * cw + at), rc,
+                         L::odds(child + 3 * cw + at), L::odds(child + 4 * cw + at));
+        for (int k = 0; k < 3; ++k) {
+            q.c[k].store(parent + k * w + j);
+            a[k].store(f + k * w + j);
+            b[k].store(f + (3 + k) * w + j);
+        }
+        q.r.store(parent + 3 * w + j);
+        q.deviation.store(parent + 4 * w + j);
+    };
+    std::size_t j = 0;
+    for (; j + W::width <= pairs; j += W::width) run(j, W{});
+    for (; j < pairs; ++j) run(j, L1{});
+    if (pairs < w) {
+        const std::size_t l = cw - 1;
+        for (int k = 0; k < 5; ++k) parent[k * w + pairs] = child[k * cw + l];
+        for (int k = 0; k < 6; ++k) f[k * w + pairs] = e[k * cw + l];
+    }
+}
