@@ -870,17 +870,20 @@ inline double max_of(double x, double y) { return x < y ? y : x; }
 // the CPU has AVX2), so every lane does exactly the scalar arithmetic (each operation the IEEE one, correctly
 // rounded, no fused multiply-add): results are bit-identical whichever runs. min_of / max_of / select keep the
 // scalar comparisons' operand order (minpd(a, b) is a < b ? a : b), so NaN and signed zeros come out as in the
-// scalar code. Besides arithmetic a lane type loads and stores `width` consecutive doubles, gathers them
-// `stride` apart, and splits 2 width consecutive ones into the even and the odd ones.
+// scalar code. Besides arithmetic a lane type loads and stores `width` consecutive doubles, splits 2 width
+// consecutive ones into the even and the odd ones, and reads `width` consecutive segments' control points.
 struct L1 {
     static constexpr std::size_t width = 1;
     double v;
     static L1 splat(double x) { return {x}; }
     static L1 load(const double* p) { return {*p}; }
-    static L1 strided(const double* p, std::size_t) { return {*p}; }
     static L1 evens(const double* p) { return {p[0]}; }
     static L1 odds(const double* p) { return {p[1]}; }
     void store(double* p) const { *p = v; }
+    // x, y, z of the four control points of one segment per lane (p: lane 0's segment, 12 doubles a segment).
+    static void points(const double* p, L1 (&x)[4], L1 (&y)[4], L1 (&z)[4]) {
+        for (int k = 0; k < 4; ++k) x[k] = {p[3 * k]}, y[k] = {p[3 * k + 1]}, z[k] = {p[3 * k + 2]};
+    }
 };
 struct M1 {
     bool v;
@@ -903,10 +906,18 @@ struct L2 {
     __m128d v;
     static L2 splat(double x) { return {_mm_set1_pd(x)}; }
     static L2 load(const double* p) { return {_mm_loadu_pd(p)}; }
-    static L2 strided(const double* p, std::size_t s) { return {_mm_set_pd(p[s], p[0])}; }
     static L2 evens(const double* p) { return {_mm_unpacklo_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
     static L2 odds(const double* p) { return {_mm_unpackhi_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
     void store(double* p) const { _mm_storeu_pd(p, v); }
+    static void points(const double* p, L2 (&x)[4], L2 (&y)[4], L2 (&z)[4]) {
+        L2 c[12];
+        for (int k = 0; k < 12; k += 2) {
+            const __m128d a = _mm_loadu_pd(p + k), b = _mm_loadu_pd(p + 12 + k);
+            c[k] = {_mm_unpacklo_pd(a, b)};
+            c[k + 1] = {_mm_unpackhi_pd(a, b)};
+        }
+        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
+    }
 };
 struct M2 {
     __m128d v;
@@ -943,7 +954,6 @@ struct L4 {
     __m256d v;
     static L4 splat(double x) { return {_mm256_set1_pd(x)}; }
     static L4 load(const double* p) { return {_mm256_loadu_pd(p)}; }
-    static L4 strided(const double* p, std::size_t s) { return {_mm256_set_pd(p[3 * s], p[2 * s], p[s], p[0])}; }
     // unpacklo of p0..3 and p4..7 is p0 p4 p2 p6; lanes (0, 2, 1, 3) of it are p0 p2 p4 p6.
     static L4 evens(const double* p) {
         return {_mm256_permute4x64_pd(_mm256_unpacklo_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
@@ -952,6 +962,21 @@ struct L4 {
         return {_mm256_permute4x64_pd(_mm256_unpackhi_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
     }
     void store(double* p) const { _mm256_storeu_pd(p, v); }
+    // Three 4 x 4 transposes: rows are the lanes' segments, columns 4 consecutive doubles of them.
+    static void points(const double* p, L4 (&x)[4], L4 (&y)[4], L4 (&z)[4]) {
+        L4 c[12];
+        for (int k = 0; k < 12; k += 4) {
+            const __m256d r0 = _mm256_loadu_pd(p + k), r1 = _mm256_loadu_pd(p + 12 + k);
+            const __m256d r2 = _mm256_loadu_pd(p + 24 + k), r3 = _mm256_loadu_pd(p + 36 + k);
+            const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+            const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+            c[k] = {_mm256_permute2f128_pd(t0, t2, 0x20)};
+            c[k + 1] = {_mm256_permute2f128_pd(t1, t3, 0x20)};
+            c[k + 2] = {_mm256_permute2f128_pd(t0, t2, 0x31)};
+            c[k + 3] = {_mm256_permute2f128_pd(t1, t3, 0x31)};
+        }
+        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
+    }
 };
 struct M4 {
     __m256d v;

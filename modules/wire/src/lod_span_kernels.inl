@@ -75,16 +75,10 @@ struct Merge {
 // chord ends (6 arrays: b0, b3), W::width segments at a time, the rest one by one.
 inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, double* wang, double* box,
                         double* ends) {
-    constexpr std::size_t stride = sizeof(CubicBezier) / sizeof(double);
-    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
-    auto run = [&]<class L>(std::size_t i, L) {
-        const double* p = &seg[i].b0.x;  // b0 x y z, b1 x y z, b2 ..., b3 ...
+    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));  // b0 .. b3, x y z each, no padding
+    auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
         L x[4], y[4], z[4];
-        for (int k = 0; k < 4; ++k) {
-            x[k] = L::strided(p + 3 * k, stride);
-            y[k] = L::strided(p + 3 * k + 1, stride);
-            z[k] = L::strided(p + 3 * k + 2, stride);
-        }
+        L::points(&seg[i].b0.x, x, y, z);  // b0 x y z, b1 x y z, b2 ..., b3 ... of each lane's segment
         const Level0<L> q(x, y, z);
         q.wang.store(wang + i);
         for (int k = 0; k < 3; ++k) {
@@ -103,6 +97,10 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
     };
     std::size_t i = 0;
     for (; i + W::width <= n; i += W::width) run(i, W{});
+#if defined(__SSE2__)
+    if constexpr (W::width > 2)
+        for (; i + 2 <= n; i += 2) run(i, L2{});
+#endif
     for (; i < n; ++i) run(i, L1{});
 }
 
@@ -113,7 +111,7 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
 inline void span_merge_level(const double* child, const double* e, std::size_t cw, double* parent, double* f,
                              std::size_t w) {
     const std::size_t pairs = cw / 2;
-    auto run = [&]<class L>(std::size_t j, L) {
+    auto run = [&]<class L>(std::size_t j, L) __attribute__((always_inline)) {
         const std::size_t at = 2 * j;
         const L a[3] = {L::evens(e + at), L::evens(e + cw + at), L::evens(e + 2 * cw + at)};
         const L m[3] = {L::odds(e + at), L::odds(e + cw + at), L::odds(e + 2 * cw + at)};
@@ -132,6 +130,10 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
     };
     std::size_t j = 0;
     for (; j + W::width <= pairs; j += W::width) run(j, W{});
+#if defined(__SSE2__)
+    if constexpr (W::width > 2)
+        for (; j + 2 <= pairs; j += 2) run(j, L2{});
+#endif
     for (; j < pairs; ++j) run(j, L1{});
     if (pairs < w) {
         const std::size_t l = cw - 1;
