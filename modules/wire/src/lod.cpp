@@ -263,10 +263,184 @@ void mark_culled(WireLod& lod, bool& changed) {
     lod.coherence.valid = false;
 }
 
+// What the hull-depth kernel needs of the view: world -> view (ViewTransform's rotation, column-major, and
+// translation), the near and far planes, the screen edges' tangents, and the plane test's inflated offsets
+// (PlaneTest's rx, ry, r, negated).
+struct HullConstants {
+    double m[9], t[3];
+    double near, far, tx, ty;
+    double neg_rx, neg_ry, neg_r;
+};
+
+// std::min, std::max by value, as they compare (glm::min and glm::max too).
+inline double min_of(double x, double y) { return y < x ? y : x; }
+inline double max_of(double x, double y) { return x < y ? y : x; }
+
+// Lanes for the span hierarchy's kernels (lod_span_kernels.inl): the kernels are written once over a lane type,
+// L1 (one double: the scalar code), L2 (two doubles in an SSE2 register) or L4 (four in an AVX register, where
+// the CPU has AVX2), so every lane does exactly the scalar arithmetic (each operation the IEEE one, correctly
+// rounded, no fused multiply-add): results are bit-identical whichever runs. min_of / max_of / select keep the
+// scalar comparisons' operand order (minpd(a, b) is a < b ? a : b), so NaN and signed zeros come out as in the
+// scalar code. Besides arithmetic a lane type loads and stores `width` consecutive doubles, splits 2 width
+// consecutive ones into the even and the odd ones, and reads `width` consecutive segments' control points.
+struct L1 {
+    static constexpr std::size_t width = 1;
+    double v;
+    static L1 splat(double x) { return {x}; }
+    static L1 load(const double* p) { return {*p}; }
+    static L1 evens(const double* p) { return {p[0]}; }
+    static L1 odds(const double* p) { return {p[1]}; }
+    void store(double* p) const { *p = v; }
+    // x, y, z of the four control points of one segment per lane (p: lane 0's segment, 12 doubles a segment).
+    static void points(const double* p, L1 (&x)[4], L1 (&y)[4], L1 (&z)[4]) {
+        for (int k = 0; k < 4; ++k) x[k] = {p[3 * k]}, y[k] = {p[3 * k + 1]}, z[k] = {p[3 * k + 2]};
+    }
+};
+struct M1 {
+    bool v;
+    [[nodiscard]] unsigned bits() const { return v ? 1u : 0u; }  // bit k: lane k
+};
+inline M1 operator&(M1 a, M1 b) { return {a.v && b.v}; }
+inline L1 neg_of(L1 a) { return {-a.v}; }
+inline L1 operator+(L1 a, L1 b) { return {a.v + b.v}; }
+inline L1 operator-(L1 a, L1 b) { return {a.v - b.v}; }
+inline L1 operator*(L1 a, L1 b) { return {a.v * b.v}; }
+inline L1 operator/(L1 a, L1 b) { return {a.v / b.v}; }
+inline M1 operator<(L1 a, L1 b) { return {a.v < b.v}; }
+inline M1 operator<=(L1 a, L1 b) { return {a.v <= b.v}; }
+inline L1 sqrt_of(L1 a) { return {std::sqrt(a.v)}; }
+inline L1 abs_of(L1 a) { return {std::abs(a.v)}; }
+inline L1 min_of(L1 x, L1 y) { return {min_of(x.v, y.v)}; }
+inline L1 max_of(L1 x, L1 y) { return {max_of(x.v, y.v)}; }
+inline L1 select(M1 m, L1 a, L1 b) { return {m.v ? a.v : b.v}; }
+
+#if defined(__SSE2__)
+struct L2 {
+    static constexpr std::size_t width = 2;
+    __m128d v;
+    static L2 splat(double x) { return {_mm_set1_pd(x)}; }
+    static L2 load(const double* p) { return {_mm_loadu_pd(p)}; }
+    static L2 evens(const double* p) { return {_mm_unpacklo_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
+    static L2 odds(const double* p) { return {_mm_unpackhi_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
+    void store(double* p) const { _mm_storeu_pd(p, v); }
+    static void points(const double* p, L2 (&x)[4], L2 (&y)[4], L2 (&z)[4]) {
+        L2 c[12];
+        for (int k = 0; k < 12; k += 2) {
+            const __m128d a = _mm_loadu_pd(p + k), b = _mm_loadu_pd(p + 12 + k);
+            c[k] = {_mm_unpacklo_pd(a, b)};
+            c[k + 1] = {_mm_unpackhi_pd(a, b)};
+        }
+        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
+    }
+};
+struct M2 {
+    __m128d v;
+    [[nodiscard]] unsigned bits() const { return static_cast<unsigned>(_mm_movemask_pd(v)); }
+};
+inline M2 operator&(M2 a, M2 b) { return {_mm_and_pd(a.v, b.v)}; }
+inline L2 neg_of(L2 a) { return {_mm_xor_pd(_mm_set1_pd(-0.0), a.v)}; }
+inline L2 operator+(L2 a, L2 b) { return {_mm_add_pd(a.v, b.v)}; }
+inline L2 operator-(L2 a, L2 b) { return {_mm_sub_pd(a.v, b.v)}; }
+inline L2 operator*(L2 a, L2 b) { return {_mm_mul_pd(a.v, b.v)}; }
+inline L2 operator/(L2 a, L2 b) { return {_mm_div_pd(a.v, b.v)}; }
+inline M2 operator<(L2 a, L2 b) { return {_mm_cmplt_pd(a.v, b.v)}; }
+inline M2 operator<=(L2 a, L2 b) { return {_mm_cmple_pd(a.v, b.v)}; }
+inline L2 sqrt_of(L2 a) { return {_mm_sqrt_pd(a.v)}; }
+inline L2 abs_of(L2 a) { return {_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)}; }
+inline L2 min_of(L2 x, L2 y) { return {_mm_min_pd(y.v, x.v)}; }  // y < x ? y : x
+inline L2 max_of(L2 x, L2 y) { return {_mm_max_pd(y.v, x.v)}; }  // y > x ? y : x, i.e. x < y ? y : x
+inline L2 select(M2 m, L2 a, L2 b) { return {_mm_or_pd(_mm_and_pd(m.v, a.v), _mm_andnot_pd(m.v, b.v))}; }
+namespace span_sse2 {
+using W = L2;
+#include "lod_span_kernels.inl"
+}  // namespace span_sse2
+#else
+namespace span_sse2 {
+using W = L1;
+#include "lod_span_kernels.inl"
+}  // namespace span_sse2
+#endif
+
+#if defined(WIRE_LOD_AVX2)
+// The same kernels four lanes wide, compiled for AVX2 (no FMA: the arithmetic stays the scalar code's) and chosen
+// at run time where the CPU has it.
+#pragma GCC push_options
+#pragma GCC target("avx2")
+struct L4 {
+    static constexpr std::size_t width = 4;
+    __m256d v;
+    static L4 splat(double x) { return {_mm256_set1_pd(x)}; }
+    static L4 load(const double* p) { return {_mm256_loadu_pd(p)}; }
+    // unpacklo of p0..3 and p4..7 is p0 p4 p2 p6; lanes (0, 2, 1, 3) of it are p0 p2 p4 p6.
+    static L4 evens(const double* p) {
+        return {_mm256_permute4x64_pd(_mm256_unpacklo_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
+    }
+    static L4 odds(const double* p) {
+        return {_mm256_permute4x64_pd(_mm256_unpackhi_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
+    }
+    void store(double* p) const { _mm256_storeu_pd(p, v); }
+    // Three 4 x 4 transposes: rows are the lanes' segments, columns 4 consecutive doubles of them.
+    static void points(const double* p, L4 (&x)[4], L4 (&y)[4], L4 (&z)[4]) {
+        L4 c[12];
+        for (int k = 0; k < 12; k += 4) {
+            const __m256d r0 = _mm256_loadu_pd(p + k), r1 = _mm256_loadu_pd(p + 12 + k);
+            const __m256d r2 = _mm256_loadu_pd(p + 24 + k), r3 = _mm256_loadu_pd(p + 36 + k);
+            const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
+            const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+            c[k] = {_mm256_permute2f128_pd(t0, t2, 0x20)};
+            c[k + 1] = {_mm256_permute2f128_pd(t1, t3, 0x20)};
+            c[k + 2] = {_mm256_permute2f128_pd(t0, t2, 0x31)};
+            c[k + 3] = {_mm256_permute2f128_pd(t1, t3, 0x31)};
+        }
+        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
+    }
+};
+struct M4 {
+    __m256d v;
+    [[nodiscard]] unsigned bits() const { return static_cast<unsigned>(_mm256_movemask_pd(v)); }
+};
+inline M4 operator&(M4 a, M4 b) { return {_mm256_and_pd(a.v, b.v)}; }
+inline L4 neg_of(L4 a) { return {_mm256_xor_pd(_mm256_set1_pd(-0.0), a.v)}; }
+inline L4 operator+(L4 a, L4 b) { return {_mm256_add_pd(a.v, b.v)}; }
+inline L4 operator-(L4 a, L4 b) { return {_mm256_sub_pd(a.v, b.v)}; }
+inline L4 operator*(L4 a, L4 b) { return {_mm256_mul_pd(a.v, b.v)}; }
+inline L4 operator/(L4 a, L4 b) { return {_mm256_div_pd(a.v, b.v)}; }
+inline M4 operator<(L4 a, L4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_LT_OQ)}; }
+inline M4 operator<=(L4 a, L4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_LE_OQ)}; }
+inline L4 sqrt_of(L4 a) { return {_mm256_sqrt_pd(a.v)}; }
+inline L4 abs_of(L4 a) { return {_mm256_andnot_pd(_mm256_set1_pd(-0.0), a.v)}; }
+inline L4 min_of(L4 x, L4 y) { return {_mm256_min_pd(y.v, x.v)}; }
+inline L4 max_of(L4 x, L4 y) { return {_mm256_max_pd(y.v, x.v)}; }
+inline L4 select(M4 m, L4 a, L4 b) { return {_mm256_blendv_pd(b.v, a.v, m.v)}; }
+namespace span_avx2 {
+using W = L4;
+#include "lod_span_kernels.inl"
+}  // namespace span_avx2
+#pragma GCC pop_options
+#endif
+
+// The span kernels for this CPU.
+struct SpanKernels {
+    void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*);
+    void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t);
+    void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
+};
+SpanKernels choose_span_kernels() {
+#if defined(WIRE_LOD_AVX2)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx2"))
+        return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel};
+#endif
+    return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::hull_depth_kernel};
+}
+const SpanKernels& span_kernels() {
+    static const SpanKernels kernels = choose_span_kernels();
+    return kernels;
+}
+
 // Per-update working memory of one thread (grows once, then reused).
 struct Scratch {
-    std::vector<double> x, y, z;  // view-space control points, 4 per segment (structure of arrays)
-    std::vector<double> z_min, k;
+    std::vector<double> z_min, k;  // per segment: hull depth and off-axis factor (hull_depths())
     std::vector<unsigned char> outside;
     std::vector<uint32_t> old_counts;
 };
@@ -341,11 +515,31 @@ public:
 
     // Smallest factor by which any ratio decided so far may change before crossing a threshold (1 or the new
     // span threshold).
+    // Each ratio r contributes min(max(r, 1/r), max(r/s, s/r)) (s = new_scale_). max(r, 1/r) is r for r >= 1 and
+    // 1/r below, both monotone in r (a correctly rounded quotient is monotone in its operands), so its smallest
+    // value over the ratios is taken at the smallest r >= 1 or the largest r < 1; the same holds around s. The walk
+    // keeps those four ratios (compares, no division per node) and margin() evaluates them: the same value.
     void note(double r) const {
         if (!(r > 0.0) || !std::isfinite(r)) return;
-        margin_ = std::min({margin_, std::max(r, 1.0 / r), std::max(r / new_scale_, new_scale_ / r)});
+        if (r >= 1.0) {
+            above_one_ = std::min(above_one_, r);
+        } else {
+            below_one_ = std::max(below_one_, r);
+        }
+        if (r >= new_scale_) {
+            above_scale_ = std::min(above_scale_, r);
+        } else {
+            below_scale_ = std::max(below_scale_, r);
+        }
     }
-    [[nodiscard]] double margin() const { return margin_; }
+    [[nodiscard]] double margin() const {
+        double m = margin_;
+        for (const double r : {above_one_, below_one_, above_scale_, below_scale_}) {
+            if (!(r > 0.0) || !std::isfinite(r)) continue;  // no ratio on that side
+            m = std::min({m, std::max(r, 1.0 / r), std::max(r / new_scale_, new_scale_ / r)});
+        }
+        return m;
+    }
 
     [[nodiscard]] double counts_scale(std::size_t level, std::size_t j) const {
         return was_merged(first(level, j), last(level, j)) ? 1.0 : new_scale_;
@@ -423,6 +617,9 @@ private:
     ViewTransform tf_;
     double c_, k_, k_cap_;
     mutable double margin_ = std::numeric_limits<double>::infinity();
+    // The noted ratios nearest 1 and new_scale_ from either side (0 or infinity: none).
+    mutable double above_one_ = std::numeric_limits<double>::infinity(), below_one_ = 0.0;
+    mutable double above_scale_ = std::numeric_limits<double>::infinity(), below_scale_ = 0.0;
     std::ptrdiff_t fit_level_ = -1;
     std::size_t fail_level_ = std::numeric_limits<std::size_t>::max();
     bool closed_;
@@ -448,74 +645,38 @@ struct Limits {
 // transform and the depth/off-axis loops vectorize. Returns false if the wire is culled by the hull test.
 // Control points to view space (structure of arrays) and every segment's hull depth and off-axis factor, into
 // scratch(): x, y, z, z_min, k.
-void hull_depths(const Curve& curve, const LodView& view) {
+void hull_depths(const Curve& curve, const LodView& view, double radius_m) {
     const std::size_t n = curve.segment_count();
     Scratch& sc = scratch();
-    sc.x.resize(4 * n);
-    sc.y.resize(4 * n);
-    sc.z.resize(4 * n);
     sc.z_min.resize(n);
     sc.k.resize(n);
     sc.outside.resize(n);
-    // World -> view for every control point (the same arithmetic as ViewTransform: rotation * p +
-    // translation).
     const ViewTransform tf(view);
-    const glm::dmat3& m = tf.rotation;
-    const glm::dvec3 t = tf.translation;
-    double* xs = sc.x.data();
-    double* ys = sc.y.data();
-    double* zs = sc.z.data();
-    for (std::size_t i = 0; i < n; ++i) {
-        const CubicBezier& seg = curve.segments[i];
-        const glm::dvec3* pts[4] = {&seg.b0, &seg.b1, &seg.b2, &seg.b3};
-        for (std::size_t c = 0; c < 4; ++c) {
-            const glm::dvec3& q = *pts[c];
-            xs[4 * i + c] = (m[0][0] * q.x + m[1][0] * q.y + m[2][0] * q.z) + t.x;
-            ys[4 * i + c] = (m[0][1] * q.x + m[1][1] * q.y + m[2][1] * q.z) + t.y;
-            zs[4 * i + c] = -((m[0][2] * q.x + m[1][2] * q.y + m[2][2] * q.z) + t.z);
-        }
-    }
-    // Hull depth and off-axis factor per segment (hull_depth() without branches).
-    const double near = view.near_m, tx = view.tan_half_x, ty = view.tan_half_y;
-    double* zmin = sc.z_min.data();
-    double* ks = sc.k.data();
-    for (std::size_t i = 0; i < n; ++i) {
-        double z = std::numeric_limits<double>::infinity(), a = 0.0, b = 0.0;
-        for (std::size_t c = 0; c < 4; ++c) {
-            const double qz = zs[4 * i + c];
-            const double den = std::max(qz, near);
-            z = std::min(z, qz);
-            a = std::max(a, std::abs(xs[4 * i + c]) / den);
-            b = std::max(b, std::abs(ys[4 * i + c]) / den);
-        }
-        const bool in_front = z >= near;
-        a = in_front ? std::min(a, tx) : tx;
-        b = in_front ? std::min(b, ty) : ty;
-        zmin[i] = std::max(z, near);
-        ks[i] = std::sqrt(1.0 + a * a + b * b);
-    }
+    const PlaneTest planes(view, radius_m);
+    HullConstants h{};
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) h.m[3 * c + r] = tf.rotation[c][r];
+    for (int r = 0; r < 3; ++r) h.t[r] = tf.translation[r];
+    h.near = view.near_m;
+    h.far = view.far_m;
+    h.tx = view.tan_half_x;
+    h.ty = view.tan_half_y;
+    h.neg_rx = -planes.rx;
+    h.neg_ry = -planes.ry;
+    h.neg_r = -planes.r;
+    span_kernels().hull_depths(curve.segments.data(), n, h, sc.z_min.data(), sc.k.data(), sc.outside.data());
 }
 
 bool per_segment_required(const Curve& curve, const LodView& view, const LodSettings& settings,
                           const Limits& lim, const LodBounds* bounds, double radius, WireLod& lod,
                           double& wire_z, double& wire_k) {
     const std::size_t n = curve.segment_count();
-    hull_depths(curve, view);
+    hull_depths(curve, view, radius);
     Scratch& sc = scratch();
-    const double* xs = sc.x.data();
-    const double* ys = sc.y.data();
-    const double* zs = sc.z.data();
     const double* zmin = sc.z_min.data();
     const double* ks = sc.k.data();
-    const PlaneTest planes(view, radius);
     unsigned wire_outside = 63u;
-    for (std::size_t i = 0; i < n; ++i) {
-        unsigned o = 63u;
-        for (std::size_t c = 0; c < 4; ++c)
-            o &= planes.outside(glm::dvec3(xs[4 * i + c], ys[4 * i + c], zs[4 * i + c]));
-        sc.outside[i] = static_cast<unsigned char>(o);
-        wire_outside &= o;
-    }
+    for (std::size_t i = 0; i < n; ++i) wire_outside &= sc.outside[i];
     if (wire_outside != 0) return false;
 
     lod.required.resize(n);
@@ -761,7 +922,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
                 wire_k = sb.k;
                 conservative_sides = true;
             } else {
-                hull_depths(curve, view);  // the exact side count needs the segments' depths
+                hull_depths(curve, view, radius);  // the exact side count needs the segments' depths
                 const Scratch& d = scratch();
                 for (std::size_t i = 0; i < n; ++i) {
                     wire_z = std::min(wire_z, d.z_min[i]);
@@ -861,157 +1022,6 @@ BoundsScratch& bounds_scratch() {
     return s;
 }
 
-// std::min, std::max by value, as they compare (glm::min and glm::max too).
-inline double min_of(double x, double y) { return y < x ? y : x; }
-inline double max_of(double x, double y) { return x < y ? y : x; }
-
-// Lanes for the span hierarchy's kernels (lod_span_kernels.inl): the kernels are written once over a lane type,
-// L1 (one double: the scalar code), L2 (two doubles in an SSE2 register) or L4 (four in an AVX register, where
-// the CPU has AVX2), so every lane does exactly the scalar arithmetic (each operation the IEEE one, correctly
-// rounded, no fused multiply-add): results are bit-identical whichever runs. min_of / max_of / select keep the
-// scalar comparisons' operand order (minpd(a, b) is a < b ? a : b), so NaN and signed zeros come out as in the
-// scalar code. Besides arithmetic a lane type loads and stores `width` consecutive doubles, splits 2 width
-// consecutive ones into the even and the odd ones, and reads `width` consecutive segments' control points.
-struct L1 {
-    static constexpr std::size_t width = 1;
-    double v;
-    static L1 splat(double x) { return {x}; }
-    static L1 load(const double* p) { return {*p}; }
-    static L1 evens(const double* p) { return {p[0]}; }
-    static L1 odds(const double* p) { return {p[1]}; }
-    void store(double* p) const { *p = v; }
-    // x, y, z of the four control points of one segment per lane (p: lane 0's segment, 12 doubles a segment).
-    static void points(const double* p, L1 (&x)[4], L1 (&y)[4], L1 (&z)[4]) {
-        for (int k = 0; k < 4; ++k) x[k] = {p[3 * k]}, y[k] = {p[3 * k + 1]}, z[k] = {p[3 * k + 2]};
-    }
-};
-struct M1 {
-    bool v;
-};
-inline L1 operator+(L1 a, L1 b) { return {a.v + b.v}; }
-inline L1 operator-(L1 a, L1 b) { return {a.v - b.v}; }
-inline L1 operator*(L1 a, L1 b) { return {a.v * b.v}; }
-inline L1 operator/(L1 a, L1 b) { return {a.v / b.v}; }
-inline M1 operator<(L1 a, L1 b) { return {a.v < b.v}; }
-inline M1 operator<=(L1 a, L1 b) { return {a.v <= b.v}; }
-inline L1 sqrt_of(L1 a) { return {std::sqrt(a.v)}; }
-inline L1 abs_of(L1 a) { return {std::abs(a.v)}; }
-inline L1 min_of(L1 x, L1 y) { return {min_of(x.v, y.v)}; }
-inline L1 max_of(L1 x, L1 y) { return {max_of(x.v, y.v)}; }
-inline L1 select(M1 m, L1 a, L1 b) { return {m.v ? a.v : b.v}; }
-
-#if defined(__SSE2__)
-struct L2 {
-    static constexpr std::size_t width = 2;
-    __m128d v;
-    static L2 splat(double x) { return {_mm_set1_pd(x)}; }
-    static L2 load(const double* p) { return {_mm_loadu_pd(p)}; }
-    static L2 evens(const double* p) { return {_mm_unpacklo_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
-    static L2 odds(const double* p) { return {_mm_unpackhi_pd(_mm_loadu_pd(p), _mm_loadu_pd(p + 2))}; }
-    void store(double* p) const { _mm_storeu_pd(p, v); }
-    static void points(const double* p, L2 (&x)[4], L2 (&y)[4], L2 (&z)[4]) {
-        L2 c[12];
-        for (int k = 0; k < 12; k += 2) {
-            const __m128d a = _mm_loadu_pd(p + k), b = _mm_loadu_pd(p + 12 + k);
-            c[k] = {_mm_unpacklo_pd(a, b)};
-            c[k + 1] = {_mm_unpackhi_pd(a, b)};
-        }
-        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
-    }
-};
-struct M2 {
-    __m128d v;
-};
-inline L2 operator+(L2 a, L2 b) { return {_mm_add_pd(a.v, b.v)}; }
-inline L2 operator-(L2 a, L2 b) { return {_mm_sub_pd(a.v, b.v)}; }
-inline L2 operator*(L2 a, L2 b) { return {_mm_mul_pd(a.v, b.v)}; }
-inline L2 operator/(L2 a, L2 b) { return {_mm_div_pd(a.v, b.v)}; }
-inline M2 operator<(L2 a, L2 b) { return {_mm_cmplt_pd(a.v, b.v)}; }
-inline M2 operator<=(L2 a, L2 b) { return {_mm_cmple_pd(a.v, b.v)}; }
-inline L2 sqrt_of(L2 a) { return {_mm_sqrt_pd(a.v)}; }
-inline L2 abs_of(L2 a) { return {_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)}; }
-inline L2 min_of(L2 x, L2 y) { return {_mm_min_pd(y.v, x.v)}; }  // y < x ? y : x
-inline L2 max_of(L2 x, L2 y) { return {_mm_max_pd(y.v, x.v)}; }  // y > x ? y : x, i.e. x < y ? y : x
-inline L2 select(M2 m, L2 a, L2 b) { return {_mm_or_pd(_mm_and_pd(m.v, a.v), _mm_andnot_pd(m.v, b.v))}; }
-namespace span_sse2 {
-using W = L2;
-#include "lod_span_kernels.inl"
-}  // namespace span_sse2
-#else
-namespace span_sse2 {
-using W = L1;
-#include "lod_span_kernels.inl"
-}  // namespace span_sse2
-#endif
-
-#if defined(WIRE_LOD_AVX2)
-// The same kernels four lanes wide, compiled for AVX2 (no FMA: the arithmetic stays the scalar code's) and chosen
-// at run time where the CPU has it.
-#pragma GCC push_options
-#pragma GCC target("avx2")
-struct L4 {
-    static constexpr std::size_t width = 4;
-    __m256d v;
-    static L4 splat(double x) { return {_mm256_set1_pd(x)}; }
-    static L4 load(const double* p) { return {_mm256_loadu_pd(p)}; }
-    // unpacklo of p0..3 and p4..7 is p0 p4 p2 p6; lanes (0, 2, 1, 3) of it are p0 p2 p4 p6.
-    static L4 evens(const double* p) {
-        return {_mm256_permute4x64_pd(_mm256_unpacklo_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
-    }
-    static L4 odds(const double* p) {
-        return {_mm256_permute4x64_pd(_mm256_unpackhi_pd(_mm256_loadu_pd(p), _mm256_loadu_pd(p + 4)), 0xD8)};
-    }
-    void store(double* p) const { _mm256_storeu_pd(p, v); }
-    // Three 4 x 4 transposes: rows are the lanes' segments, columns 4 consecutive doubles of them.
-    static void points(const double* p, L4 (&x)[4], L4 (&y)[4], L4 (&z)[4]) {
-        L4 c[12];
-        for (int k = 0; k < 12; k += 4) {
-            const __m256d r0 = _mm256_loadu_pd(p + k), r1 = _mm256_loadu_pd(p + 12 + k);
-            const __m256d r2 = _mm256_loadu_pd(p + 24 + k), r3 = _mm256_loadu_pd(p + 36 + k);
-            const __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1);
-            const __m256d t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
-            c[k] = {_mm256_permute2f128_pd(t0, t2, 0x20)};
-            c[k + 1] = {_mm256_permute2f128_pd(t1, t3, 0x20)};
-            c[k + 2] = {_mm256_permute2f128_pd(t0, t2, 0x31)};
-            c[k + 3] = {_mm256_permute2f128_pd(t1, t3, 0x31)};
-        }
-        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
-    }
-};
-struct M4 {
-    __m256d v;
-};
-inline L4 operator+(L4 a, L4 b) { return {_mm256_add_pd(a.v, b.v)}; }
-inline L4 operator-(L4 a, L4 b) { return {_mm256_sub_pd(a.v, b.v)}; }
-inline L4 operator*(L4 a, L4 b) { return {_mm256_mul_pd(a.v, b.v)}; }
-inline L4 operator/(L4 a, L4 b) { return {_mm256_div_pd(a.v, b.v)}; }
-inline M4 operator<(L4 a, L4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_LT_OQ)}; }
-inline M4 operator<=(L4 a, L4 b) { return {_mm256_cmp_pd(a.v, b.v, _CMP_LE_OQ)}; }
-inline L4 sqrt_of(L4 a) { return {_mm256_sqrt_pd(a.v)}; }
-inline L4 abs_of(L4 a) { return {_mm256_andnot_pd(_mm256_set1_pd(-0.0), a.v)}; }
-inline L4 min_of(L4 x, L4 y) { return {_mm256_min_pd(y.v, x.v)}; }
-inline L4 max_of(L4 x, L4 y) { return {_mm256_max_pd(y.v, x.v)}; }
-inline L4 select(M4 m, L4 a, L4 b) { return {_mm256_blendv_pd(b.v, a.v, m.v)}; }
-namespace span_avx2 {
-using W = L4;
-#include "lod_span_kernels.inl"
-}  // namespace span_avx2
-#pragma GCC pop_options
-#endif
-
-// The span kernels for this CPU.
-struct SpanKernels {
-    void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*);
-    void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t);
-};
-SpanKernels span_kernels() {
-#if defined(WIRE_LOD_AVX2)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx2")) return {span_avx2::span_level0, span_avx2::span_merge_level};
-#endif
-    return {span_sse2::span_level0, span_sse2::span_merge_level};
-}
-
 // Smallest and largest of v[0..w) as std::min / std::max in sequence give them, for values that are never -0
 // (a deviation is a sum of square roots): four lanes, a NaN skipped as the sequence skips it.
 void deviation_range(const double* v, std::size_t w, double& lo_out, double& hi_out) {
@@ -1096,7 +1106,7 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
         sc.ends[0].resize(6 * n);
         sc.ends[1].resize(6 * n);
     }
-    static const SpanKernels kernels = span_kernels();
+    const SpanKernels& kernels = span_kernels();
     kernels.level0(curve.segments.data(), n, out.level_data(0), wang, sc.boxes.data(), sc.ends[0].data());
     {
         // The wire's box and the largest M (M is never -0: a root of a sum of squares).

@@ -141,3 +141,52 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
         for (int k = 0; k < 6; ++k) f[k * w + pairs] = e[k * cw + l];
     }
 }
+
+// Every segment's hull depth (nearest control point depth, clamped to near), off-axis factor k and plane mask
+// (bit i: all four control points farther than the radius outside plane i): hull_depth() and PlaneTest::outside()
+// W::width segments at a time, the same arithmetic per lane (world -> view as ViewTransform computes it).
+inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullConstants& h, double* z_min,
+                              double* k_out, unsigned char* outside) {
+    auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
+        L x[4], y[4], z[4];
+        L::points(&seg[i].b0.x, x, y, z);
+        const L near = L::splat(h.near), far = L::splat(h.far), tx = L::splat(h.tx), ty = L::splat(h.ty);
+        const L neg_rx = L::splat(h.neg_rx), neg_ry = L::splat(h.neg_ry), neg_r = L::splat(h.neg_r);
+        L zm = L::splat(std::numeric_limits<double>::infinity()), a = L::splat(0.0), b = L::splat(0.0);
+        decltype(zm < zm) out[6];
+        for (int c = 0; c < 4; ++c) {
+            const L qx = ((L::splat(h.m[0]) * x[c] + L::splat(h.m[3]) * y[c]) + L::splat(h.m[6]) * z[c]) +
+                         L::splat(h.t[0]);
+            const L qy = ((L::splat(h.m[1]) * x[c] + L::splat(h.m[4]) * y[c]) + L::splat(h.m[7]) * z[c]) +
+                         L::splat(h.t[1]);
+            const L qz = neg_of(((L::splat(h.m[2]) * x[c] + L::splat(h.m[5]) * y[c]) + L::splat(h.m[8]) * z[c]) +
+                                L::splat(h.t[2]));
+            const L den = max_of(qz, near);
+            zm = min_of(zm, qz);
+            a = max_of(a, abs_of(qx) / den);
+            b = max_of(b, abs_of(qy) / den);
+            const decltype(zm < zm) o[6] = {qx + qz * tx < neg_rx, qz * tx - qx < neg_rx, qy + qz * ty < neg_ry,
+                                            qz * ty - qy < neg_ry, qz - near < neg_r,    far - qz < neg_r};
+            for (int p = 0; p < 6; ++p) out[p] = c == 0 ? o[p] : out[p] & o[p];
+        }
+        const auto in_front = near <= zm;
+        a = select(in_front, min_of(a, tx), tx);
+        b = select(in_front, min_of(b, ty), ty);
+        max_of(zm, near).store(z_min + i);
+        sqrt_of((L::splat(1.0) + a * a) + b * b).store(k_out + i);
+        unsigned bits[6];
+        for (int p = 0; p < 6; ++p) bits[p] = out[p].bits();
+        for (std::size_t lane = 0; lane < L::width; ++lane) {
+            unsigned o = 0;
+            for (int p = 0; p < 6; ++p) o |= ((bits[p] >> lane) & 1u) << p;
+            outside[i + lane] = static_cast<unsigned char>(o);
+        }
+    };
+    std::size_t i = 0;
+    for (; i + W::width <= n; i += W::width) run(i, W{});
+#if defined(__SSE2__)
+    if constexpr (W::width > 2)
+        for (; i + 2 <= n; i += 2) run(i, L2{});
+#endif
+    for (; i < n; ++i) run(i, L1{});
+}
