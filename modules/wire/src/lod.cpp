@@ -424,14 +424,17 @@ struct SpanKernels {
     void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*);
     void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t);
     void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
+    void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
 };
 SpanKernels choose_span_kernels() {
 #if defined(WIRE_LOD_AVX2)
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx2"))
-        return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel};
+        return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel,
+                span_avx2::wang_roots};
 #endif
-    return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::hull_depth_kernel};
+    return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::hull_depth_kernel,
+            span_sse2::wang_roots};
 }
 const SpanKernels& span_kernels() {
     static const SpanKernels kernels = choose_span_kernels();
@@ -441,6 +444,7 @@ const SpanKernels& span_kernels() {
 // Per-update working memory of one thread (grows once, then reused).
 struct Scratch {
     std::vector<double> z_min, k;  // per segment: hull depth and off-axis factor (hull_depths())
+    std::vector<double> m, eps, root;  // per segment: Wang's M, world tolerance, Wang's root
     std::vector<unsigned char> outside;
     std::vector<uint32_t> old_counts;
 };
@@ -532,10 +536,23 @@ public:
             below_scale_ = std::max(below_scale_, r);
         }
     }
+    // A level-wide ratio (set_depth_range) contributes max(r, 1/r) alone: kept the same way.
+    void note_level(double r) {
+        if (!(r > 0.0) || !std::isfinite(r)) return;
+        if (r >= 1.0) {
+            level_above_one_ = std::min(level_above_one_, r);
+        } else {
+            level_below_one_ = std::max(level_below_one_, r);
+        }
+    }
     [[nodiscard]] double margin() const {
-        double m = margin_;
-        for (const double r : {above_one_, below_one_, above_scale_, below_scale_}) {
+        double m = std::numeric_limits<double>::infinity();
+        for (const double r : {level_above_one_, level_below_one_}) {
             if (!(r > 0.0) || !std::isfinite(r)) continue;  // no ratio on that side
+            m = std::min(m, std::max(r, 1.0 / r));
+        }
+        for (const double r : {above_one_, below_one_, above_scale_, below_scale_}) {
+            if (!(r > 0.0) || !std::isfinite(r)) continue;
             m = std::min({m, std::max(r, 1.0 / r), std::max(r / new_scale_, new_scale_ / r)});
         }
         return m;
@@ -559,10 +576,10 @@ public:
             if (!loop_limit && fit <= 1.0) {
                 fit_level_ = static_cast<std::ptrdiff_t>(l);
             }
-            if (!loop_limit && fit > 0.0 && std::isfinite(fit)) margin_ = std::min(margin_, std::max(fit, 1.0 / fit));
+            if (!loop_limit) note_level(fit);
             const double fail = b_.level_deviation_min(l) * c_ * k_ / zh;
             if (fail > 1.0 && fail_level_ == levels) fail_level_ = l;
-            if (fail > 0.0 && std::isfinite(fail)) margin_ = std::min(margin_, std::max(fail, 1.0 / fail));
+            note_level(fail);
         }
     }
 
@@ -616,7 +633,7 @@ private:
     const LodView& view_;
     ViewTransform tf_;
     double c_, k_, k_cap_;
-    mutable double margin_ = std::numeric_limits<double>::infinity();
+    double level_above_one_ = std::numeric_limits<double>::infinity(), level_below_one_ = 0.0;
     // The noted ratios nearest 1 and new_scale_ from either side (0 or infinity: none).
     mutable double above_one_ = std::numeric_limits<double>::infinity(), below_one_ = 0.0;
     mutable double above_scale_ = std::numeric_limits<double>::infinity(), below_scale_ = 0.0;
@@ -683,22 +700,31 @@ bool per_segment_required(const Curve& curve, const LodView& view, const LodSett
     wire_z = std::numeric_limits<double>::infinity();
     wire_k = 1.0;
     const double scale = lim.eps / view.focal_px;
+    // Wang's M of every segment (cached in the bounds), then every segment's world tolerance and root in a lane
+    // kernel (computed for all; used where the segment needs them).
+    const double* mm = nullptr;
+    if (bounds != nullptr) {
+        mm = &bounds->data[bounds->data.size() - bounds->segments];  // wang_m(0 .. n): segments == n here
+    } else {
+        sc.m.resize(n);
+        for (std::size_t i = 0; i < n; ++i)
+            sc.m[i] = std::max(glm::length(curve.segments[i].b0 - 2.0 * curve.segments[i].b1 + curve.segments[i].b2),
+                               glm::length(curve.segments[i].b1 - 2.0 * curve.segments[i].b2 + curve.segments[i].b3));
+        mm = sc.m.data();
+    }
+    sc.eps.resize(n);
+    sc.root.resize(n);
+    span_kernels().wang_roots(zmin, ks, mm, n, scale, sc.eps.data(), sc.root.data());
     for (std::size_t i = 0; i < n; ++i) {
         const bool seg_visible = sc.outside[i] == 0;
         uint32_t raw = 1;
         if (seg_visible || !settings.coarse_offscreen_segments) {
-            const double eps_world = scale * zmin[i] / ks[i];
-            const double mm = bounds != nullptr
-                                  ? bounds->wang_m(i)
-                                  : std::max(glm::length(curve.segments[i].b0 - 2.0 * curve.segments[i].b1 +
-                                                         curve.segments[i].b2),
-                                             glm::length(curve.segments[i].b1 - 2.0 * curve.segments[i].b2 +
-                                                         curve.segments[i].b3));
+            const double eps_world = sc.eps[i];  // scale * zmin[i] / ks[i]
             // wang_ring_count() on the cached M.
-            if (!(eps_world > 0.0) || !std::isfinite(mm)) {
+            if (!(eps_world > 0.0) || !std::isfinite(mm[i])) {
                 raw = lim.max_rings;
             } else {
-                const double c = std::ceil(std::sqrt(3.0 * mm / (4.0 * eps_world)));
+                const double c = std::ceil(sc.root[i]);  // sqrt(3 M / (4 eps_world))
                 raw = !(c < static_cast<double>(lim.max_rings))
                           ? lim.max_rings
                           : std::max<uint32_t>(1, static_cast<uint32_t>(c));

@@ -190,3 +190,21 @@ inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullC
 #endif
     for (; i < n; ++i) run(i, L1{});
 }
+
+// Per segment: the world tolerance at its hull depth, eps = scale z_min / k, and Wang's root sqrt(3 M / (4 eps))
+// (wang_ring_count()'s arithmetic), W::width segments at a time.
+inline void wang_roots(const double* z_min, const double* k, const double* m, std::size_t n, double scale,
+                       double* eps_out, double* root_out) {
+    auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
+        const L eps = (L::splat(scale) * L::load(z_min + i)) / L::load(k + i);
+        eps.store(eps_out + i);
+        sqrt_of((L::splat(3.0) * L::load(m + i)) / (L::splat(4.0) * eps)).store(root_out + i);
+    };
+    std::size_t i = 0;
+    for (; i + W::width <= n; i += W::width) run(i, W{});
+#if defined(__SSE2__)
+    if constexpr (W::width > 2)
+        for (; i + 2 <= n; i += 2) run(i, L2{});
+#endif
+    for (; i < n; ++i) run(i, L1{});
+}
