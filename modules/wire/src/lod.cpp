@@ -272,6 +272,16 @@ struct HullConstants {
     double neg_rx, neg_ry, neg_r;
 };
 
+// What the span walk's ratio kernel needs (SpanMerger::ratio() for a whole level): the view transform as above,
+// the tolerance factor c = focal / eps, the off-axis bounds (k of the wire's sphere, the screen-edge cap), the
+// frustum and the inflation of a span's sphere by the tube radius.
+struct RatioConstants {
+    double m[9], t[3];
+    double c, k, k_cap;
+    double near, far, tx, ty, sx, sy, radius;
+    bool inside, coarse_offscreen;
+};
+
 // std::min, std::max by value, as they compare (glm::min and glm::max too).
 inline double min_of(double x, double y) { return y < x ? y : x; }
 inline double max_of(double x, double y) { return x < y ? y : x; }
@@ -301,6 +311,7 @@ struct M1 {
     [[nodiscard]] unsigned bits() const { return v ? 1u : 0u; }  // bit k: lane k
 };
 inline M1 operator&(M1 a, M1 b) { return {a.v && b.v}; }
+inline M1 operator|(M1 a, M1 b) { return {a.v || b.v}; }
 inline L1 neg_of(L1 a) { return {-a.v}; }
 inline L1 operator+(L1 a, L1 b) { return {a.v + b.v}; }
 inline L1 operator-(L1 a, L1 b) { return {a.v - b.v}; }
@@ -338,6 +349,7 @@ struct M2 {
     [[nodiscard]] unsigned bits() const { return static_cast<unsigned>(_mm_movemask_pd(v)); }
 };
 inline M2 operator&(M2 a, M2 b) { return {_mm_and_pd(a.v, b.v)}; }
+inline M2 operator|(M2 a, M2 b) { return {_mm_or_pd(a.v, b.v)}; }
 inline L2 neg_of(L2 a) { return {_mm_xor_pd(_mm_set1_pd(-0.0), a.v)}; }
 inline L2 operator+(L2 a, L2 b) { return {_mm_add_pd(a.v, b.v)}; }
 inline L2 operator-(L2 a, L2 b) { return {_mm_sub_pd(a.v, b.v)}; }
@@ -400,6 +412,7 @@ struct M4 {
     [[nodiscard]] unsigned bits() const { return static_cast<unsigned>(_mm256_movemask_pd(v)); }
 };
 inline M4 operator&(M4 a, M4 b) { return {_mm256_and_pd(a.v, b.v)}; }
+inline M4 operator|(M4 a, M4 b) { return {_mm256_or_pd(a.v, b.v)}; }
 inline L4 neg_of(L4 a) { return {_mm256_xor_pd(_mm256_set1_pd(-0.0), a.v)}; }
 inline L4 operator+(L4 a, L4 b) { return {_mm256_add_pd(a.v, b.v)}; }
 inline L4 operator-(L4 a, L4 b) { return {_mm256_sub_pd(a.v, b.v)}; }
@@ -425,16 +438,17 @@ struct SpanKernels {
     void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t);
     void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
     void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
+    void (*ratios)(const double*, std::size_t, const RatioConstants&, double*);
 };
 SpanKernels choose_span_kernels() {
 #if defined(WIRE_LOD_AVX2)
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx2"))
         return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel,
-                span_avx2::wang_roots};
+                span_avx2::wang_roots, span_avx2::span_ratios};
 #endif
     return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::hull_depth_kernel,
-            span_sse2::wang_roots};
+            span_sse2::wang_roots, span_sse2::span_ratios};
 }
 const SpanKernels& span_kernels() {
     static const SpanKernels kernels = choose_span_kernels();
@@ -445,6 +459,7 @@ const SpanKernels& span_kernels() {
 struct Scratch {
     std::vector<double> z_min, k;  // per segment: hull depth and off-axis factor (hull_depths())
     std::vector<double> m, eps, root;  // per segment: Wang's M, world tolerance, Wang's root
+    std::vector<double> ratios;        // per hierarchy node: SpanMerger's ratios
     std::vector<unsigned char> outside;
     std::vector<uint32_t> old_counts;
 };
@@ -477,6 +492,37 @@ public:
           old_(old),
           sx_(std::sqrt(1.0 + view.tan_half_x * view.tan_half_x)),
           sy_(std::sqrt(1.0 + view.tan_half_y * view.tan_half_y)) {}
+
+    // ratio() of every node of a level at once (a lane kernel), computed when the walk first needs the level.
+    [[nodiscard]] double level_ratio(std::size_t level, std::size_t j) const {
+        if (((ready_ >> level) & 1u) == 0) {
+            if (ratios_.size() < b_.data.size()) ratios_.resize(b_.data.size());
+            RatioConstants rc{};
+            for (int c = 0; c < 3; ++c)
+                for (int r = 0; r < 3; ++r) rc.m[3 * c + r] = tf_.rotation[c][r];
+            for (int r = 0; r < 3; ++r) rc.t[r] = tf_.translation[r];
+            rc.c = c_;
+            rc.k = k_;
+            rc.k_cap = k_cap_;
+            rc.near = view_.near_m;
+            rc.far = view_.far_m;
+            rc.tx = view_.tan_half_x;
+            rc.ty = view_.tan_half_y;
+            rc.sx = sx_;
+            rc.sy = sy_;
+            rc.radius = b_.radius_max_m;
+            rc.inside = inside_;
+            rc.coarse_offscreen = coarse_offscreen_;
+            span_kernels().ratios(b_.level_data(level), b_.level_width(level), rc,
+                                  ratios_.data() + b_.level_start[level]);
+            ready_ |= uint64_t{1} << level;
+        }
+        const std::size_t s = first(level, j), e = last(level, j);
+        if (e - s > 1 && closed_ && 3 * (e - s) > b_.segments) {
+            return std::numeric_limits<double>::infinity();  // a loop keeps >= 3 intervals
+        }
+        return ratios_[b_.level_start[level] + j];
+    }
 
     [[nodiscard]] std::size_t root_level() const { return b_.levels - 1; }
     [[nodiscard]] std::size_t first(std::size_t level, std::size_t j) const { return j << level; }
@@ -611,7 +657,7 @@ private:
         if (level >= fail_level_) {
             r = std::numeric_limits<double>::infinity();
         } else if (static_cast<std::ptrdiff_t>(level) > fit_level_) {
-            r = ratio(level, j);
+            r = level_ratio(level, j);
             note(r);
         }
         if (!required_done && r <= 1.0) {
@@ -634,6 +680,8 @@ private:
     ViewTransform tf_;
     double c_, k_, k_cap_;
     double level_above_one_ = std::numeric_limits<double>::infinity(), level_below_one_ = 0.0;
+    mutable uint64_t ready_ = 0;  // bit l: the ratios of level l are in ratios_
+    std::vector<double>& ratios_ = scratch().ratios;  // per node, at level_start (root level first)
     // The noted ratios nearest 1 and new_scale_ from either side (0 or infinity: none).
     mutable double above_one_ = std::numeric_limits<double>::infinity(), below_one_ = 0.0;
     mutable double above_scale_ = std::numeric_limits<double>::infinity(), below_scale_ = 0.0;

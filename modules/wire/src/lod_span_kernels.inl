@@ -208,3 +208,45 @@ inline void wang_roots(const double* z_min, const double* k, const double* m, st
 #endif
     for (; i < n; ++i) run(i, L1{});
 }
+
+// SpanMerger::ratio() (without the loop limit, which the caller applies) of the w nodes of one level (`node`: its
+// five arrays), W::width nodes at a time: deviation * c * k / max(z_lo, near) with z_lo the nearest depth of the
+// node's sphere; where the wire's sphere is not inside the frustum, k is bounded over the node's own sphere
+// (uncapped; the cap where the sphere reaches the near plane) and a node whose sphere, inflated by the tube
+// radius, is outside a plane gets 0 (with coarse off-screen spans).
+inline void span_ratios(const double* node, std::size_t w, const RatioConstants& h, double* out) {
+    auto run = [&]<class L>(std::size_t j, L) __attribute__((always_inline)) {
+        const L px = L::load(node + j), py = L::load(node + w + j), pz = L::load(node + 2 * w + j);
+        const L r = L::load(node + 3 * w + j), dev = L::load(node + 4 * w + j);
+        const L near = L::splat(h.near);
+        const L z = neg_of(((L::splat(h.m[2]) * px + L::splat(h.m[5]) * py) + L::splat(h.m[8]) * pz) +
+                           L::splat(h.t[2]));
+        const L zr = z - r;
+        if (h.inside) {
+            ((dev * L::splat(h.c)) * L::splat(h.k) / max_of(zr, near)).store(out + j);
+            return;
+        }
+        const L qx = ((L::splat(h.m[0]) * px + L::splat(h.m[3]) * py) + L::splat(h.m[6]) * pz) + L::splat(h.t[0]);
+        const L qy = ((L::splat(h.m[1]) * px + L::splat(h.m[4]) * py) + L::splat(h.m[7]) * pz) + L::splat(h.t[1]);
+        const L one = L::splat(1.0);
+        const L a = (abs_of(qx) + r) / zr, b = (abs_of(qy) + r) / zr;
+        const L k = select(near <= zr, sqrt_of((one + a * a) + b * b), L::splat(h.k_cap));
+        L ratio = (dev * L::splat(h.c)) * k / max_of(zr, near);
+        if (h.coarse_offscreen) {
+            const L ri = r + L::splat(h.radius);
+            const L neg_ri = neg_of(ri), tx = L::splat(h.tx), ty = L::splat(h.ty);
+            const L rx = neg_ri * L::splat(h.sx), ry = neg_ri * L::splat(h.sy);
+            const auto out_of_view = (((qx + z * tx < rx) | (z * tx - qx < rx)) | ((qy + z * ty < ry) | (z * ty - qy < ry))) |
+                                     ((z - near < neg_ri) | (L::splat(h.far) - z < neg_ri));
+            ratio = select(out_of_view, L::splat(0.0), ratio);
+        }
+        ratio.store(out + j);
+    };
+    std::size_t j = 0;
+    for (; j + W::width <= w; j += W::width) run(j, W{});
+#if defined(__SSE2__)
+    if constexpr (W::width > 2)
+        for (; j + 2 <= w; j += 2) run(j, L2{});
+#endif
+    for (; j < w; ++j) run(j, L1{});
+}
