@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <numbers>
 
@@ -432,6 +434,66 @@ using W = L4;
 #pragma GCC pop_options
 #endif
 
+#if defined(WIRE_LOD_AVX2)
+// Eight lanes (AVX-512F), where the CPU has it; the same kernels again.
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+#pragma GCC diagnostic push
+// GCC 12 warns about the intrinsics' own _mm512_undefined_pd() pass-through operands (a known false positive).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+struct L8 {
+    static constexpr std::size_t width = 8;
+    __m512d v;
+    static L8 splat(double x) { return {_mm512_set1_pd(x)}; }
+    static L8 load(const double* p) { return {_mm512_loadu_pd(p)}; }
+    static L8 evens(const double* p) {
+        const __m512i idx = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0);
+        return {_mm512_permutex2var_pd(_mm512_loadu_pd(p), idx, _mm512_loadu_pd(p + 8))};
+    }
+    static L8 odds(const double* p) {
+        const __m512i idx = _mm512_set_epi64(15, 13, 11, 9, 7, 5, 3, 1);
+        return {_mm512_permutex2var_pd(_mm512_loadu_pd(p), idx, _mm512_loadu_pd(p + 8))};
+    }
+    void store(double* p) const { _mm512_storeu_pd(p, v); }
+    // Two groups of four segments, each by L4's transposes (AVX-512F includes AVX2's shuffles).
+    static void points(const double* p, L8 (&x)[4], L8 (&y)[4], L8 (&z)[4]) {
+        L4 x0[4], y0[4], z0[4], x1[4], y1[4], z1[4];
+        L4::points(p, x0, y0, z0);
+        L4::points(p + 48, x1, y1, z1);
+        auto join = [](L4 a, L4 b) { return L8{_mm512_insertf64x4(_mm512_castpd256_pd512(a.v), b.v, 1)}; };
+        for (int k = 0; k < 4; ++k) x[k] = join(x0[k], x1[k]), y[k] = join(y0[k], y1[k]), z[k] = join(z0[k], z1[k]);
+    }
+};
+struct M8 {
+    __mmask8 v;
+    [[nodiscard]] unsigned bits() const { return v; }
+};
+inline M8 operator&(M8 a, M8 b) { return {static_cast<__mmask8>(a.v & b.v)}; }
+inline M8 operator|(M8 a, M8 b) { return {static_cast<__mmask8>(a.v | b.v)}; }
+inline L8 operator+(L8 a, L8 b) { return {_mm512_add_pd(a.v, b.v)}; }
+inline L8 operator-(L8 a, L8 b) { return {_mm512_sub_pd(a.v, b.v)}; }
+inline L8 operator*(L8 a, L8 b) { return {_mm512_mul_pd(a.v, b.v)}; }
+inline L8 operator/(L8 a, L8 b) { return {_mm512_div_pd(a.v, b.v)}; }
+inline M8 operator<(L8 a, L8 b) { return {_mm512_cmp_pd_mask(a.v, b.v, _CMP_LT_OQ)}; }
+inline M8 operator<=(L8 a, L8 b) { return {_mm512_cmp_pd_mask(a.v, b.v, _CMP_LE_OQ)}; }
+inline L8 sqrt_of(L8 a) { return {_mm512_sqrt_pd(a.v)}; }
+inline L8 abs_of(L8 a) { return {_mm512_abs_pd(a.v)}; }
+inline L8 neg_of(L8 a) {
+    return {_mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(a.v), _mm512_set1_epi64(INT64_MIN)))};
+}
+inline L8 min_of(L8 x, L8 y) { return {_mm512_min_pd(y.v, x.v)}; }
+inline L8 max_of(L8 x, L8 y) { return {_mm512_max_pd(y.v, x.v)}; }
+inline L8 select(M8 m, L8 a, L8 b) { return {_mm512_mask_blend_pd(m.v, b.v, a.v)}; }
+namespace span_avx512 {
+using W = L8;
+#define WIRE_LOD_TAIL4 1
+#include "lod_span_kernels.inl"
+#undef WIRE_LOD_TAIL4
+}  // namespace span_avx512
+#pragma GCC diagnostic pop
+#pragma GCC pop_options
+#endif
+
 // The span kernels for this CPU.
 struct SpanKernels {
     void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*);
@@ -443,6 +505,9 @@ struct SpanKernels {
 SpanKernels choose_span_kernels() {
 #if defined(WIRE_LOD_AVX2)
     __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f") && std::getenv("WIRE_LOD_NO_AVX512") == nullptr)
+        return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::hull_depth_kernel,
+                span_avx512::wang_roots, span_avx512::span_ratios};
     if (__builtin_cpu_supports("avx2"))
         return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel,
                 span_avx2::wang_roots, span_avx2::span_ratios};
@@ -570,17 +635,12 @@ public:
     // value over the ratios is taken at the smallest r >= 1 or the largest r < 1; the same holds around s. The walk
     // keeps those four ratios (compares, no division per node) and margin() evaluates them: the same value.
     void note(double r) const {
-        if (!(r > 0.0) || !std::isfinite(r)) return;
-        if (r >= 1.0) {
-            above_one_ = std::min(above_one_, r);
-        } else {
-            below_one_ = std::max(below_one_, r);
-        }
-        if (r >= new_scale_) {
-            above_scale_ = std::min(above_scale_, r);
-        } else {
-            below_scale_ = std::max(below_scale_, r);
-        }
+        // Branch-free (the sides of 1 and s alternate unpredictably along the walk): std::min / std::max as selects.
+        const bool ok = r > 0.0 && r <= std::numeric_limits<double>::max();  // positive and finite
+        above_one_ = ok && r >= 1.0 && r < above_one_ ? r : above_one_;
+        below_one_ = ok && r < 1.0 && below_one_ < r ? r : below_one_;
+        above_scale_ = ok && r >= new_scale_ && r < above_scale_ ? r : above_scale_;
+        below_scale_ = ok && r < new_scale_ && below_scale_ < r ? r : below_scale_;
     }
     // A level-wide ratio (set_depth_range) contributes max(r, 1/r) alone: kept the same way.
     void note_level(double r) {

@@ -1,5 +1,6 @@
 // The span hierarchy's kernels (compute_lod_bounds), included by lod.cpp once per lane width: W is the wide lane
-// type (L1, L2 or L4 of lod.cpp), L1 does the tail. Not a header: no include guard, no namespace of its own.
+// type (L1, L2, L4 or L8 of lod.cpp); narrower lanes do the tail (L4 where WIRE_LOD_TAIL4 is defined, L2, L1). Not
+// a header: no include guard, no namespace of its own.
 
 // Level 0 of the span hierarchy for one segment per lane: x, y, z of its four control points in; Wang's M, the
 // box (lo, hi), the sphere (centre c, radius r) and the deviation out. A larger of two lengths is the root of the
@@ -97,6 +98,9 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
     };
     std::size_t i = 0;
     for (; i + W::width <= n; i += W::width) run(i, W{});
+#if defined(WIRE_LOD_TAIL4)
+    for (; i + 4 <= n; i += 4) run(i, L4{});
+#endif
 #if defined(__SSE2__)
     if constexpr (W::width > 2)
         for (; i + 2 <= n; i += 2) run(i, L2{});
@@ -130,6 +134,9 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
     };
     std::size_t j = 0;
     for (; j + W::width <= pairs; j += W::width) run(j, W{});
+#if defined(WIRE_LOD_TAIL4)
+    for (; j + 4 <= pairs; j += 4) run(j, L4{});
+#endif
 #if defined(__SSE2__)
     if constexpr (W::width > 2)
         for (; j + 2 <= pairs; j += 2) run(j, L2{});
@@ -184,6 +191,9 @@ inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullC
     };
     std::size_t i = 0;
     for (; i + W::width <= n; i += W::width) run(i, W{});
+#if defined(WIRE_LOD_TAIL4)
+    for (; i + 4 <= n; i += 4) run(i, L4{});
+#endif
 #if defined(__SSE2__)
     if constexpr (W::width > 2)
         for (; i + 2 <= n; i += 2) run(i, L2{});
@@ -202,6 +212,9 @@ inline void wang_roots(const double* z_min, const double* k, const double* m, st
     };
     std::size_t i = 0;
     for (; i + W::width <= n; i += W::width) run(i, W{});
+#if defined(WIRE_LOD_TAIL4)
+    for (; i + 4 <= n; i += 4) run(i, L4{});
+#endif
 #if defined(__SSE2__)
     if constexpr (W::width > 2)
         for (; i + 2 <= n; i += 2) run(i, L2{});
@@ -244,6 +257,9 @@ inline void span_ratios(const double* node, std::size_t w, const RatioConstants&
     };
     std::size_t j = 0;
     for (; j + W::width <= w; j += W::width) run(j, W{});
+#if defined(WIRE_LOD_TAIL4)
+    for (; j + 4 <= w; j += 4) run(j, L4{});
+#endif
 #if defined(__SSE2__)
     if constexpr (W::width > 2)
         for (; j + 2 <= w; j += 2) run(j, L2{});
