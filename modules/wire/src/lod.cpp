@@ -502,13 +502,17 @@ struct SpanKernels {
     void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
     void (*ratios)(const double*, std::size_t, const RatioConstants&, double*);
 };
+// The widest the CPU has; WIRE_LOD_LANES=2 or 4 in the environment caps the width (to compare the paths: every
+// width gives the same bits).
 SpanKernels choose_span_kernels() {
 #if defined(WIRE_LOD_AVX2)
+    const char* cap = std::getenv("WIRE_LOD_LANES");
+    const int lanes = cap != nullptr ? std::atoi(cap) : 8;
     __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && std::getenv("WIRE_LOD_NO_AVX512") == nullptr)
+    if (lanes >= 8 && __builtin_cpu_supports("avx512f"))
         return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::hull_depth_kernel,
                 span_avx512::wang_roots, span_avx512::span_ratios};
-    if (__builtin_cpu_supports("avx2"))
+    if (lanes >= 4 && __builtin_cpu_supports("avx2"))
         return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel,
                 span_avx2::wang_roots, span_avx2::span_ratios};
 #endif
