@@ -1209,14 +1209,29 @@ double ordered_max(const double* v, std::size_t n) {
     return ordered_extreme<true>(v, n, -std::numeric_limits<double>::infinity());
 }
 
+// std::max(0.0, r) over the radii in sequence (curve_bounding_sphere()'s radius): four lanes, in sequence when
+// the result is a zero.
+double largest_radius(const std::vector<float>& radii) {
+    const std::size_t n = radii.size();
+    double acc[4] = {0.0, 0.0, 0.0, 0.0};
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (int k = 0; k < 4; ++k) acc[k] = max_of(acc[k], static_cast<double>(radii[i + k]));
+    for (; i < n; ++i) acc[0] = max_of(acc[0], static_cast<double>(radii[i]));
+    const double r = max_of(max_of(acc[0], acc[1]), max_of(acc[2], acc[3]));
+    if (r != 0.0) return r;
+    double seq = 0.0;
+    for (const float x : radii) seq = std::max(seq, static_cast<double>(x));
+    return seq;
+}
+
 }  // namespace
 
 void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     const std::size_t n = curve.segment_count();
     out.segments = n;
     out.sphere = BoundingSphere{};  // curve_bounding_sphere(curve), from the level-0 boxes below
-    out.radius_max_m = 0.0;
-    for (const float r : curve.radius_m) out.radius_max_m = std::max(out.radius_max_m, static_cast<double>(r));
+    out.radius_max_m = largest_radius(curve.radius_m);
     out.wang_m_max = 0.0;
     out.levels = 0;
     static std::atomic<uint64_t> versions{0};  // unique over all curves: a state made for other bounds never matches
