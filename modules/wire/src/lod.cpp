@@ -1234,8 +1234,16 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     out.radius_max_m = largest_radius(curve.radius_m);
     out.wang_m_max = 0.0;
     out.levels = 0;
-    static std::atomic<uint64_t> versions{0};  // unique over all curves: a state made for other bounds never matches
-    out.version = versions.fetch_add(1, std::memory_order_relaxed) + 1;
+    // Unique over all curves (a state made for other bounds never matches): each thread takes blocks of 2^16
+    // versions from one counter, so threads do not contend for it on every wire.
+    static std::atomic<uint64_t> version_blocks{0};
+    thread_local uint64_t next_version = 0, block_end = 0;
+    if (next_version == block_end) {
+        const uint64_t block = version_blocks.fetch_add(1, std::memory_order_relaxed);
+        next_version = (block << 16) + 1;  // never 0
+        block_end = (block + 1) << 16;
+    }
+    out.version = next_version++;
     if (n == 0) {
         out.data.clear();
         return;
