@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -88,6 +89,16 @@ Status check_settings(const SplineSettings& s) {
 
 Status check_nodes(const WireNodes& w, bool use_physics) {
     static const char* const kAxis[3] = {"x", "y", "z"};
+    // The common case in one branch-free pass: positions only, every coordinate finite and in range (NaN and
+    // Inf fail the comparison). Anything else, or a bad value, takes the per-node checks and their messages.
+    if (!w.positions.empty() && w.stretch.empty() && w.radius_m.empty() && w.kb_tension.empty() &&
+        w.kb_bias.empty() && w.kb_continuity.empty() && !use_physics) {
+        const double* v = &w.positions[0].x;  // 3 coordinates a node, contiguous
+        const std::size_t count = 3 * w.positions.size();
+        std::int64_t in_range = 0;
+        for (std::size_t i = 0; i < count; ++i) in_range += std::abs(v[i]) <= kMaxCoordinate_m;
+        if (in_range == static_cast<std::int64_t>(count)) return Status::success();
+    }
     for (std::size_t i = 0; i < w.positions.size(); ++i) {
         for (int a = 0; a < 3; ++a) {
             const double v = w.positions[i][a];
@@ -125,6 +136,27 @@ Status check_nodes(const WireNodes& w, bool use_physics) {
     return Status::success();
 }
 
+// The curve stage's per-node and per-segment passes work on structure-of-arrays scratch (x, y, z arrays, per
+// thread, reused across calls) with branch-free bodies, so the compiler vectorizes them across nodes; the rare
+// special nodes (a merge, a tensed node, a bad value) are flagged and handled by a scalar pass. Every value is
+// computed by the same operations in the same order as the scalar form (vectorizing across independent nodes
+// changes no rounding), so the output is bit-identical to it.
+
+// Per-thread pool of double arrays: carve(k) hands out the next k doubles (valid until the next reset).
+struct Pool {
+    std::vector<double> buf;
+    std::size_t used = 0;
+    void reset(std::size_t total) {
+        if (buf.size() < total) buf.resize(total);
+        used = 0;
+    }
+    double* carve(std::size_t k) {
+        double* p = buf.data() + used;
+        used += k;
+        return p;
+    }
+};
+
 // Merged nodes: the first input node of each group is kept; `last` is the group's last input node, whose
 // element is the one that leaves the group (its stretch belongs to the outgoing segment).
 struct Merged {
@@ -132,7 +164,65 @@ struct Merged {
     std::vector<uint32_t> first, last;
 };
 
-void merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m) {
+// Segment chords, structure of arrays. Segment k is at index k + 1; index 0 repeats the last segment and index
+// segs + 1 the first (wrap-around ghosts, so per-node passes read a node's incoming chord at i and outgoing at
+// i + 1 without index arithmetic; on open wires the ghosts only feed end values that are overwritten).
+struct Chords {
+    std::vector<double> dx, dy, dz;  // chords
+    std::vector<double> len;         // their lengths (> merge epsilon)
+    std::vector<double> ex, ey, ez;  // unit directions d / len (computed once; every kind that needs them reads these)
+    std::size_t segs = 0;
+    dvec3 d(std::size_t k) const { return {dx[k + 1], dy[k + 1], dz[k + 1]}; }
+    dvec3 e(std::size_t k) const { return {ex[k + 1], ey[k + 1], ez[k + 1]}; }
+    double l(std::size_t k) const { return len[k + 1]; }
+};
+
+// Kernels: the vectorized loops, one function each, so that `__restrict` on their parameters tells the compiler
+// the arrays do not overlap (it does not trust that of local pointers into one buffer). Kernels with selects are
+// compiled without trapping math: GCC turns their `?:` into vector blends only then. That changes no value (every
+// operation is still performed and rounded as written; NaN comparisons keep their meaning), only whether an
+// operation whose result is discarded may raise a floating-point exception flag, which nothing here reads.
+#if defined(__GNUC__) && !defined(__clang__)
+#define WIRE_SELECT_KERNEL __attribute__((optimize("no-trapping-math")))
+#else
+#define WIRE_SELECT_KERNEL
+#endif
+
+// Chords k = 0 .. count-1 from node coordinates a (3 per node, node k at 3k) to b (node k + 1's at 3k).
+void chords_kernel(std::size_t count, const double* __restrict a, const double* __restrict b, double* __restrict dx,
+                   double* __restrict dy, double* __restrict dz, double* __restrict len, double* __restrict ex,
+                   double* __restrict ey, double* __restrict ez) {
+    for (std::size_t k = 0; k < count; ++k) {
+        // Differences of nearby doubles: exact, whatever the offset. Length as glm::length: (x*x + y*y) + z*z.
+        const double x = b[3 * k] - a[3 * k], y = b[3 * k + 1] - a[3 * k + 1], z = b[3 * k + 2] - a[3 * k + 2];
+        const double l = std::sqrt(x * x + y * y + z * z);
+        const double inv = 1.0 / l;
+        dx[k] = x, dy[k] = y, dz[k] = z, len[k] = l;
+        ex[k] = x * inv, ey[k] = y * inv, ez[k] = z * inv;
+    }
+}
+
+// Chords of the nodes P[0..n) (n >= 2; closed: the closing chord P[0] - P[n-1] too), lengths and unit directions.
+void fill_chords(const dvec3* P, std::size_t n, bool closed, Chords& ch) {
+    const std::size_t segs = closed ? n : n - 1;
+    ch.segs = segs;
+    for (std::vector<double>* v : {&ch.dx, &ch.dy, &ch.dz, &ch.len, &ch.ex, &ch.ey, &ch.ez}) v->resize(segs + 2);
+    const auto chords = [&](std::size_t k0, std::size_t count, const dvec3* a, const dvec3* b) {
+        chords_kernel(count, &a->x, &b->x, ch.dx.data() + 1 + k0, ch.dy.data() + 1 + k0, ch.dz.data() + 1 + k0,
+                      ch.len.data() + 1 + k0, ch.ex.data() + 1 + k0, ch.ey.data() + 1 + k0, ch.ez.data() + 1 + k0);
+    };
+    chords(0, n - 1, P, P + 1);
+    if (closed) chords(n - 1, 1, P + (n - 1), P);
+    for (std::vector<double>* v : {&ch.dx, &ch.dy, &ch.dz, &ch.len, &ch.ex, &ch.ey, &ch.ez}) {
+        (*v)[0] = (*v)[segs];
+        (*v)[segs + 1] = (*v)[1];
+    }
+}
+
+// Coincident-node merging. Returns the curve's nodes: the input positions themselves when nothing merges (the
+// common case: decided from the input's chords, which are then the curve's), else m.p. `ch` holds the chords of
+// the returned nodes when there are at least 2 of them (3 closed).
+const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m, Chords& ch, std::size_t& count) {
     const std::size_t n = w.positions.size();
     dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
     for (const dvec3& p : w.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
@@ -140,6 +230,20 @@ void merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m) {
     const double max_abs = n ? std::max(glm::length(lo), glm::length(hi)) : 0.0;
     const double rel = s.merge_epsilon_rel > 0.0 ? s.merge_epsilon_rel : 1e-9;
     const double eps = std::max(rel * diag, 64.0 * DBL_EPSILON * max_abs);
+    if (n >= 3) {
+        // The chords of consecutive input nodes are the distances the merge tests (the closing one too: the
+        // length of a negated difference is the same number); nothing merges when all exceed eps.
+        fill_chords(w.positions.data(), n, s.closed, ch);
+        const double* len = ch.len.data() + 1;
+        std::int64_t apart = 0;
+        for (std::size_t k = 0; k < ch.segs; ++k) apart += len[k] > eps;
+        if (apart == static_cast<std::int64_t>(ch.segs)) {
+            m.first.resize(n), m.last.resize(n);
+            for (std::size_t i = 0; i < n; ++i) m.first[i] = m.last[i] = static_cast<uint32_t>(i);
+            count = n;
+            return w.positions.data();
+        }
+    }
     m.p.clear(), m.first.clear(), m.last.clear();
     for (std::size_t i = 0; i < n; ++i) {
         if (!m.p.empty() && glm::length(w.positions[i] - m.p.back()) <= eps) {
@@ -153,88 +257,106 @@ void merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m) {
     if (s.closed && m.p.size() >= 2 && glm::length(m.p.back() - m.p.front()) <= eps) {
         m.p.pop_back(), m.first.pop_back(), m.last.pop_back();  // the loop's end coincides with its start
     }
+    count = m.p.size();
+    if (count >= (s.closed ? 3u : 2u)) fill_chords(m.p.data(), count, s.closed, ch);
+    return m.p.data();
 }
 
-// Tridiagonal solve (sub a, diagonal b, super c); callers pass diagonally dominant rows. Twisted ("burn at both
-// ends") elimination: rows are eliminated from the top and from the bottom at once, meeting in the middle row, so
-// the two serial chains of one division each per row run side by side (half the latency of Thomas' one chain).
-template <class V>
-void thomas(const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& c,
-            std::vector<V>& r) {
-    const std::size_t n = b.size();
-    thread_local std::vector<double> f;  // top half: c'/pivot; bottom half: a'/pivot (reused, no allocation)
-    f.resize(n);
+// Tridiagonal solve (sub a, diagonal b, super c) of n rows for C right-hand sides r[0..C) (structure of arrays;
+// each component gets exactly the operations the vector form gave it); callers pass diagonally dominant rows.
+// Twisted ("burn at both ends") elimination: rows are eliminated from the top and from the bottom at once, meeting
+// in the middle row, so the two serial chains of one division each per row run side by side (half the latency of
+// Thomas' one chain).
+template <int C>
+void thomas(const double* a, const double* b, const double* c, std::size_t n, double* const* r) {
+    thread_local std::vector<double> fv;  // top half: c'/pivot; bottom half: a'/pivot (reused, no allocation)
+    fv.resize(n);
+    double* f = fv.data();
     if (n < 4) {  // plain Thomas
         double inv = 1.0 / b[0];
         f[0] = c[0] * inv;
-        r[0] = r[0] * inv;
+        for (int q = 0; q < C; ++q) r[q][0] = r[q][0] * inv;
         for (std::size_t i = 1; i < n; ++i) {
             inv = 1.0 / (b[i] - a[i] * f[i - 1]);
             f[i] = c[i] * inv;
-            r[i] = (r[i] - a[i] * r[i - 1]) * inv;
+            for (int q = 0; q < C; ++q) r[q][i] = (r[q][i] - a[i] * r[q][i - 1]) * inv;
         }
-        for (std::size_t i = n - 1; i-- > 0;) r[i] = r[i] - f[i] * r[i + 1];
+        for (std::size_t i = n - 1; i-- > 0;)
+            for (int q = 0; q < C; ++q) r[q][i] = r[q][i] - f[i] * r[q][i + 1];
         return;
     }
     const std::size_t p = n / 2;  // the meeting row; top rows 0..p-1, bottom rows p+1..n-1
     auto top = [&](std::size_t i) {
         const double inv = 1.0 / (b[i] - a[i] * f[i - 1]);
         f[i] = c[i] * inv;
-        r[i] = (r[i] - a[i] * r[i - 1]) * inv;
+        for (int q = 0; q < C; ++q) r[q][i] = (r[q][i] - a[i] * r[q][i - 1]) * inv;
     };
     auto bottom = [&](std::size_t j) {
         const double inv = 1.0 / (b[j] - c[j] * f[j + 1]);
         f[j] = a[j] * inv;
-        r[j] = (r[j] - c[j] * r[j + 1]) * inv;
+        for (int q = 0; q < C; ++q) r[q][j] = (r[q][j] - c[j] * r[q][j + 1]) * inv;
     };
     double inv = 1.0 / b[0];
     f[0] = c[0] * inv;
-    r[0] = r[0] * inv;
+    for (int q = 0; q < C; ++q) r[q][0] = r[q][0] * inv;
     inv = 1.0 / b[n - 1];
     f[n - 1] = a[n - 1] * inv;
-    r[n - 1] = r[n - 1] * inv;
+    for (int q = 0; q < C; ++q) r[q][n - 1] = r[q][n - 1] * inv;
     std::size_t i = 1, j = n - 2;
     for (; i < p && j > p; ++i, --j) top(i), bottom(j);
     for (; i < p; ++i) top(i);
     for (; j > p; --j) bottom(j);
     // Row p with x[p-1] = r[p-1] - f[p-1] x[p] and x[p+1] = r[p+1] - f[p+1] x[p] substituted.
-    r[p] = (r[p] - a[p] * r[p - 1] - c[p] * r[p + 1]) * (1.0 / (b[p] - a[p] * f[p - 1] - c[p] * f[p + 1]));
+    inv = 1.0 / (b[p] - a[p] * f[p - 1] - c[p] * f[p + 1]);
+    for (int q = 0; q < C; ++q) r[q][p] = (r[q][p] - a[p] * r[q][p - 1] - c[p] * r[q][p + 1]) * inv;
     for (i = p, j = p; i > 0 && j + 1 < n;) {
         --i, ++j;
-        r[i] = r[i] - f[i] * r[i + 1];
-        r[j] = r[j] - f[j] * r[j - 1];
+        for (int q = 0; q < C; ++q) {
+            r[q][i] = r[q][i] - f[i] * r[q][i + 1];
+            r[q][j] = r[q][j] - f[j] * r[q][j - 1];
+        }
     }
-    while (i > 0) --i, r[i] = r[i] - f[i] * r[i + 1];
-    while (j + 1 < n) ++j, r[j] = r[j] - f[j] * r[j - 1];
+    while (i > 0) {
+        --i;
+        for (int q = 0; q < C; ++q) r[q][i] = r[q][i] - f[i] * r[q][i + 1];
+    }
+    while (j + 1 < n) {
+        ++j;
+        for (int q = 0; q < C; ++q) r[q][j] = r[q][j] - f[j] * r[q][j - 1];
+    }
 }
 
 // Cyclic tridiagonal (corners a[0] at column n-1 and c[n-1] at column 0) by Sherman-Morrison, n >= 3.
-void thomas_cyclic(const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& c,
-                   std::vector<dvec3>& r) {
-    const std::size_t n = b.size();
+void thomas_cyclic(const double* a, const double* b, const double* c, std::size_t n, double* const* r) {
     const double alpha = c[n - 1], beta = a[0], gamma = -b[0];
     thread_local std::vector<double> bb;
-    bb.assign(b.begin(), b.end());
+    bb.assign(b, b + n);
     bb[0] = b[0] - gamma;
     bb[n - 1] = b[n - 1] - alpha * beta / gamma;
-    thomas(a, bb, c, r);
+    thomas<3>(a, bb.data(), c, n, r);
     thread_local std::vector<double> z;
     z.assign(n, 0.0);
     z[0] = gamma, z[n - 1] = alpha;
-    thomas(a, bb, c, z);
-    const dvec3 fact = (r[0] + beta * r[n - 1] / gamma) / (1.0 + z[0] + beta * z[n - 1] / gamma);
-    for (std::size_t i = 0; i < n; ++i) r[i] -= fact * z[i];
+    double* const zr[1] = {z.data()};
+    thomas<1>(a, bb.data(), c, n, zr);
+    const double den = 1.0 + z[0] + beta * z[n - 1] / gamma;
+    for (int q = 0; q < 3; ++q) {
+        const double fact = (r[q][0] + beta * r[q][n - 1] / gamma) / den;
+        for (std::size_t i = 0; i < n; ++i) r[q][i] = r[q][i] - fact * z[i];
+    }
 }
 
-struct Chords {
-    std::vector<dvec3> d;     // segment chords
-    std::vector<double> len;  // their lengths (> merge epsilon)
-    std::vector<dvec3> e;     // unit directions d / len (computed once; every kind that needs them reads these)
-};
-
-// Per-segment Hermite tangents (per unit of the segment parameter u): t0 at the start, t1 at the end.
+// Per-segment Hermite tangents (per unit of the segment parameter u): t0 at the start, t1 at the end; structure
+// of arrays.
 struct Tangents {
-    std::vector<dvec3> t0, t1;
+    std::vector<double> t0x, t0y, t0z, t1x, t1y, t1z;
+    void resize(std::size_t segs) {
+        for (std::vector<double>* v : {&t0x, &t0y, &t0z, &t1x, &t1y, &t1z}) v->resize(segs);
+    }
+    void set0(std::size_t k, const dvec3& v) { t0x[k] = v.x, t0y[k] = v.y, t0z[k] = v.z; }
+    void set1(std::size_t k, const dvec3& v) { t1x[k] = v.x, t1y[k] = v.y, t1z[k] = v.z; }
+    void scale0(std::size_t k, double s) { t0x[k] = t0x[k] * s, t0y[k] = t0y[k] * s, t0z[k] = t0z[k] * s; }
+    void scale1(std::size_t k, double s) { t1x[k] = t1x[k] * s, t1y[k] = t1y[k] * s, t1z[k] = t1z[k] * s; }
 };
 
 // ---- automatic: the nu-spline under tension read from the nodes' turning pattern (DESIGN §4.1,
@@ -258,176 +380,267 @@ constexpr double kShareLo = 0.3, kShareHi = 0.45;
 constexpr double kStraightLo = 0.0, kStraightHi = 0.1;
 constexpr double kStraightTension = 30.0;
 
-/// Per-node tension weight g in [0, 1] from the turning pattern (see the constants above).
-/// The result is per-thread storage, valid until the next call on the same thread.
-const std::vector<double>& concentrated_turns(const Chords& ch, bool closed, std::vector<double>* straight = nullptr) {
-    const std::size_t segs = ch.d.size();
-    const std::size_t n = closed ? segs : segs + 1;
-    thread_local std::vector<double> g;
-    g.assign(n, 0.0);
-    if (straight) straight->assign(n, 0.0);
-    if (n < 3) return g;
-    // Curvature vectors k_i = (e_out - e_in) / (mean of the two elements): |k| ~ 2 sin(phi/2) / h.
-    thread_local std::vector<dvec3> k;
-    k.assign(n, dvec3(0.0));
-    auto interior = [&](std::size_t i) { return closed || (i > 0 && i + 1 < n); };
-    // Index arithmetic without `%` (an integer division per use: it was most of this function's time).
-    const auto seg_in = [segs](std::size_t i) { return i == 0 ? segs - 1 : i - 1; };
-    const auto seg_out = [segs](std::size_t i) { return i == segs ? 0 : i; };
+constexpr double kReversal = -1.0 + 1e-12;
+
+// Per node i (incoming chord at index i, outgoing at i + 1): curvature vector k_i and chord-bisector tangent t_i.
+WIRE_SELECT_KERNEL void curvature_kernel(std::size_t n, const double* __restrict ex, const double* __restrict ey,
+                      const double* __restrict ez, const double* __restrict len, double* __restrict kx,
+                      double* __restrict ky, double* __restrict kz, double* __restrict tx, double* __restrict ty,
+                      double* __restrict tz) {
     for (std::size_t i = 0; i < n; ++i) {
-        if (!interior(i)) continue;
-        const std::size_t kin = seg_in(i), kout = seg_out(i);
-        k[i] = (ch.e[kout] - ch.e[kin]) * (2.0 / (ch.len[kin] + ch.len[kout]));
+        const double s = 2.0 / (len[i] + len[i + 1]);
+        kx[i] = (ex[i + 1] - ex[i]) * s;
+        ky[i] = (ey[i + 1] - ey[i]) * s;
+        kz[i] = (ez[i + 1] - ez[i]) * s;
+        const double bx = ex[i] + ex[i + 1], by = ey[i] + ey[i + 1], bz = ez[i] + ez[i + 1];
+        const double lb = std::sqrt(bx * bx + by * by + bz * bz);
+        const double inv = 1.0 / lb;
+        const bool ok = lb > 1e-12;  // else the chords reverse: the outgoing one
+        tx[i] = ok ? bx * inv : ex[i + 1];
+        ty[i] = ok ? by * inv : ey[i + 1];
+        tz[i] = ok ? bz * inv : ez[i + 1];
     }
+}
+
+// Per edge j (tangents t_j, t_j+1): the rotation's axis, cosine and 1 / (1 + cos) (0 at a reversal).
+WIRE_SELECT_KERNEL void edge_kernel(std::size_t n, const double* __restrict tx, const double* __restrict ty, const double* __restrict tz,
+                 double* __restrict ax, double* __restrict ay, double* __restrict az, double* __restrict ec,
+                 double* __restrict eq) {
+    for (std::size_t j = 0; j < n; ++j) {
+        const double c = tx[j] * tx[j + 1] + ty[j] * ty[j + 1] + tz[j] * tz[j + 1];
+        ax[j] = ty[j] * tz[j + 1] - ty[j + 1] * tz[j];
+        ay[j] = tz[j] * tx[j + 1] - tz[j + 1] * tx[j];
+        az[j] = tx[j] * ty[j + 1] - tx[j + 1] * ty[j];
+        const double q = 1.0 / (1.0 + c);
+        ec[j] = c;
+        eq[j] = c <= kReversal ? 0.0 : q;
+    }
+}
+
+// Per node (arrays offset so that node i's incoming chord length, previous node's curvature and previous edge are
+// at index i, its own at i + 1, the next node's curvature at i + 2): the turn its neighbours predict, and the
+// spread's ingredients |k|, |k| + |k~| and |k - k~|^2.
+WIRE_SELECT_KERNEL void spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
+                   const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
+                   const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
+                   const double* __restrict eq, double* __restrict lkv, double* __restrict sumv,
+                   double* __restrict miss2v) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const double hin = len[i], hout = len[i + 1];
+        // Forwards along the previous edge (index i) from node i-1 (index i of k).
+        double fx, fy, fz;
+        {
+            const double a_x = ax[i], a_y = ay[i], a_z = az[i], c = ec[i], q = eq[i];
+            const double vx = kx[i], vy = ky[i], vz = kz[i];
+            const double cx = a_y * vz - vy * a_z, cy = a_z * vx - vz * a_x, cz = a_x * vy - vx * a_y;
+            const double dq = (a_x * vx + a_y * vy + a_z * vz) * q;
+            const bool rev = c <= kReversal;
+            fx = rev ? -vx : vx * c + cx + a_x * dq;
+            fy = rev ? -vy : vy * c + cy + a_y * dq;
+            fz = rev ? -vz : vz * c + cz + a_z * dq;
+        }
+        // Backwards along node i's own edge (index i + 1) from node i+1 (index i + 2 of k).
+        double bx, by, bz;
+        {
+            const double a_x = ax[i + 1], a_y = ay[i + 1], a_z = az[i + 1], c = ec[i + 1], q = eq[i + 1];
+            const double vx = kx[i + 2], vy = ky[i + 2], vz = kz[i + 2];
+            const double cx = a_y * vz - vy * a_z, cy = a_z * vx - vz * a_x, cz = a_x * vy - vx * a_y;
+            const double dq = (a_x * vx + a_y * vy + a_z * vz) * q;
+            const bool rev = c <= kReversal;
+            bx = rev ? -vx : vx * c - cx + a_x * dq;
+            by = rev ? -vy : vy * c - cy + a_y * dq;
+            bz = rev ? -vz : vz * c - cz + a_z * dq;
+        }
+        const double s = 1.0 / (hin + hout);
+        const double px = (hout * fx + hin * bx) * s, py = (hout * fy + hin * by) * s, pz = (hout * fz + hin * bz) * s;
+        const double vx = kx[i + 1], vy = ky[i + 1], vz = kz[i + 1];
+        const double lk = std::sqrt(vx * vx + vy * vy + vz * vz), lp = std::sqrt(px * px + py * py + pz * pz);
+        const double mx = vx - px, my = vy - py, mz = vz - pz;
+        lkv[i] = lk;
+        sumv[i] = lk + lp;
+        miss2v[i] = mx * mx + my * my + mz * mz;
+    }
+}
+
+/// Per-node tension weights from the turning pattern (see the constants above): g in [0, 1] (concentrated
+/// turn), straight in [0, 1] (end of a load-free span), and the diagonal addition w they give (0 where both are 0).
+/// n curve nodes; every output resized to n.
+void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vector<double>& g,
+                        std::vector<double>& straight, std::vector<double>& w) {
+    g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
+    if (n < 3) return;
+    thread_local Pool pool;
+    pool.reset(3 * (n + 2) + 3 * (n + 1) + 5 * (n + 1) + 3 * n);
+    // Curvature vectors k_i = (e_out - e_in) / (mean of the two elements): |k| ~ 2 sin(phi/2) / h. Node i's at
+    // index i + 1; index 0 repeats the last node's, index n + 1 the first's (wrap-around ghosts).
+    double* __restrict kx = pool.carve(n + 2);
+    double* __restrict ky = pool.carve(n + 2);
+    double* __restrict kz = pool.carve(n + 2);
     // Node tangents (chord bisectors), to carry a neighbour's curvature vector to node i by the rotation that
-    // takes its tangent to node i's (on a circle this maps one curvature vector exactly onto the next).
-    thread_local std::vector<dvec3> t;
-    t.assign(n, dvec3(0.0));
-    for (std::size_t i = 0; i < n; ++i) {
-        const bool in = closed || i > 0, out = closed || i + 1 < n;
-        const dvec3 e_in = in ? ch.e[seg_in(i)] : dvec3(0.0);
-        const dvec3 e_out = out ? ch.e[seg_out(i)] : dvec3(0.0);
-        const dvec3 b = e_in + e_out;
-        const double lb = glm::length(b);
-        t[i] = lb > 1e-12 ? b * (1.0 / lb) : (out ? e_out : e_in);
+    // takes its tangent to node i's (on a circle this maps one curvature vector exactly onto the next). Index n
+    // repeats node 0's.
+    double* __restrict tx = pool.carve(n + 1);
+    double* __restrict ty = pool.carve(n + 1);
+    double* __restrict tz = pool.carve(n + 1);
+    const double* __restrict ex = ch.ex.data();  // node i: incoming chord at i, outgoing at i + 1
+    const double* __restrict ey = ch.ey.data();
+    const double* __restrict ez = ch.ez.data();
+    const double* __restrict len = ch.len.data();
+    // Every node, branch-free (open wires' end values are replaced below).
+    curvature_kernel(n, ex, ey, ez, len, kx + 1, ky + 1, kz + 1, tx, ty, tz);
+    if (!closed) {  // constant extrapolation
+        kx[1] = kx[2], ky[1] = ky[2], kz[1] = kz[2];
+        kx[n] = kx[n - 1], ky[n] = ky[n - 1], kz[n] = kz[n - 1];
+        tx[0] = tx[1], ty[0] = ty[1], tz[0] = tz[1];
+        tx[n - 1] = tx[n - 2], ty[n - 1] = ty[n - 2], tz[n - 1] = tz[n - 2];
     }
-    if (!closed) k[0] = k[1], k[n - 1] = k[n - 2], t[0] = t[1], t[n - 1] = t[n - 2];  // constant extrapolation
-    // Rodrigues rotation t[j] -> t[j+1] per edge j (axis sin, cos, 1 / (1 + cos)), once per edge: node j+1 carries
-    // k[j] forwards with it, node j carries k[j+1] backwards with its inverse (axis negated, the same cosine).
-    struct EdgeTurn {
-        dvec3 axis;
-        double c, q;
-    };
-    thread_local std::vector<EdgeTurn> edge;
-    const std::size_t edges = closed ? n : n - 1;
-    edge.resize(edges);
-    for (std::size_t j = 0; j < edges; ++j) {
-        const dvec3& ta = t[j];
-        const dvec3& tb = t[j + 1 == n ? 0 : j + 1];
-        const double c = glm::dot(ta, tb);
-        edge[j] = EdgeTurn{glm::cross(ta, tb), c, c <= -1.0 + 1e-12 ? 0.0 : 1.0 / (1.0 + c)};
-    }
-    const auto carry = [&](const EdgeTurn& e, const dvec3& kv, double sense) {  // sense +1: forwards, -1: back
-        if (e.c <= -1.0 + 1e-12) return -kv;  // reversal: any perpendicular axis; the sign is what matters
-        return kv * e.c + sense * glm::cross(e.axis, kv) + e.axis * (glm::dot(e.axis, kv) * e.q);
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!interior(i)) continue;
-        const std::size_t kin = seg_in(i), kout = seg_out(i);
-        const double hin = ch.len[kin], hout = ch.len[kout];
-        // What the neighbours predict at node i: their curvature vectors, carried to node i's tangent,
-        // interpolated linearly in arc length.
-        const dvec3 pred =
-            (hout * carry(edge[i == 0 ? n - 1 : i - 1], k[i == 0 ? n - 1 : i - 1], 1.0) +
-             hin * carry(edge[i], k[i + 1 == n ? 0 : i + 1], -1.0)) *
-            (1.0 / (hin + hout));
-        const double lk = glm::length(k[i]), lp = glm::length(pred), sum = lk + lp;
+    kx[0] = kx[n], ky[0] = ky[n], kz[0] = kz[n];
+    kx[n + 1] = kx[1], ky[n + 1] = ky[1], kz[n + 1] = kz[1];
+    tx[n] = tx[0], ty[n] = ty[0], tz[n] = tz[0];
+    // Rodrigues rotation t[j] -> t[j+1] per edge j (axis sin, cos, 1 / (1 + cos)), once per edge, at index j + 1
+    // (index 0 repeats the last edge): node j+1 carries k[j] forwards with it, node j carries k[j+1] backwards
+    // with its inverse (axis negated, the same cosine).
+    double* __restrict ax = pool.carve(n + 1);
+    double* __restrict ay = pool.carve(n + 1);
+    double* __restrict az = pool.carve(n + 1);
+    double* __restrict ec = pool.carve(n + 1);
+    double* __restrict eq = pool.carve(n + 1);
+    edge_kernel(n, tx, ty, tz, ax + 1, ay + 1, az + 1, ec + 1, eq + 1);
+    ax[0] = ax[n], ay[0] = ay[n], az[0] = az[n], ec[0] = ec[n], eq[0] = eq[n];
+    // What the neighbours predict at node i: their curvature vectors, carried to node i's tangent (a reversal,
+    // any perpendicular axis: the sign is what matters), interpolated linearly in arc length; the spread's
+    // ingredients per node.
+    double* __restrict lkv = pool.carve(n);
+    double* __restrict sumv = pool.carve(n);
+    double* __restrict miss2v = pool.carve(n);
+    const std::size_t first = closed ? 0 : 1, end = closed ? n : n - 1;
+    spread_kernel(end - first, len + first, kx + first, ky + first, kz + first, ax + first, ay + first, az + first,
+                  ec + first, eq + first, lkv + first, sumv + first, miss2v + first);
+    // The rare nodes whose turn the neighbours do not predict (the common case, d <= kSpreadLo: g = 0 and
+    // straight = 0, decided on squares, without the root), and not straight here and around.
+    static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
+    for (std::size_t i = first; i < end; ++i) {
+        const double sum = sumv[i], miss2 = miss2v[i];
         if (!(sum > 0.0) || !std::isfinite(sum)) continue;  // straight here and around: nothing to decide
-        // The neighbours predict this turn (d <= kSpreadLo: g = 0 and straight = 0, the common case), decided
-        // on squares, without the root.
-        const dvec3 miss = k[i] - pred;
-        const double miss2 = glm::dot(miss, miss);
         if (miss2 <= (kSpreadLo * sum) * (kSpreadLo * sum)) continue;
+        const double hin = len[i], hout = len[i + 1];
         const double inv_sum = 1.0 / sum;
         const double d = std::sqrt(miss2) * inv_sum;
         // Turning below ~1e-6 rad is rounding noise of collinear nodes (and invisible): nothing to decide.
         const double turn = 0.5 * sum * (hin + hout);
         const double unshared = smoothstep(kSpreadLo, kSpreadHi, d) * smoothstep(1e-8, 1e-6, turn);
-        const double share = lk * inv_sum;
+        const double share = lkv[i] * inv_sum;
         g[i] = unshared * smoothstep(kShareLo, kShareHi, share);
-        if (straight) (*straight)[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, share));
+        straight[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, share));
+        // Log-uniform in g (an untensed weight adds 0: expm1(0) = 0 exactly, so the call is skipped).
+        const double wc = g[i] != 0.0 ? std::expm1(g[i] * log_max) : 0.0;
+        const double ws = straight[i] != 0.0 ? std::expm1(straight[i] * log_straight) : 0.0;
+        w[i] = wc + ws;
     }
-    return g;
+}
+
+// Interior rows of the tangent system (node j: incoming chord at index j, outgoing at j + 1; diagonal 2 + w_j).
+void rows_kernel(std::size_t rows, const double* __restrict w, const double* __restrict ex, const double* __restrict ey,
+                 const double* __restrict ez, const double* __restrict len, double* __restrict a, double* __restrict b,
+                 double* __restrict c, double* __restrict rx, double* __restrict ry, double* __restrict rz) {
+    for (std::size_t j = 0; j < rows; ++j) {
+        const double hin = len[j], hout = len[j + 1], sum = hin + hout;
+        const double aj = hout / sum, cj = hin / sum;
+        a[j] = aj, c[j] = cj, b[j] = 2.0 + w[j];
+        rx[j] = 3.0 * (aj * ex[j] + cj * ex[j + 1]);
+        ry[j] = 3.0 * (aj * ey[j] + cj * ey[j + 1]);
+        rz[j] = 3.0 * (aj * ez[j] + cj * ez[j + 1]);
+    }
+}
+
+// Segment tangents from node tangents per unit chord (D: node k's at k, k + 1's at k + 1) and chord lengths.
+void tangents_kernel(std::size_t segs, const double* __restrict D, const double* __restrict len, double* __restrict t0,
+                     double* __restrict t1) {
+    for (std::size_t k = 0; k < segs; ++k) {
+        t0[k] = D[k] * len[k];
+        t1[k] = D[k + 1] * len[k];
+    }
 }
 
 /// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
-/// proportional to the tangent (tension). Rows as c2_tangents' with w_i added to the diagonal; open ends
-/// not-a-knot, blending to free ends (zero curvature) as the neighbouring node gets tensed.
-void automatic_tangents(const Chords& ch, bool closed, const std::vector<double>& g, const std::vector<double>& gs, Tangents& tg) {
-    const std::size_t segs = ch.d.size();
-    const std::size_t n = closed ? segs : segs + 1;
-    // Working memory: per thread, reused (no allocation per call once large enough).
-    const std::vector<dvec3>& s = ch.e;
-    thread_local std::vector<double> w;
-    w.resize(n);
-    // Log-uniform in g; most nodes are untensed (g = 0: expm1(0) = 0 exactly, so the calls are skipped).
-    static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
-    for (std::size_t i = 0; i < n; ++i) {
-        const double wc = g[i] != 0.0 ? std::expm1(g[i] * log_max) : 0.0;
-        const double ws = gs[i] != 0.0 ? std::expm1(gs[i] * log_straight) : 0.0;
-        w[i] = wc + ws;
-    }
-    thread_local std::vector<dvec3> D;
-    D.resize(n);
+/// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
+/// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
+/// the neighbouring node gets tensed.
+void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const std::vector<double>& g,
+                        const std::vector<double>& gs, const std::vector<double>& w, Tangents& tg) {
+    const std::size_t segs = ch.segs;
+    const double* __restrict ex = ch.ex.data();  // node i: incoming chord at i, outgoing at i + 1
+    const double* __restrict ey = ch.ey.data();
+    const double* __restrict ez = ch.ez.data();
+    const double* __restrict len = ch.len.data();
+    // Working memory: per thread, reused (no allocation per call once large enough). D (node tangents per unit
+    // chord) has index n repeating node 0's.
+    thread_local Pool pool;
+    pool.reset(3 * (n + 1) + 3 * n);
+    double* const D[3] = {pool.carve(n + 1), pool.carve(n + 1), pool.carve(n + 1)};
+    double* __restrict a = pool.carve(n);
+    double* __restrict b = pool.carve(n);
+    double* __restrict c = pool.carve(n);
+    // Rows i0 .. i0 + rows - 1 of the interior system, their right-hand sides in place in D.
+    const auto fill_rows = [&](std::size_t i0, std::size_t rows) {
+        rows_kernel(rows, w.data() + i0, ex + i0, ey + i0, ez + i0, len + i0, a, b, c, D[0] + i0, D[1] + i0, D[2] + i0);
+    };
+    const auto node = [&](std::size_t i) { return dvec3(D[0][i], D[1][i], D[2][i]); };
+    const auto set_node = [&](std::size_t i, const dvec3& v) { D[0][i] = v.x, D[1][i] = v.y, D[2][i] = v.z; };
     if (closed) {
-        thread_local std::vector<double> a, b, c;
-        a.assign(n, 0.0), b.assign(n, 0.0), c.assign(n, 0.0);
-        for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t kin = i == 0 ? segs - 1 : i - 1, kout = i;
-            const double hin = ch.len[kin], hout = ch.len[kout], sum = hin + hout;
-            a[i] = hout / sum, c[i] = hin / sum, b[i] = 2.0 + w[i];
-            D[i] = 3.0 * (a[i] * s[kin] + c[i] * s[kout]);
-        }
-        thomas_cyclic(a, b, c, D);
+        fill_rows(0, n);
+        thomas_cyclic(a, b, c, n, D);
     } else if (n == 2) {
-        D[0] = D[1] = s[0];
+        set_node(0, ch.e(0)), set_node(1, ch.e(0));
     } else {
+        const auto s = [&](std::size_t k) { return ch.e(k); };
         // End rows beta D0 + D1 = r: not-a-knot (beta = h1/(h0+h1)) blending to free (beta = 2, r = 3 s0).
-        const double h0 = ch.len[0], h1 = ch.len[1], hL = ch.len[segs - 1], hP = ch.len[segs - 2];
-        const dvec3 r0n = (s[0] * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s[1]) / ((h0 + h1) * (h0 + h1));
-        const dvec3 rln = (s[segs - 1] * (hP * (3.0 * hL + 2.0 * hP)) + (hL * hL) * s[segs - 2]) / ((hP + hL) * (hP + hL));
+        const double h0 = ch.l(0), h1 = ch.l(1), hL = ch.l(segs - 1), hP = ch.l(segs - 2);
+        const dvec3 r0n = (s(0) * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s(1)) / ((h0 + h1) * (h0 + h1));
+        const dvec3 rln = (s(segs - 1) * (hP * (3.0 * hL + 2.0 * hP)) + (hL * hL) * s(segs - 2)) / ((hP + hL) * (hP + hL));
         // The not-a-knot end makes the first (last) two segments one cubic, which overshoots when either
         // node it spans is tensed (its tangent nearly vanishes): then the end becomes free.
         const auto tensed = [&](std::size_t i) { return std::max(g[i], gs[i]); };
         const double g0 = std::max(tensed(1), n > 3 ? tensed(2) : 0.0), gl = std::max(tensed(n - 2), n > 3 ? tensed(n - 3) : 0.0);
         const double beta0 = (1.0 - g0) * h1 / (h0 + h1) + 2.0 * g0, betal = (1.0 - gl) * hP / (hP + hL) + 2.0 * gl;
-        const dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s[0], rl = (1.0 - gl) * rln + (3.0 * gl) * s[segs - 1];
+        const dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s(0), rl = (1.0 - gl) * rln + (3.0 * gl) * s(segs - 1);
         const std::size_t m = n - 2;
-        thread_local std::vector<double> a, b, c;
-        a.assign(m, 0.0), b.assign(m, 0.0), c.assign(m, 0.0);
-        thread_local std::vector<dvec3> r;
-        r.assign(m, dvec3(0.0));
-        for (std::size_t j = 0; j < m; ++j) {
-            const std::size_t i = j + 1;
-            const double hin = ch.len[i - 1], hout = ch.len[i], sum = hin + hout;
-            a[j] = hout / sum, c[j] = hin / sum, b[j] = 2.0 + w[i];
-            r[j] = 3.0 * (a[j] * s[i - 1] + c[j] * s[i]);
-        }
+        fill_rows(1, m);  // row j is node j + 1's
         if (m == 1) {
             // 3 nodes: not-a-knot at both ends is the interpolating parabola (one cubic through 3 points is
             // not determined: the elimination below would be singular); it blends with the tensed solution
             // with free ends as the middle node gets tensed.
             const double g1 = g[1];
-            const dvec3 p0 = s[0] - h0 * (s[1] - s[0]) / (h0 + h1), p1 = (h1 * s[0] + h0 * s[1]) / (h0 + h1);
-            const dvec3 p2 = s[1] + h1 * (s[1] - s[0]) / (h0 + h1);
+            const dvec3 p0 = s(0) - h0 * (s(1) - s(0)) / (h0 + h1), p1 = (h1 * s(0) + h0 * s(1)) / (h0 + h1);
+            const dvec3 p2 = s(1) + h1 * (s(1) - s(0)) / (h0 + h1);
             // Free ends: 2 D0 + D1 = 3 s0, 2 D2 + D1 = 3 s1, middle row a D0 + (2 + w) D1 + c D2 = r.
-            const dvec3 t1 = (r[0] - 1.5 * (a[0] * s[0] + c[0] * s[1])) / (b[0] - 0.5 * (a[0] + c[0]));
-            const dvec3 t0 = 0.5 * (3.0 * s[0] - t1), t2 = 0.5 * (3.0 * s[1] - t1);
-            D[0] = (1.0 - g1) * p0 + g1 * t0;
-            D[1] = (1.0 - g1) * p1 + g1 * t1;
-            D[2] = (1.0 - g1) * p2 + g1 * t2;
+            const dvec3 t1 = (node(1) - 1.5 * (a[0] * s(0) + c[0] * s(1))) / (b[0] - 0.5 * (a[0] + c[0]));
+            const dvec3 t0 = 0.5 * (3.0 * s(0) - t1), t2 = 0.5 * (3.0 * s(1) - t1);
+            set_node(0, (1.0 - g1) * p0 + g1 * t0);
+            set_node(1, (1.0 - g1) * p1 + g1 * t1);
+            set_node(2, (1.0 - g1) * p2 + g1 * t2);
         } else {
             // Eliminate D0 and D[n-1] (pivots stay >= 1: a/beta <= 1).
-            r[0] -= (a[0] / beta0) * r0, b[0] -= a[0] / beta0, a[0] = 0.0;
-            r[m - 1] -= (c[m - 1] / betal) * rl, b[m - 1] -= c[m - 1] / betal, c[m - 1] = 0.0;
-            thomas(a, b, c, r);
-            for (std::size_t j = 0; j < m; ++j) D[j + 1] = r[j];
-            D[0] = (r0 - D[1]) / beta0;
-            D[n - 1] = (rl - D[n - 2]) / betal;
+            set_node(1, node(1) - (a[0] / beta0) * r0), b[0] -= a[0] / beta0, a[0] = 0.0;
+            set_node(m, node(m) - (c[m - 1] / betal) * rl), b[m - 1] -= c[m - 1] / betal, c[m - 1] = 0.0;
+            double* const r[3] = {D[0] + 1, D[1] + 1, D[2] + 1};
+            thomas<3>(a, b, c, m, r);
+            set_node(0, (r0 - node(1)) / beta0);
+            set_node(n - 1, (rl - node(n - 2)) / betal);
         }
     }
-    for (std::size_t k = 0; k < segs; ++k) {
-        tg.t0[k] = D[k] * ch.len[k];
-        tg.t1[k] = D[k + 1 == n ? 0 : k + 1] * ch.len[k];
-    }
+    D[0][n] = D[0][0], D[1][n] = D[1][0], D[2][n] = D[2][0];
+    tangents_kernel(segs, D[0], len + 1, tg.t0x.data(), tg.t1x.data());
+    tangents_kernel(segs, D[1], len + 1, tg.t0y.data(), tg.t1y.data());
+    tangents_kernel(segs, D[2], len + 1, tg.t0z.data(), tg.t1z.data());
 }
 
 // C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the automatic
 // spline's solve with no node tensed (w = 0 everywhere, ends purely not-a-knot), so the two share one solver.
-void c2_tangents(const Chords& ch, bool closed, Tangents& tg) {
+void c2_tangents(const Chords& ch, std::size_t n, bool closed, Tangents& tg) {
     thread_local std::vector<double> untensed;
-    untensed.assign(closed ? ch.d.size() : ch.d.size() + 1, 0.0);
-    automatic_tangents(ch, closed, untensed, untensed, tg);
+    untensed.assign(n, 0.0);
+    automatic_tangents(ch, n, closed, untensed, untensed, untensed, tg);
 }
 
 }  // namespace
@@ -454,9 +667,11 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
                          !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
     if (Status st = check_nodes(nodes, physics); !st) return st;
 
-    thread_local Merged m;  // working memory, reused: no allocation per call once it is large enough
-    merge_nodes(nodes, settings, m);
-    const std::size_t n = m.p.size();
+    // Working memory, reused: no allocation per call once it is large enough.
+    thread_local Merged m;
+    thread_local Chords ch;
+    std::size_t n = 0;
+    const dvec3* const P = merge_nodes(nodes, settings, m, ch, n);
     const bool closed = settings.closed;
     if (n < 2) {
         return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(nodes.size()) +
@@ -468,13 +683,6 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     }
     const std::size_t segs = closed ? n : n - 1;
 
-    thread_local Chords ch;
-    ch.d.resize(segs), ch.len.resize(segs), ch.e.resize(segs);
-    for (std::size_t k = 0; k < segs; ++k) {
-        ch.d[k] = m.p[k + 1 == n ? 0 : k + 1] - m.p[k];  // differences of nearby doubles: exact, whatever the offset
-        ch.len[k] = glm::length(ch.d[k]);
-        ch.e[k] = ch.d[k] * (1.0 / ch.len[k]);
-    }
     std::vector<float>& seg_stretch = out.stretch;  // built in place
     seg_stretch.assign(segs, 1.0f);
     if (!nodes.stretch.empty()) {
@@ -482,28 +690,30 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     }
 
     thread_local Tangents tg;
-    tg.t0.resize(segs), tg.t1.resize(segs);
+    tg.resize(segs);
     const SplineKind kind = settings.kind;
     if (kind == SplineKind::linear) {
-        for (std::size_t k = 0; k < segs; ++k) tg.t0[k] = tg.t1[k] = ch.d[k];
+        for (std::size_t k = 0; k < segs; ++k) tg.set0(k, ch.d(k)), tg.set1(k, ch.d(k));
     } else if (kind == SplineKind::c2) {
-        c2_tangents(ch, closed, tg);
+        c2_tangents(ch, n, closed, tg);
     } else if (kind == SplineKind::automatic) {
-        thread_local std::vector<double> gs;
-        const std::vector<double>& g = concentrated_turns(ch, closed, &gs);
-        automatic_tangents(ch, closed, g, gs, tg);
+        thread_local std::vector<double> g, gs, w;
+        concentrated_turns(ch, n, closed, g, gs, w);
+        automatic_tangents(ch, n, closed, g, gs, w, tg);
         // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
-        // C2 only where it is 0).
-        for (std::size_t j = 0; j < n; ++j) {
-            const uint32_t src = m.first[j];
-            const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
-            const double t_curv = physics ? curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
-                                                              nodes.delta_length_m[src], nodes.area_m2[src])
-                                          : 0.0;
-            const double keep = (1.0 - t_user) * (1.0 - t_curv);
-            if (keep == 1.0) continue;
-            if (closed || j + 1 < n) tg.t0[j == segs ? 0 : j] *= keep;
-            if (closed || j > 0) tg.t1[j == 0 ? segs - 1 : j - 1] *= keep;
+        // C2 only where it is 0). Nothing to scale with the wire's tension 0 and no per-node or physics input.
+        if (!nodes.kb_tension.empty() || physics || settings.tension != 0.0) {
+            for (std::size_t j = 0; j < n; ++j) {
+                const uint32_t src = m.first[j];
+                const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
+                const double t_curv = physics ? curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
+                                                                  nodes.delta_length_m[src], nodes.area_m2[src])
+                                              : 0.0;
+                const double keep = (1.0 - t_user) * (1.0 - t_curv);
+                if (keep == 1.0) continue;
+                if (closed || j + 1 < n) tg.scale0(j == segs ? 0 : j, keep);
+                if (closed || j > 0) tg.scale1(j == 0 ? segs - 1 : j - 1, keep);
+            }
         }
     } else {
         const double alpha = settings.alpha;
@@ -513,10 +723,10 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
             const std::size_t kin = has_in ? (j == 0 ? segs - 1 : j - 1) : 0;
             const std::size_t kout = has_out ? (j == segs ? 0 : j) : segs - 1;
             // Open ends reflect the missing neighbour (P[-1] = 2P[0]-P[1]): the missing chord equals the other.
-            const dvec3 din = has_in ? ch.d[kin] : ch.d[kout];
-            const dvec3 dout = has_out ? ch.d[kout] : ch.d[kin];
-            const double lin = has_in ? ch.len[kin] : ch.len[kout];
-            const double lout = has_out ? ch.len[kout] : ch.len[kin];
+            const dvec3 din = has_in ? ch.d(kin) : ch.d(kout);
+            const dvec3 dout = has_out ? ch.d(kout) : ch.d(kin);
+            const double lin = has_in ? ch.l(kin) : ch.l(kout);
+            const double lout = has_out ? ch.l(kout) : ch.l(kin);
 
             const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
             const double b = nodes.kb_bias.empty() ? settings.bias : nodes.kb_bias[src];
@@ -544,38 +754,62 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
             const double w = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);  // w + iw = 1
             const dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
             const dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
-            if (has_out) tg.t0[kout] = start;
-            if (has_in) tg.t1[kin] = end;
+            if (has_out) tg.set0(kout, start);
+            if (has_in) tg.set1(kin, end);
         }
     }
 
-    out.closed = closed;
-    out.segments.reserve(segs);  // appended, not resized: no zero-fill of what is written next
-    for (std::size_t k = 0; k < segs; ++k) {
-        const dvec3& p0 = m.p[k];
-        const dvec3& p1 = m.p[k + 1 == n ? 0 : k + 1];
-        const CubicBezier& bz =
-            out.segments.emplace_back(CubicBezier{p0, p0 + tg.t0[k] * (1.0 / 3.0), p1 - tg.t1[k] * (1.0 / 3.0), p1});
-        // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the
-        // tube's float vertices downstream.
-        constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
-        const auto in_range = [](const dvec3& b) {
-            return std::abs(b.x) <= kMaxControl_m && std::abs(b.y) <= kMaxControl_m && std::abs(b.z) <= kMaxControl_m;
+    // Inner control points B1 = P0 + t0/3, B2 = P1 - t1/3, in place of the tangents, and their range check.
+    // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the tube's
+    // float vertices downstream.
+    constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
+    std::int64_t in_range = 0;
+    {
+        const double* __restrict p = &P[0].x;  // node j's coordinates at 3j .. 3j+2
+        double* __restrict b1x = tg.t0x.data();
+        double* __restrict b1y = tg.t0y.data();
+        double* __restrict b1z = tg.t0z.data();
+        double* __restrict b2x = tg.t1x.data();
+        double* __restrict b2y = tg.t1y.data();
+        double* __restrict b2z = tg.t1z.data();
+        const auto ok = [](double v) { return std::abs(v) <= kMaxControl_m; };  // false for NaN too
+        const auto control = [&](std::size_t k, std::size_t k1) {
+            const double x1 = p[3 * k] + b1x[k] * (1.0 / 3.0), y1 = p[3 * k + 1] + b1y[k] * (1.0 / 3.0),
+                         z1 = p[3 * k + 2] + b1z[k] * (1.0 / 3.0);
+            const double x2 = p[3 * k1] - b2x[k] * (1.0 / 3.0), y2 = p[3 * k1 + 1] - b2y[k] * (1.0 / 3.0),
+                         z2 = p[3 * k1 + 2] - b2z[k] * (1.0 / 3.0);
+            b1x[k] = x1, b1y[k] = y1, b1z[k] = z1, b2x[k] = x2, b2y[k] = y2, b2z[k] = z2;
+            return static_cast<std::int64_t>(ok(x1) & ok(y1) & ok(z1) & ok(x2) & ok(y2) & ok(z2));
         };
-        const bool finite = in_range(bz.b1) && in_range(bz.b2);  // false for NaN too
-        if (!finite) {
+        for (std::size_t k = 0; k + 1 < n; ++k) in_range += control(k, k + 1);
+        if (closed) in_range += control(n - 1, 0);
+    }
+    if (in_range != static_cast<std::int64_t>(segs)) {
+        for (std::size_t k = 0; k < segs; ++k) {
+            const double v[6] = {tg.t0x[k], tg.t0y[k], tg.t0z[k], tg.t1x[k], tg.t1y[k], tg.t1z[k]};
+            if (std::all_of(v, v + 6, [](double x) { return std::abs(x) <= kMaxControl_m; })) continue;
             const uint32_t src = m.first[k];
             clear_curve(out);
             return Status::error(node_prefix(src) + "tangent overflowed (alpha " + describe(settings.alpha) +
                                      " is too extreme for this node spacing)", static_cast<int>(src));
         }
     }
+    out.closed = closed;
+    out.segments.reserve(segs);  // appended, not resized: no zero-fill of what is written next
+    for (std::size_t k = 0; k < segs; ++k) {
+        out.segments.push_back(CubicBezier{P[k], dvec3(tg.t0x[k], tg.t0y[k], tg.t0z[k]),
+                                           dvec3(tg.t1x[k], tg.t1y[k], tg.t1z[k]), P[k + 1 == n ? 0 : k + 1]});
+    }
     out.source_node = m.first;
-    out.radius_m.resize(n);
     const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : 0.01f;
-    for (std::size_t j = 0; j < n; ++j) {
-        const float r = nodes.radius_m.empty() ? 0.0f : nodes.radius_m[m.first[j]];
-        out.radius_m[j] = r > 0.0f ? r : wire_radius;
+    if (nodes.radius_m.empty()) {
+        out.radius_m.assign(n, wire_radius);
+    } else {
+        out.radius_m.resize(n);
+        for (std::size_t j = 0; j < n; ++j) {
+            const float r = nodes.radius_m[m.first[j]];
+            out.radius_m[j] = r > 0.0f ? r : wire_radius;
+        }
     }
     return Status::success();
 }
