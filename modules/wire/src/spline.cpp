@@ -11,6 +11,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace wire {
 namespace {
 
@@ -87,17 +91,43 @@ Status check_settings(const SplineSettings& s) {
     return Status::success();
 }
 
+// True when |v[i]| <= limit for every i < count (false for NaN and Inf): an AND of vector comparisons, no branch
+// per value.
+bool all_within(const double* v, std::size_t count, double limit) {
+    std::size_t i = 0;
+    bool all = true;
+#if defined(__SSE2__)
+    const __m128d lim = _mm_set1_pd(limit), sign = _mm_set1_pd(-0.0);
+    __m128d ok = _mm_cmpeq_pd(lim, lim);  // all ones (limit is a number)
+    for (; i + 2 <= count; i += 2) ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, _mm_loadu_pd(v + i)), lim));
+    all = _mm_movemask_pd(ok) == 3;
+#endif
+    for (; i < count; ++i) all &= std::abs(v[i]) <= limit;
+    return all;
+}
+
+// True when v[i] > limit for every i < count (false for NaN).
+bool all_above(const double* v, std::size_t count, double limit) {
+    std::size_t i = 0;
+    bool all = true;
+#if defined(__SSE2__)
+    const __m128d lim = _mm_set1_pd(limit);
+    __m128d ok = _mm_cmpeq_pd(lim, lim);  // all ones (limit is a number)
+    for (; i + 2 <= count; i += 2) ok = _mm_and_pd(ok, _mm_cmpgt_pd(_mm_loadu_pd(v + i), lim));
+    all = _mm_movemask_pd(ok) == 3;
+#endif
+    for (; i < count; ++i) all &= v[i] > limit;
+    return all;
+}
+
 Status check_nodes(const WireNodes& w, bool use_physics) {
     static const char* const kAxis[3] = {"x", "y", "z"};
     // The common case in one branch-free pass: positions only, every coordinate finite and in range (NaN and
     // Inf fail the comparison). Anything else, or a bad value, takes the per-node checks and their messages.
     if (!w.positions.empty() && w.stretch.empty() && w.radius_m.empty() && w.kb_tension.empty() &&
         w.kb_bias.empty() && w.kb_continuity.empty() && !use_physics) {
-        const double* v = &w.positions[0].x;  // 3 coordinates a node, contiguous
-        const std::size_t count = 3 * w.positions.size();
-        std::int64_t in_range = 0;
-        for (std::size_t i = 0; i < count; ++i) in_range += std::abs(v[i]) <= kMaxCoordinate_m;
-        if (in_range == static_cast<std::int64_t>(count)) return Status::success();
+        // 3 coordinates a node, contiguous
+        if (all_within(&w.positions[0].x, 3 * w.positions.size(), kMaxCoordinate_m)) return Status::success();
     }
     for (std::size_t i = 0; i < w.positions.size(); ++i) {
         for (int a = 0; a < 3; ++a) {
@@ -234,10 +264,7 @@ const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m,
         // The chords of consecutive input nodes are the distances the merge tests (the closing one too: the
         // length of a negated difference is the same number); nothing merges when all exceed eps.
         fill_chords(w.positions.data(), n, s.closed, ch);
-        const double* len = ch.len.data() + 1;
-        std::int64_t apart = 0;
-        for (std::size_t k = 0; k < ch.segs; ++k) apart += len[k] > eps;
-        if (apart == static_cast<std::int64_t>(ch.segs)) {
+        if (all_above(ch.len.data() + 1, ch.segs, eps)) {
             m.first.resize(n), m.last.resize(n);
             for (std::size_t i = 0; i < n; ++i) m.first[i] = m.last[i] = static_cast<uint32_t>(i);
             count = n;
@@ -562,6 +589,21 @@ void tangents_kernel(std::size_t segs, const double* __restrict D, const double*
     }
 }
 
+// Inner Bezier control points of segments k = 0 .. count-1, in place of their tangents: B1 = P0 + t0/3 from
+// node coordinates p0 (3 per node, segment k's start at 3k), B2 = P1 - t1/3 from p1 (its end at 3k).
+void controls_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1, double* __restrict b1x,
+                     double* __restrict b1y, double* __restrict b1z, double* __restrict b2x, double* __restrict b2y,
+                     double* __restrict b2z) {
+    for (std::size_t k = 0; k < count; ++k) {
+        b1x[k] = p0[3 * k] + b1x[k] * (1.0 / 3.0);
+        b1y[k] = p0[3 * k + 1] + b1y[k] * (1.0 / 3.0);
+        b1z[k] = p0[3 * k + 2] + b1z[k] * (1.0 / 3.0);
+        b2x[k] = p1[3 * k] - b2x[k] * (1.0 / 3.0);
+        b2y[k] = p1[3 * k + 1] - b2y[k] * (1.0 / 3.0);
+        b2z[k] = p1[3 * k + 2] - b2z[k] * (1.0 / 3.0);
+    }
+}
+
 /// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
 /// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
 /// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
@@ -763,31 +805,19 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the tube's
     // float vertices downstream.
     constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
-    std::int64_t in_range = 0;
-    {
-        const double* __restrict p = &P[0].x;  // node j's coordinates at 3j .. 3j+2
-        double* __restrict b1x = tg.t0x.data();
-        double* __restrict b1y = tg.t0y.data();
-        double* __restrict b1z = tg.t0z.data();
-        double* __restrict b2x = tg.t1x.data();
-        double* __restrict b2y = tg.t1y.data();
-        double* __restrict b2z = tg.t1z.data();
-        const auto ok = [](double v) { return std::abs(v) <= kMaxControl_m; };  // false for NaN too
-        const auto control = [&](std::size_t k, std::size_t k1) {
-            const double x1 = p[3 * k] + b1x[k] * (1.0 / 3.0), y1 = p[3 * k + 1] + b1y[k] * (1.0 / 3.0),
-                         z1 = p[3 * k + 2] + b1z[k] * (1.0 / 3.0);
-            const double x2 = p[3 * k1] - b2x[k] * (1.0 / 3.0), y2 = p[3 * k1 + 1] - b2y[k] * (1.0 / 3.0),
-                         z2 = p[3 * k1 + 2] - b2z[k] * (1.0 / 3.0);
-            b1x[k] = x1, b1y[k] = y1, b1z[k] = z1, b2x[k] = x2, b2y[k] = y2, b2z[k] = z2;
-            return static_cast<std::int64_t>(ok(x1) & ok(y1) & ok(z1) & ok(x2) & ok(y2) & ok(z2));
-        };
-        for (std::size_t k = 0; k + 1 < n; ++k) in_range += control(k, k + 1);
-        if (closed) in_range += control(n - 1, 0);
-    }
-    if (in_range != static_cast<std::int64_t>(segs)) {
+    const auto controls = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
+        controls_kernel(count, &p0->x, &p1->x, tg.t0x.data() + k0, tg.t0y.data() + k0, tg.t0z.data() + k0,
+                        tg.t1x.data() + k0, tg.t1y.data() + k0, tg.t1z.data() + k0);
+    };
+    controls(0, n - 1, P, P + 1);
+    if (closed) controls(n - 1, 1, P + (n - 1), P);
+    bool in_range = true;
+    for (const std::vector<double>* v : {&tg.t0x, &tg.t0y, &tg.t0z, &tg.t1x, &tg.t1y, &tg.t1z})
+        in_range &= all_within(v->data(), segs, kMaxControl_m);
+    if (!in_range) {
         for (std::size_t k = 0; k < segs; ++k) {
             const double v[6] = {tg.t0x[k], tg.t0y[k], tg.t0z[k], tg.t1x[k], tg.t1y[k], tg.t1z[k]};
-            if (std::all_of(v, v + 6, [](double x) { return std::abs(x) <= kMaxControl_m; })) continue;
+            if (all_within(v, 6, kMaxControl_m)) continue;
             const uint32_t src = m.first[k];
             clear_curve(out);
             return Status::error(node_prefix(src) + "tangent overflowed (alpha " + describe(settings.alpha) +
@@ -795,10 +825,13 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         }
     }
     out.closed = closed;
-    out.segments.reserve(segs);  // appended, not resized: no zero-fill of what is written next
+    out.segments.resize(segs);
+    CubicBezier* const seg = out.segments.data();
     for (std::size_t k = 0; k < segs; ++k) {
-        out.segments.push_back(CubicBezier{P[k], dvec3(tg.t0x[k], tg.t0y[k], tg.t0z[k]),
-                                           dvec3(tg.t1x[k], tg.t1y[k], tg.t1z[k]), P[k + 1 == n ? 0 : k + 1]});
+        seg[k].b0 = P[k];
+        seg[k].b1 = dvec3(tg.t0x[k], tg.t0y[k], tg.t0z[k]);
+        seg[k].b2 = dvec3(tg.t1x[k], tg.t1y[k], tg.t1z[k]);
+        seg[k].b3 = P[k + 1 == n ? 0 : k + 1];
     }
     out.source_node = m.first;
     const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : 0.01f;
