@@ -8,12 +8,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace wire {
 namespace {
@@ -91,30 +88,64 @@ Status check_settings(const SplineSettings& s) {
     return Status::success();
 }
 
+// Kernels: the vectorized loops, one function each, so that `__restrict` on their parameters tells the compiler
+// the arrays do not overlap (it does not trust that of local pointers into one buffer). Kernels with selects are
+// compiled without trapping math: GCC turns their `?:` into vector blends only then. That changes no value (every
+// operation is still performed and rounded as written; NaN comparisons keep their meaning), only whether an
+// operation whose result is discarded may raise a floating-point exception flag, which nothing here reads.
+#if defined(__GNUC__) && !defined(__clang__)
+#define WIRE_SELECT_KERNEL __attribute__((optimize("no-trapping-math")))
+#else
+#define WIRE_SELECT_KERNEL
+#endif
+// Each kernel is also compiled for AVX-512 and AVX2 machines, picked at load time (4 and 8 lanes where baseline
+// x86-64 has 2: 1.44 -> 1.12 ms for the stage on 1,000 moving 64-node wires). The same operations round the same
+// way in every instruction set, and wire_core never fuses a multiply-add (-ffp-contract=off), so the clones'
+// results are bit-identical to the baseline's.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__ELF__)
+#define WIRE_KERNEL __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define WIRE_KERNEL
+#endif
+
 // True when |v[i]| <= limit for every i < count (false for NaN and Inf): an AND of vector comparisons, no branch
 // per value.
+WIRE_KERNEL
 bool all_within(const double* v, std::size_t count, double limit) {
     std::size_t i = 0;
     bool all = true;
-#if defined(__SSE2__)
-    const __m128d lim = _mm_set1_pd(limit), sign = _mm_set1_pd(-0.0);
-    __m128d ok = _mm_cmpeq_pd(lim, lim);  // all ones (limit is a number)
-    for (; i + 2 <= count; i += 2) ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, _mm_loadu_pd(v + i)), lim));
-    all = _mm_movemask_pd(ok) == 3;
+#if defined(__GNUC__)
+    using v4d = double __attribute__((vector_size(32)));
+    using v4i = long long __attribute__((vector_size(32)));
+    const v4d hi = {limit, limit, limit, limit}, lo = -hi;
+    v4i ok = {-1, -1, -1, -1};
+    for (; i + 4 <= count; i += 4) {
+        v4d x;
+        std::memcpy(&x, v + i, sizeof x);
+        ok &= (x <= hi) & (x >= lo);
+    }
+    all = (ok[0] & ok[1] & ok[2] & ok[3]) != 0;
 #endif
     for (; i < count; ++i) all &= std::abs(v[i]) <= limit;
     return all;
 }
 
 // True when v[i] > limit for every i < count (false for NaN).
+WIRE_KERNEL
 bool all_above(const double* v, std::size_t count, double limit) {
     std::size_t i = 0;
     bool all = true;
-#if defined(__SSE2__)
-    const __m128d lim = _mm_set1_pd(limit);
-    __m128d ok = _mm_cmpeq_pd(lim, lim);  // all ones (limit is a number)
-    for (; i + 2 <= count; i += 2) ok = _mm_and_pd(ok, _mm_cmpgt_pd(_mm_loadu_pd(v + i), lim));
-    all = _mm_movemask_pd(ok) == 3;
+#if defined(__GNUC__)
+    using v4d = double __attribute__((vector_size(32)));
+    using v4i = long long __attribute__((vector_size(32)));
+    const v4d lo = {limit, limit, limit, limit};
+    v4i ok = {-1, -1, -1, -1};
+    for (; i + 4 <= count; i += 4) {
+        v4d x;
+        std::memcpy(&x, v + i, sizeof x);
+        ok &= x > lo;
+    }
+    all = (ok[0] & ok[1] & ok[2] & ok[3]) != 0;
 #endif
     for (; i < count; ++i) all &= v[i] > limit;
     return all;
@@ -207,26 +238,6 @@ struct Chords {
     double l(std::size_t k) const { return len[k + 1]; }
 };
 
-// Kernels: the vectorized loops, one function each, so that `__restrict` on their parameters tells the compiler
-// the arrays do not overlap (it does not trust that of local pointers into one buffer). Kernels with selects are
-// compiled without trapping math: GCC turns their `?:` into vector blends only then. That changes no value (every
-// operation is still performed and rounded as written; NaN comparisons keep their meaning), only whether an
-// operation whose result is discarded may raise a floating-point exception flag, which nothing here reads.
-#if defined(__GNUC__) && !defined(__clang__)
-#define WIRE_SELECT_KERNEL __attribute__((optimize("no-trapping-math")))
-#else
-#define WIRE_SELECT_KERNEL
-#endif
-// Each kernel is also compiled for AVX-512 and AVX2 machines, picked at load time (4 and 8 lanes where baseline
-// x86-64 has 2: 1.44 -> 1.12 ms for the stage on 1,000 moving 64-node wires). The same operations round the same
-// way in every instruction set, and wire_core never fuses a multiply-add (-ffp-contract=off), so the clones'
-// results are bit-identical to the baseline's.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__ELF__)
-#define WIRE_KERNEL __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define WIRE_KERNEL
-#endif
-
 // Chords k = 0 .. count-1 from node coordinates a (3 per node, node k at 3k) to b (node k + 1's at 3k).
 WIRE_KERNEL
 void chords_kernel(std::size_t count, const double* __restrict a, const double* __restrict b, double* __restrict dx,
@@ -303,64 +314,91 @@ const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m,
 // each component gets exactly the operations the vector form gave it); callers pass diagonally dominant rows.
 // Twisted ("burn at both ends") elimination: rows are eliminated from the top and from the bottom at once, meeting
 // in the middle row, so the two serial chains of one division each per row run side by side (half the latency of
-// Thomas' one chain).
+// Thomas' one chain). The chains' values are carried in registers (a store through r may not alias f or the
+// other components, so nothing is reloaded on the critical path).
 template <int C>
-void thomas(const double* a, const double* b, const double* c, std::size_t n, double* const* r) {
-    thread_local std::vector<double> fv;  // top half: c'/pivot; bottom half: a'/pivot (reused, no allocation)
-    fv.resize(n);
-    double* f = fv.data();
-    if (n < 4) {  // plain Thomas
-        double inv = 1.0 / b[0];
-        f[0] = c[0] * inv;
-        for (int q = 0; q < C; ++q) r[q][0] = r[q][0] * inv;
-        for (std::size_t i = 1; i < n; ++i) {
-            inv = 1.0 / (b[i] - a[i] * f[i - 1]);
-            f[i] = c[i] * inv;
-            for (int q = 0; q < C; ++q) r[q][i] = (r[q][i] - a[i] * r[q][i - 1]) * inv;
+void thomas_kernel(const double* __restrict a, const double* __restrict b, const double* __restrict c, std::size_t n,
+                   double* __restrict f, double* __restrict rx, double* __restrict ry, double* __restrict rz) {
+    // One row step for every component: r[i] = (r[i] - m * prev) * inv, prev = r[i].
+    const auto step = [&](std::size_t i, double m, double inv, double& px, double& py, double& pz) {
+        px = (rx[i] - m * px) * inv, rx[i] = px;
+        if constexpr (C == 3) {
+            py = (ry[i] - m * py) * inv, ry[i] = py;
+            pz = (rz[i] - m * pz) * inv, rz[i] = pz;
         }
-        for (std::size_t i = n - 1; i-- > 0;)
-            for (int q = 0; q < C; ++q) r[q][i] = r[q][i] - f[i] * r[q][i + 1];
+    };
+    const auto first = [&](std::size_t i, double inv, double& px, double& py, double& pz) {  // r[i] * inv
+        px = rx[i] * inv, rx[i] = px;
+        if constexpr (C == 3) {
+            py = ry[i] * inv, ry[i] = py;
+            pz = rz[i] * inv, rz[i] = pz;
+        }
+    };
+    const auto back = [&](std::size_t i, double& px, double& py, double& pz) {
+        px = rx[i] - f[i] * px, rx[i] = px;
+        if constexpr (C == 3) {
+            py = ry[i] - f[i] * py, ry[i] = py;
+            pz = rz[i] - f[i] * pz, rz[i] = pz;
+        }
+    };
+    double tx = 0.0, ty = 0.0, tz = 0.0;  // the top chain's last row
+    double inv = 1.0 / b[0];
+    double ft = c[0] * inv;
+    f[0] = ft;
+    first(0, inv, tx, ty, tz);
+    if (n < 4) {  // plain Thomas
+        for (std::size_t i = 1; i < n; ++i) {
+            inv = 1.0 / (b[i] - a[i] * ft);
+            ft = c[i] * inv;
+            f[i] = ft;
+            step(i, a[i], inv, tx, ty, tz);
+        }
+        for (std::size_t i = n - 1; i-- > 0;) back(i, tx, ty, tz);
         return;
     }
     const std::size_t p = n / 2;  // the meeting row; top rows 0..p-1, bottom rows p+1..n-1
-    auto top = [&](std::size_t i) {
-        const double inv = 1.0 / (b[i] - a[i] * f[i - 1]);
-        f[i] = c[i] * inv;
-        for (int q = 0; q < C; ++q) r[q][i] = (r[q][i] - a[i] * r[q][i - 1]) * inv;
-    };
-    auto bottom = [&](std::size_t j) {
-        const double inv = 1.0 / (b[j] - c[j] * f[j + 1]);
-        f[j] = a[j] * inv;
-        for (int q = 0; q < C; ++q) r[q][j] = (r[q][j] - c[j] * r[q][j + 1]) * inv;
-    };
-    double inv = 1.0 / b[0];
-    f[0] = c[0] * inv;
-    for (int q = 0; q < C; ++q) r[q][0] = r[q][0] * inv;
+    double bx = 0.0, by = 0.0, bz = 0.0;  // the bottom chain's last row
     inv = 1.0 / b[n - 1];
-    f[n - 1] = a[n - 1] * inv;
-    for (int q = 0; q < C; ++q) r[q][n - 1] = r[q][n - 1] * inv;
+    double fb = a[n - 1] * inv;
+    f[n - 1] = fb;
+    first(n - 1, inv, bx, by, bz);
+    const auto top = [&](std::size_t i) {
+        const double it = 1.0 / (b[i] - a[i] * ft);
+        ft = c[i] * it;
+        f[i] = ft;
+        step(i, a[i], it, tx, ty, tz);
+    };
+    const auto bottom = [&](std::size_t j) {
+        const double ib = 1.0 / (b[j] - c[j] * fb);
+        fb = a[j] * ib;
+        f[j] = fb;
+        step(j, c[j], ib, bx, by, bz);
+    };
     std::size_t i = 1, j = n - 2;
     for (; i < p && j > p; ++i, --j) top(i), bottom(j);
     for (; i < p; ++i) top(i);
     for (; j > p; --j) bottom(j);
     // Row p with x[p-1] = r[p-1] - f[p-1] x[p] and x[p+1] = r[p+1] - f[p+1] x[p] substituted.
-    inv = 1.0 / (b[p] - a[p] * f[p - 1] - c[p] * f[p + 1]);
-    for (int q = 0; q < C; ++q) r[q][p] = (r[q][p] - a[p] * r[q][p - 1] - c[p] * r[q][p + 1]) * inv;
+    inv = 1.0 / (b[p] - a[p] * ft - c[p] * fb);
+    tx = (rx[p] - a[p] * tx - c[p] * bx) * inv, rx[p] = tx, bx = tx;
+    if constexpr (C == 3) {
+        ty = (ry[p] - a[p] * ty - c[p] * by) * inv, ry[p] = ty, by = ty;
+        tz = (rz[p] - a[p] * tz - c[p] * bz) * inv, rz[p] = tz, bz = tz;
+    }
     for (i = p, j = p; i > 0 && j + 1 < n;) {
         --i, ++j;
-        for (int q = 0; q < C; ++q) {
-            r[q][i] = r[q][i] - f[i] * r[q][i + 1];
-            r[q][j] = r[q][j] - f[j] * r[q][j - 1];
-        }
+        back(i, tx, ty, tz);
+        back(j, bx, by, bz);
     }
-    while (i > 0) {
-        --i;
-        for (int q = 0; q < C; ++q) r[q][i] = r[q][i] - f[i] * r[q][i + 1];
-    }
-    while (j + 1 < n) {
-        ++j;
-        for (int q = 0; q < C; ++q) r[q][j] = r[q][j] - f[j] * r[q][j - 1];
-    }
+    while (i > 0) --i, back(i, tx, ty, tz);
+    while (j + 1 < n) ++j, back(j, bx, by, bz);
+}
+
+template <int C>
+void thomas(const double* a, const double* b, const double* c, std::size_t n, double* const* r) {
+    thread_local std::vector<double> fv;  // top half: c'/pivot; bottom half: a'/pivot (reused, no allocation)
+    fv.resize(n);
+    thomas_kernel<C>(a, b, c, n, fv.data(), r[0], C == 3 ? r[1] : nullptr, C == 3 ? r[2] : nullptr);
 }
 
 // Cyclic tridiagonal (corners a[0] at column n-1 and c[n-1] at column 0) by Sherman-Morrison, n >= 3.
@@ -620,6 +658,22 @@ void controls_kernel(std::size_t count, const double* __restrict p0, const doubl
     }
 }
 
+// Bezier segments k = 0 .. count-1 (12 doubles each, out at 12k) from node coordinates p0 (3 per node, segment
+// k's start at 3k), p1 (its end at 3k) and the inner control points.
+WIRE_KERNEL
+void segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
+                     const double* __restrict b1x, const double* __restrict b1y, const double* __restrict b1z,
+                     const double* __restrict b2x, const double* __restrict b2y, const double* __restrict b2z,
+                     double* __restrict out) {
+    for (std::size_t k = 0; k < count; ++k) {
+        double* o = out + 12 * k;
+        o[0] = p0[3 * k], o[1] = p0[3 * k + 1], o[2] = p0[3 * k + 2];
+        o[3] = b1x[k], o[4] = b1y[k], o[5] = b1z[k];
+        o[6] = b2x[k], o[7] = b2y[k], o[8] = b2z[k];
+        o[9] = p1[3 * k], o[10] = p1[3 * k + 1], o[11] = p1[3 * k + 2];
+    }
+}
+
 /// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
 /// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
 /// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
@@ -841,14 +895,15 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         }
     }
     out.closed = closed;
+    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
     out.segments.resize(segs);
     CubicBezier* const seg = out.segments.data();
-    for (std::size_t k = 0; k < segs; ++k) {
-        seg[k].b0 = P[k];
-        seg[k].b1 = dvec3(tg.t0x[k], tg.t0y[k], tg.t0z[k]);
-        seg[k].b2 = dvec3(tg.t1x[k], tg.t1y[k], tg.t1z[k]);
-        seg[k].b3 = P[k + 1 == n ? 0 : k + 1];
-    }
+    const auto segments = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
+        segments_kernel(count, &p0->x, &p1->x, tg.t0x.data() + k0, tg.t0y.data() + k0, tg.t0z.data() + k0,
+                        tg.t1x.data() + k0, tg.t1y.data() + k0, tg.t1z.data() + k0, &seg[k0].b0.x);
+    };
+    segments(0, n - 1, P, P + 1);
+    if (closed) segments(n - 1, 1, P + (n - 1), P);
     out.source_node = m.first;
     const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : 0.01f;
     if (nodes.radius_m.empty()) {
