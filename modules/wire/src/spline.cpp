@@ -270,13 +270,50 @@ void fill_chords(const dvec3* P, std::size_t n, bool closed, Chords& ch) {
     }
 }
 
+// Bounding box of n nodes (3 finite coordinates each, node i's at 3i) into lo and hi (3 each, HUGE_VAL and
+// -HUGE_VAL on entry). Minima and maxima are exact in any order (only the sign of a zero could depend on it, and
+// the merge reads the box only through lengths), so four nodes at a time.
+WIRE_KERNEL
+void bbox_kernel(const double* p, std::size_t n, double* lo, double* hi) {
+    std::size_t i = 0;
+#if defined(__GNUC__)
+    using v4d = double __attribute__((vector_size(32)));
+    if (n >= 4) {
+        // 12 doubles a step: x y z x | y z x y | z x y z.
+        v4d l[3], h[3];
+        for (int a = 0; a < 3; ++a) std::memcpy(&l[a], p + 4 * a, sizeof(v4d)), h[a] = l[a];
+        for (i = 4; i + 4 <= n; i += 4) {
+            for (int a = 0; a < 3; ++a) {
+                v4d x;
+                std::memcpy(&x, p + 3 * i + 4 * a, sizeof x);
+                l[a] = x < l[a] ? x : l[a];
+                h[a] = x > h[a] ? x : h[a];
+            }
+        }
+        for (int a = 0; a < 3; ++a) {
+            for (int lane = 0; lane < 4; ++lane) {
+                const int axis = (4 * a + lane) % 3;
+                lo[axis] = std::min(lo[axis], l[a][lane]);
+                hi[axis] = std::max(hi[axis], h[a][lane]);
+            }
+        }
+    }
+#endif
+    for (; i < n; ++i) {
+        for (int axis = 0; axis < 3; ++axis) {
+            lo[axis] = std::min(lo[axis], p[3 * i + axis]);
+            hi[axis] = std::max(hi[axis], p[3 * i + axis]);
+        }
+    }
+}
+
 // Coincident-node merging. Returns the curve's nodes: the input positions themselves when nothing merges (the
 // common case: decided from the input's chords, which are then the curve's), else m.p. `ch` holds the chords of
 // the returned nodes when there are at least 2 of them (3 closed).
 const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m, Chords& ch, std::size_t& count) {
     const std::size_t n = w.positions.size();
     dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-    for (const dvec3& p : w.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    bbox_kernel(n ? &w.positions[0].x : nullptr, n, &lo.x, &hi.x);
     const double diag = n ? glm::length(hi - lo) : 0.0;
     const double max_abs = n ? std::max(glm::length(lo), glm::length(hi)) : 0.0;
     const double rel = s.merge_epsilon_rel > 0.0 ? s.merge_epsilon_rel : 1e-9;
@@ -422,11 +459,13 @@ void thomas_cyclic(const double* a, const double* b, const double* c, std::size_
 }
 
 // Per-segment Hermite tangents (per unit of the segment parameter u): t0 at the start, t1 at the end; structure
-// of arrays.
+// of arrays, the six arrays one after the other in one buffer (checked in one pass).
 struct Tangents {
-    std::vector<double> t0x, t0y, t0z, t1x, t1y, t1z;
+    std::vector<double> buf;
+    double *t0x = nullptr, *t0y = nullptr, *t0z = nullptr, *t1x = nullptr, *t1y = nullptr, *t1z = nullptr;
     void resize(std::size_t segs) {
-        for (std::vector<double>* v : {&t0x, &t0y, &t0z, &t1x, &t1y, &t1z}) v->resize(segs);
+        buf.resize(6 * segs);
+        t0x = buf.data(), t0y = t0x + segs, t0z = t0y + segs, t1x = t0z + segs, t1y = t1x + segs, t1z = t1y + segs;
     }
     void set0(std::size_t k, const dvec3& v) { t0x[k] = v.x, t0y[k] = v.y, t0z[k] = v.z; }
     void set1(std::size_t k, const dvec3& v) { t1x[k] = v.x, t1y[k] = v.y, t1z[k] = v.z; }
@@ -742,9 +781,9 @@ void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const std:
         }
     }
     D[0][n] = D[0][0], D[1][n] = D[1][0], D[2][n] = D[2][0];
-    tangents_kernel(segs, D[0], len + 1, tg.t0x.data(), tg.t1x.data());
-    tangents_kernel(segs, D[1], len + 1, tg.t0y.data(), tg.t1y.data());
-    tangents_kernel(segs, D[2], len + 1, tg.t0z.data(), tg.t1z.data());
+    tangents_kernel(segs, D[0], len + 1, tg.t0x, tg.t1x);
+    tangents_kernel(segs, D[1], len + 1, tg.t0y, tg.t1y);
+    tangents_kernel(segs, D[2], len + 1, tg.t0z, tg.t1z);
 }
 
 // C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the automatic
@@ -771,8 +810,12 @@ void clear_curve(Curve& c) {
     c.closed = false;
 }
 
-Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
-    clear_curve(out);
+namespace {
+
+// build_curve without its clearing of `out` on entry: every field is overwritten on success (the segments
+// resized, not cleared first: a curve reused for the same wire is not zero-filled before it is written), and
+// build_curve clears it on failure.
+Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
     if (Status st = check_settings(settings); !st) return st;
     if (Status st = check_sizes(nodes); !st) return st;
     const bool physics = settings.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
@@ -876,15 +919,12 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     // float vertices downstream.
     constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
     const auto controls = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
-        controls_kernel(count, &p0->x, &p1->x, tg.t0x.data() + k0, tg.t0y.data() + k0, tg.t0z.data() + k0,
-                        tg.t1x.data() + k0, tg.t1y.data() + k0, tg.t1z.data() + k0);
+        controls_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0,
+                        tg.t1x + k0, tg.t1y + k0, tg.t1z + k0);
     };
     controls(0, n - 1, P, P + 1);
     if (closed) controls(n - 1, 1, P + (n - 1), P);
-    bool in_range = true;
-    for (const std::vector<double>* v : {&tg.t0x, &tg.t0y, &tg.t0z, &tg.t1x, &tg.t1y, &tg.t1z})
-        in_range &= all_within(v->data(), segs, kMaxControl_m);
-    if (!in_range) {
+    if (!all_within(tg.buf.data(), 6 * segs, kMaxControl_m)) {
         for (std::size_t k = 0; k < segs; ++k) {
             const double v[6] = {tg.t0x[k], tg.t0y[k], tg.t0z[k], tg.t1x[k], tg.t1y[k], tg.t1z[k]};
             if (all_within(v, 6, kMaxControl_m)) continue;
@@ -899,8 +939,8 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     out.segments.resize(segs);
     CubicBezier* const seg = out.segments.data();
     const auto segments = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
-        segments_kernel(count, &p0->x, &p1->x, tg.t0x.data() + k0, tg.t0y.data() + k0, tg.t0z.data() + k0,
-                        tg.t1x.data() + k0, tg.t1y.data() + k0, tg.t1z.data() + k0, &seg[k0].b0.x);
+        segments_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0,
+                        tg.t1x + k0, tg.t1y + k0, tg.t1z + k0, &seg[k0].b0.x);
     };
     segments(0, n - 1, P, P + 1);
     if (closed) segments(n - 1, 1, P + (n - 1), P);
@@ -916,6 +956,14 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
         }
     }
     return Status::success();
+}
+
+}  // namespace
+
+Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
+    Status st = build_curve_into(nodes, settings, out);
+    if (!st) clear_curve(out);
+    return st;
 }
 
 }  // namespace wire
