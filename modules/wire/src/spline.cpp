@@ -1,6 +1,8 @@
 // The curve stage: validation, coincident-node merging, analytic Hermite tangents per spline kind, Bezier form.
 #include "wire/spline.hpp"
 
+#include "wire/detail/segment_soa.hpp"  // WIRE_VECTOR_CLONES
+
 #include <glm/geometric.hpp>
 
 #include <algorithm>
@@ -11,6 +13,10 @@
 #include <cstring>
 #include <string>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace wire {
 namespace {
@@ -98,54 +104,65 @@ Status check_settings(const SplineSettings& s) {
 #else
 #define WIRE_SELECT_KERNEL
 #endif
-// Each kernel is also compiled for AVX-512 and AVX2 machines, picked at load time (4 and 8 lanes where baseline
-// x86-64 has 2: 1.44 -> 1.12 ms for the stage on 1,000 moving 64-node wires). The same operations round the same
-// way in every instruction set, and wire_core never fuses a multiply-add (-ffp-contract=off), so the clones'
-// results are bit-identical to the baseline's.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__ELF__)
-#define WIRE_KERNEL __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+// Each kernel is also compiled for AVX-512 and AVX2 machines, picked at load time (WIRE_VECTOR_CLONES: 8 and 4
+// lanes where baseline x86-64 has 2; 1.44 -> 1.12 ms for the stage on 1,000 moving 64-node wires); every clone's
+// results are bit-identical to the baseline's (see the macro).
+#define WIRE_KERNEL WIRE_VECTOR_CLONES
+
+// all_within has a second version for AVX2 machines, chosen at load time like the kernels' clones (the compiler
+// does not vectorize this reduction, and GCC's vector types split slowly on the SSE2 baseline); the same condition
+// as WIRE_VECTOR_CLONES'.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(WIRE_NO_VECTOR_CLONES) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define WIRE_RANGE_VERSIONS 1
+#define WIRE_RANGE_DEFAULT __attribute__((target("default")))
 #else
-#define WIRE_KERNEL
+#define WIRE_RANGE_DEFAULT
 #endif
 
 // True when |v[i]| <= limit for every i < count (false for NaN and Inf): an AND of vector comparisons, no branch
 // per value.
-WIRE_KERNEL
+WIRE_RANGE_DEFAULT
 bool all_within(const double* v, std::size_t count, double limit) {
     std::size_t i = 0;
     bool all = true;
-#if defined(__GNUC__)
-    using v4d = double __attribute__((vector_size(32)));
-    using v4i = long long __attribute__((vector_size(32)));
-    const v4d hi = {limit, limit, limit, limit}, lo = -hi;
-    v4i ok = {-1, -1, -1, -1};
-    for (; i + 4 <= count; i += 4) {
-        v4d x;
-        std::memcpy(&x, v + i, sizeof x);
-        ok &= (x <= hi) & (x >= lo);
-    }
-    all = (ok[0] & ok[1] & ok[2] & ok[3]) != 0;
+#if defined(__SSE2__)
+    const __m128d lim = _mm_set1_pd(limit), sign = _mm_set1_pd(-0.0);
+    __m128d ok = _mm_cmpeq_pd(lim, lim);  // all ones (limit is a number)
+    for (; i + 2 <= count; i += 2) ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, _mm_loadu_pd(v + i)), lim));
+    all = _mm_movemask_pd(ok) == 3;
 #endif
     for (; i < count; ++i) all &= std::abs(v[i]) <= limit;
     return all;
 }
 
-// True when v[i] > limit for every i < count (false for NaN).
-WIRE_KERNEL
-bool all_above(const double* v, std::size_t count, double limit) {
-    std::size_t i = 0;
-    bool all = true;
-#if defined(__GNUC__)
+#if defined(WIRE_RANGE_VERSIONS)
+__attribute__((target("avx2"))) bool all_within(const double* v, std::size_t count, double limit) {
     using v4d = double __attribute__((vector_size(32)));
     using v4i = long long __attribute__((vector_size(32)));
-    const v4d lo = {limit, limit, limit, limit};
+    const v4d hi = {limit, limit, limit, limit}, lo = -hi;
     v4i ok = {-1, -1, -1, -1};
+    std::size_t i = 0;
     for (; i + 4 <= count; i += 4) {
         v4d x;
         std::memcpy(&x, v + i, sizeof x);
-        ok &= x > lo;
+        ok &= (x <= hi) & (x >= lo);
     }
-    all = (ok[0] & ok[1] & ok[2] & ok[3]) != 0;
+    bool all = (ok[0] & ok[1] & ok[2] & ok[3]) != 0;
+    for (; i < count; ++i) all &= std::abs(v[i]) <= limit;
+    return all;
+}
+#endif
+
+// True when v[i] > limit for every i < count (false for NaN).
+bool all_above(const double* v, std::size_t count, double limit) {
+    std::size_t i = 0;
+    bool all = true;
+#if defined(__SSE2__)
+    const __m128d lim = _mm_set1_pd(limit);
+    __m128d ok = _mm_cmpeq_pd(lim, lim);  // all ones (limit is a number)
+    for (; i + 2 <= count; i += 2) ok = _mm_and_pd(ok, _mm_cmpgt_pd(_mm_loadu_pd(v + i), lim));
+    all = _mm_movemask_pd(ok) == 3;
 #endif
     for (; i < count; ++i) all &= v[i] > limit;
     return all;
@@ -272,27 +289,27 @@ void fill_chords(const dvec3* P, std::size_t n, bool closed, Chords& ch) {
 
 // Bounding box of n nodes (3 finite coordinates each, node i's at 3i) into lo and hi (3 each, HUGE_VAL and
 // -HUGE_VAL on entry). Minima and maxima are exact in any order (only the sign of a zero could depend on it, and
-// the merge reads the box only through lengths), so four nodes at a time.
+// the merge reads the box only through lengths), so two nodes at a time.
 WIRE_KERNEL
 void bbox_kernel(const double* p, std::size_t n, double* lo, double* hi) {
     std::size_t i = 0;
 #if defined(__GNUC__)
-    using v4d = double __attribute__((vector_size(32)));
-    if (n >= 4) {
-        // 12 doubles a step: x y z x | y z x y | z x y z.
-        v4d l[3], h[3];
-        for (int a = 0; a < 3; ++a) std::memcpy(&l[a], p + 4 * a, sizeof(v4d)), h[a] = l[a];
-        for (i = 4; i + 4 <= n; i += 4) {
+    using v2d = double __attribute__((vector_size(16)));  // native on the SSE2 baseline too
+    if (n >= 2) {
+        // 6 doubles (2 nodes) a step: x y | z x | y z.
+        v2d l[3], h[3];
+        for (int a = 0; a < 3; ++a) std::memcpy(&l[a], p + 2 * a, sizeof(v2d)), h[a] = l[a];
+        for (i = 2; i + 2 <= n; i += 2) {
             for (int a = 0; a < 3; ++a) {
-                v4d x;
-                std::memcpy(&x, p + 3 * i + 4 * a, sizeof x);
+                v2d x;
+                std::memcpy(&x, p + 3 * i + 2 * a, sizeof x);
                 l[a] = x < l[a] ? x : l[a];
                 h[a] = x > h[a] ? x : h[a];
             }
         }
         for (int a = 0; a < 3; ++a) {
-            for (int lane = 0; lane < 4; ++lane) {
-                const int axis = (4 * a + lane) % 3;
+            for (int lane = 0; lane < 2; ++lane) {
+                const int axis = (2 * a + lane) % 3;
                 lo[axis] = std::min(lo[axis], l[a][lane]);
                 hi[axis] = std::max(hi[axis], h[a][lane]);
             }
