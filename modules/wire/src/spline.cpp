@@ -551,14 +551,15 @@ void edge_kernel(std::size_t n, const double* __restrict tx, const double* __res
 }
 
 // Per node (arrays offset so that node i's incoming chord length, previous node's curvature and previous edge are
-// at index i, its own at i + 1, the next node's curvature at i + 2): the turn its neighbours predict, and the
-// spread's ingredients |k|, |k| + |k~| and |k - k~|^2.
+// at index i, its own at i + 1, the next node's curvature at i + 2): the turn its neighbours predict, the spread's
+// ingredients |k|, |k| + |k~| and |k - k~|^2, and flag 1 where the spread must be decided (0: the neighbours
+// predict this turn, d <= kSpreadLo, decided on squares without the root; or straight here and around).
 WIRE_KERNEL WIRE_SELECT_KERNEL
 void spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
                    const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
                    const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
                    const double* __restrict eq, double* __restrict lkv, double* __restrict sumv,
-                   double* __restrict miss2v) {
+                   double* __restrict miss2v, double* __restrict flag) {
     for (std::size_t i = 0; i < count; ++i) {
         const double hin = len[i], hout = len[i + 1];
         // Forwards along the previous edge (index i) from node i-1 (index i of k).
@@ -590,9 +591,13 @@ void spread_kernel(std::size_t count, const double* __restrict len, const double
         const double vx = kx[i + 1], vy = ky[i + 1], vz = kz[i + 1];
         const double lk = std::sqrt(vx * vx + vy * vy + vz * vz), lp = std::sqrt(px * px + py * py + pz * pz);
         const double mx = vx - px, my = vy - py, mz = vz - pz;
+        const double sum = lk + lp, miss2 = mx * mx + my * my + mz * mz;
         lkv[i] = lk;
-        sumv[i] = lk + lp;
-        miss2v[i] = mx * mx + my * my + mz * mz;
+        sumv[i] = sum;
+        miss2v[i] = miss2;
+        // sum > 0 and finite (lengths are >= 0 or NaN), and the miss beyond kSpreadLo of it.
+        const bool decide = (sum > 0.0) & (sum <= DBL_MAX) & !(miss2 <= (kSpreadLo * sum) * (kSpreadLo * sum));
+        flag[i] = decide ? 1.0 : 0.0;
     }
 }
 
@@ -604,7 +609,7 @@ void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
     g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
     if (n < 3) return;
     thread_local Pool pool;
-    pool.reset(3 * (n + 2) + 3 * (n + 1) + 5 * (n + 1) + 3 * n);
+    pool.reset(3 * (n + 2) + 3 * (n + 1) + 5 * (n + 1) + 4 * n);
     // Curvature vectors k_i = (e_out - e_in) / (mean of the two elements): |k| ~ 2 sin(phi/2) / h. Node i's at
     // index i + 1; index 0 repeats the last node's, index n + 1 the first's (wrap-around ghosts).
     double* __restrict kx = pool.carve(n + 2);
@@ -647,16 +652,17 @@ void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
     double* __restrict lkv = pool.carve(n);
     double* __restrict sumv = pool.carve(n);
     double* __restrict miss2v = pool.carve(n);
+    double* __restrict flag = pool.carve(n);
     const std::size_t first = closed ? 0 : 1, end = closed ? n : n - 1;
     spread_kernel(end - first, len + first, kx + first, ky + first, kz + first, ax + first, ay + first, az + first,
-                  ec + first, eq + first, lkv + first, sumv + first, miss2v + first);
+                  ec + first, eq + first, lkv + first, sumv + first, miss2v + first, flag + first);
     // The rare nodes whose turn the neighbours do not predict (the common case, d <= kSpreadLo: g = 0 and
-    // straight = 0, decided on squares, without the root), and not straight here and around.
+    // straight = 0), and not straight here and around: none in most wires (one vector test).
+    if (all_within(flag + first, end - first, 0.5)) return;
     static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
     for (std::size_t i = first; i < end; ++i) {
+        if (flag[i] == 0.0) continue;
         const double sum = sumv[i], miss2 = miss2v[i];
-        if (!(sum > 0.0) || !std::isfinite(sum)) continue;  // straight here and around: nothing to decide
-        if (miss2 <= (kSpreadLo * sum) * (kSpreadLo * sum)) continue;
         const double hin = len[i], hout = len[i + 1];
         const double inv_sum = 1.0 / sum;
         const double d = std::sqrt(miss2) * inv_sum;
