@@ -140,15 +140,24 @@ bool all_within(const double* v, std::size_t count, double limit) {
 __attribute__((target("avx2"))) bool all_within(const double* v, std::size_t count, double limit) {
     using v4d = double __attribute__((vector_size(32)));
     using v4i = long long __attribute__((vector_size(32)));
-    const v4d hi = {limit, limit, limit, limit}, lo = -hi;
-    v4i ok = {-1, -1, -1, -1};
+    const v4d hi = {limit, limit, limit, limit};
+    const v4i magnitude = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX};  // clears the sign bit: |x|
+    v4i ok0 = {-1, -1, -1, -1}, ok1 = ok0;
     std::size_t i = 0;
-    for (; i + 4 <= count; i += 4) {
-        v4d x;
-        std::memcpy(&x, v + i, sizeof x);
-        ok &= (x <= hi) & (x >= lo);
+    for (; i + 8 <= count; i += 8) {  // two independent chains
+        v4i x0, x1;
+        std::memcpy(&x0, v + i, sizeof x0);
+        std::memcpy(&x1, v + i + 4, sizeof x1);
+        ok0 &= reinterpret_cast<v4d>(x0 & magnitude) <= hi;
+        ok1 &= reinterpret_cast<v4d>(x1 & magnitude) <= hi;
     }
-    bool all = (ok[0] & ok[1] & ok[2] & ok[3]) != 0;
+    for (; i + 4 <= count; i += 4) {
+        v4i x;
+        std::memcpy(&x, v + i, sizeof x);
+        ok0 &= reinterpret_cast<v4d>(x & magnitude) <= hi;
+    }
+    ok0 &= ok1;
+    bool all = (ok0[0] & ok0[1] & ok0[2] & ok0[3]) != 0;
     for (; i < count; ++i) all &= std::abs(v[i]) <= limit;
     return all;
 }
