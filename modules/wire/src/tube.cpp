@@ -1,12 +1,15 @@
 // Tube mesh from ring records: sides with a duplicated seam, flat caps, closed loops; no allocation per call.
 #include "wire/tube.hpp"
 
+#include "wire/detail/segment_soa.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <vector>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -282,15 +285,78 @@ TubeCounts strip_counts(std::size_t ring_count, bool closed) {
     return {.vertices = rows * 2, .indices = (rows - 1) * 6};
 }
 
+namespace {
+/// ring_frame_quaternion_xyz() of n frames given as 6 arrays (normal x, y, z, binormal x, y, z, each the ring's
+/// float promoted to double), into 3 arrays: glm::quat_cast's operations (its four candidates, the largest by the
+/// same strict comparisons, taken by selects instead of a switch), then glm::normalize's and the sign flip, in the
+/// same order, so the result is bit for bit the one-ring function's; the loop vectorizes.
+WIRE_VECTOR_CLONES void frame_quaternions(const double* __restrict f, std::size_t n, float* __restrict qx,
+                                          float* __restrict qy, float* __restrict qz) {
+    for (std::size_t k = 0; k < n; ++k) {
+        const double rx = f[k], ry = f[n + k], rz = f[2 * n + k];
+        const double sx = f[3 * n + k], sy = f[4 * n + k], sz = f[5 * n + k];
+        // glm::cross(r, s): the matrix's third column.
+        const double tx = ry * sz - sy * rz, ty = rz * sx - sz * rx, tz = rx * sy - sx * ry;
+        // m[c][r] of dmat3(r, s, t).
+        const double m00 = rx, m01 = ry, m02 = rz, m10 = sx, m11 = sy, m12 = sz, m20 = tx, m21 = ty, m22 = tz;
+        const double four_x = m00 - m11 - m22;
+        const double four_y = m11 - m00 - m22;
+        const double four_z = m22 - m00 - m11;
+        const double four_w = m00 + m11 + m22;
+        double big = four_w;
+        int index = 0;
+        index = four_x > big ? 1 : index;
+        big = four_x > big ? four_x : big;
+        index = four_y > big ? 2 : index;
+        big = four_y > big ? four_y : big;
+        index = four_z > big ? 3 : index;
+        big = four_z > big ? four_z : big;
+        const double value = std::sqrt(big + 1.0) * 0.5;
+        const double mult = 0.25 / value;
+        const double a = (m12 - m21) * mult, b = (m20 - m02) * mult, c = (m01 - m10) * mult;
+        const double d = (m01 + m10) * mult, e = (m20 + m02) * mult, g = (m12 + m21) * mult;
+        const double w = index == 0 ? value : (index == 1 ? a : (index == 2 ? b : c));
+        const double x = index == 0 ? a : (index == 1 ? value : (index == 2 ? d : e));
+        const double y = index == 0 ? b : (index == 1 ? d : (index == 2 ? value : g));
+        const double z = index == 0 ? c : (index == 1 ? e : (index == 2 ? g : value));
+        const double len = std::sqrt((w * w + x * x) + (y * y + z * z));
+        const double inv = 1.0 / len;
+        const bool zero = len <= 0.0;  // glm::normalize's identity quaternion
+        const double nw = zero ? 1.0 : w * inv;
+        const double sign = nw < 0.0 ? -1.0 : 1.0;
+        qx[k] = static_cast<float>(sign * (zero ? 0.0 : x * inv));
+        qy[k] = static_cast<float>(sign * (zero ? 0.0 : y * inv));
+        qz[k] = static_cast<float>(sign * (zero ? 0.0 : z * inv));
+    }
+}
+}  // namespace
+
 TubeCounts write_strip(std::span<const Ring> rings, bool closed, float u_close, std::span<TubeVertex> vertices,
                        std::span<uint32_t> indices, uint32_t base_vertex) {
     const TubeCounts c = strip_counts(rings.size(), closed);
     assert(vertices.size() >= c.vertices && indices.size() >= c.indices);
     const std::size_t rows = c.vertices / 2;
+    // Every ring's frame quaternion in one vectorized pass (per-thread scratch, grown once, then reused).
+    const std::size_t n = rings.size();
+    thread_local std::vector<double> frames;
+    thread_local std::vector<float> quats;
+    frames.resize(6 * n);
+    quats.resize(3 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const Ring& ring = rings[k];
+        frames[k] = ring.normal.x;
+        frames[n + k] = ring.normal.y;
+        frames[2 * n + k] = ring.normal.z;
+        frames[3 * n + k] = ring.binormal.x;
+        frames[4 * n + k] = ring.binormal.y;
+        frames[5 * n + k] = ring.binormal.z;
+    }
+    frame_quaternions(frames.data(), n, quats.data(), quats.data() + n, quats.data() + 2 * n);
     for (std::size_t row = 0; row < rows; ++row) {
-        const Ring& ring = rings[row == rings.size() ? 0 : row];
+        const std::size_t k = row == n ? 0 : row;
+        const Ring& ring = rings[k];
         const float u = row == rings.size() ? u_close : ring.u;
-        const glm::vec3 q = ring_frame_quaternion_xyz(ring);
+        const glm::vec3 q(quats[k], quats[n + k], quats[2 * n + k]);
         vertices[2 * row] = {ring.centre_m, q, {u, -ring.radius_m}};
         vertices[2 * row + 1] = {ring.centre_m, q, {u, ring.radius_m}};
     }

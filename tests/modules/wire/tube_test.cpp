@@ -2,7 +2,9 @@
 // uv ranges, reuse without allocation, and a reference checksum.
 #include "ring_test_curves.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <random>
 
 namespace wire::test {
 namespace {
@@ -173,6 +175,62 @@ constexpr uint64_t kReferenceIndexChecksum = 7087155;
 
 // Reference: counts and a checksum of a fixed mesh. Regenerate (after an intended change) by running this test and
 // copying the printed values.
+// write_strip computes its rings' frame quaternions in one vectorized pass (glm::quat_cast's candidates taken by
+// selects, not a switch); each must be bit for bit ring_frame_quaternion_xyz() of the same ring, whichever of the
+// four candidates is the largest, with either sign, on rotations near the switch points and in float rounding.
+TEST(Tube, StripQuaternionsEqualTheOneRingFunction) {
+    std::mt19937_64 rng(20261124);
+    std::uniform_real_distribution<double> uni(-1.0, 1.0);
+    std::vector<Ring> rings;
+    auto add = [&](glm::dvec3 r, glm::dvec3 s) {
+        Ring ring;
+        ring.normal = glm::vec3(glm::normalize(r));
+        ring.binormal = glm::vec3(glm::normalize(s));
+        ring.radius_m = 0.01f;
+        rings.push_back(ring);
+    };
+    // Random rotations (all four largest-candidate cases occur), then half turns about each axis and about
+    // diagonals, where two candidates tie.
+    for (int k = 0; k < 4000; ++k) {
+        const glm::dvec3 a(uni(rng), uni(rng), uni(rng)), b(uni(rng), uni(rng), uni(rng));
+        if (glm::length(a) < 1e-3) continue;
+        const glm::dvec3 r = glm::normalize(a);
+        const glm::dvec3 s = b - glm::dot(b, r) * r;
+        if (glm::length(s) < 1e-3) continue;
+        add(r, s);
+    }
+    const double h = std::sqrt(0.5);
+    add({1, 0, 0}, {0, 1, 0});
+    add({1, 0, 0}, {0, -1, 0});
+    add({-1, 0, 0}, {0, 1, 0});
+    add({-1, 0, 0}, {0, -1, 0});
+    add({0, 1, 0}, {1, 0, 0});
+    add({0, 0, 1}, {0, 1, 0});
+    add({h, h, 0}, {h, -h, 0});
+    add({h, 0, h}, {0, 1, 0});
+    add({0, h, h}, {1, 0, 0});
+    for (int open = 0; open < 2; ++open) {
+        const bool closed = open == 0;
+        const TubeCounts c = strip_counts(rings.size(), closed);
+        std::vector<TubeVertex> vertices(c.vertices);
+        std::vector<uint32_t> indices(c.indices);
+        (void)write_strip(rings, closed, 1.0f, vertices, indices);
+        std::array<int, 4> largest{};  // which candidate was the largest, over the cases (coverage)
+        for (std::size_t k = 0; k < vertices.size() / 2; ++k) {
+            const Ring& ring = rings[k == rings.size() ? 0 : k];
+            const glm::vec3 expected = ring_frame_quaternion_xyz(ring);
+            for (int v = 0; v < 2; ++v) {
+                ASSERT_EQ(std::memcmp(&vertices[2 * k + v].normal, &expected, sizeof expected), 0)
+                    << "ring " << k << ": " << vertices[2 * k + v].normal.x << " vs " << expected.x;
+            }
+            const glm::dvec3 r(ring.normal), s(ring.binormal), t = glm::cross(r, s);
+            const double f[4] = {r.x + s.y + t.z, r.x - s.y - t.z, s.y - r.x - t.z, t.z - r.x - s.y};
+            ++largest[static_cast<std::size_t>(std::max_element(f, f + 4) - f)];
+        }
+        for (int i = 0; i < 4; ++i) EXPECT_GT(largest[static_cast<std::size_t>(i)], 10) << "candidate " << i;
+    }
+}
+
 TEST(Tube, ReferenceChecksum) {
     const RingSet set = rings_for(helix_curve(1.0, 0.3, 1, 4), 3);
     TubeMesh mesh;
