@@ -290,7 +290,7 @@ namespace {
 /// float promoted to double), into 3 arrays: glm::quat_cast's operations (its four candidates, the largest by the
 /// same strict comparisons, taken by selects instead of a switch), then glm::normalize's and the sign flip, in the
 /// same order, so the result is bit for bit the one-ring function's; the loop vectorizes.
-WIRE_VECTOR_CLONES void frame_quaternions(const double* __restrict f, std::size_t n, float* __restrict qx,
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void frame_quaternions(const double* __restrict f, std::size_t n, float* __restrict qx,
                                           float* __restrict qy, float* __restrict qz) {
     for (std::size_t k = 0; k < n; ++k) {
         const double rx = f[k], ry = f[n + k], rz = f[2 * n + k];

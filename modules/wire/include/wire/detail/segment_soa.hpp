@@ -17,6 +17,16 @@
 #define WIRE_VECTOR_CLONES
 #endif
 
+/// A kernel whose `?:` selects should become vector blends: GCC if-converts them only without trapping math. No
+/// value changes (every operation is still performed and rounded as written; NaN comparisons keep their meaning);
+/// only whether an operation whose result is discarded may raise a floating-point exception flag, which nothing
+/// here reads.
+#if defined(__GNUC__) && !defined(__clang__)
+#define WIRE_SELECT_KERNEL __attribute__((optimize("no-trapping-math")))
+#else
+#define WIRE_SELECT_KERNEL
+#endif
+
 namespace wire::detail {
 
 /// Segments' control points as 12 arrays of `n` (b0.x, b0.y, b0.z, b1.x, ... b3.z): the layout the per-segment
