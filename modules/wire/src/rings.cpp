@@ -152,29 +152,45 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     return out;
 }
 
-/// SegmentCoeffs's derivative coefficients d0, d1, d2 (component a) of segment k of n laid out by
-/// detail::transpose_segments(), the same expressions.
-inline void derivative_coeffs(const double* __restrict b, std::size_t n, std::size_t k, double d0[3], double d1[3],
-                              double d2[3]) {
-    for (int a = 0; a < 3; ++a) {
-        const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
-        d0[a] = 3.0 * (p1 - p0);
-        d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
-        d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
+/// The lengths of gauss_whole_segments() alone (a wire of one radius: u is length times u_per_m). No select, so
+/// no WIRE_SELECT_KERNEL: that attribute keeps the loop from some of its -O3 treatment (15% slower on AVX-512).
+WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n, double* __restrict length_m) {
+    for (std::size_t k = 0; k < n; ++k) {
+        double d0[3], d1[3], d2[3];
+        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
+            const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
+            d0[a] = 3.0 * (p1 - p0);
+            d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
+            d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
+        }
+        double len = 0.0;
+        for (int q = 0; q < kGlPoints; ++q) {
+            const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
+            const double x = d0[0] + t * (d1[0] + t * d2[0]);
+            const double y = d0[1] + t * (d1[1] + t * d2[1]);
+            const double z = d0[2] + t * (d1[2] + t * d2[2]);
+            len += (1.0 * kGlW[q]) * std::sqrt(x * x + y * y + z * z);
+        }
+        length_m[k] = len;
     }
 }
 
 /// integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for the n segments laid out by detail::transpose_segments(): the
 /// same operations in the same order. constant[k] != 0: a constant-radius segment, u = length u_per_m[k]; else u
 /// integrates speed / radius (the segment's radius polynomial r0 + t (r1 + t (r2 + t r3))), times u_scale[k].
-WIRE_VECTOR_CLONES void gauss_whole_segments(const double* __restrict b, std::size_t n,
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void gauss_whole_segments(const double* __restrict b, std::size_t n,
                                              const double* __restrict constant, const double* __restrict u_per_m, const double* __restrict u_scale,
                                              const double* __restrict r0, const double* __restrict r1,
                                              const double* __restrict r2, const double* __restrict r3,
                                              double* __restrict length_m, double* __restrict u) {
     for (std::size_t k = 0; k < n; ++k) {
         double d0[3], d1[3], d2[3];
-        derivative_coeffs(b, n, k, d0, d1, d2);
+        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
+            const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
+            d0[a] = 3.0 * (p1 - p0);
+            d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
+            d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
+        }
         double len = 0.0, u_varying = 0.0;
         for (int q = 0; q < kGlPoints; ++q) {
             const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
@@ -184,7 +200,8 @@ WIRE_VECTOR_CLONES void gauss_whole_segments(const double* __restrict b, std::si
             const double w = 1.0 * kGlW[q];
             const double speed = std::sqrt(x * x + y * y + z * z);
             len += w * speed;
-            u_varying += w * speed / std::max(r0[k] + t * (r1[k] + t * (r2[k] + t * r3[k])), 1e-30);
+            const double radius = r0[k] + t * (r1[k] + t * (r2[k] + t * r3[k]));
+            u_varying += w * speed / (radius < 1e-30 ? 1e-30 : radius);  // std::max(radius, 1e-30)
         }
         length_m[k] = len;
         u[k] = constant[k] != 0.0 ? len * u_per_m[k] : u_varying * u_scale[k];
@@ -225,7 +242,8 @@ struct SegmentTables {
         double* const r1 = r0 + n;
         double* const r2 = r1 + n;
         double* const r3 = r2 + n;
-        if (uniform_radius(curve)) {
+        const bool uniform = uniform_radius(curve);
+        if (uniform) {
             // One radius (or none): every segment is constant-radius (both node slopes 0, so r1 = r2 = r3 = 0
             // exactly); SegmentCoeffs::load's u_per_m without its per-segment slope work.
             const double r = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
@@ -255,7 +273,12 @@ struct SegmentTables {
                 r3[k] = c.r3;
             }
         }
-        gauss_whole_segments(soa.data(), n, constant, u_per_m, u_scale, r0, r1, r2, r3, length_m.data(), u.data());
+        if (uniform) {
+            gauss_whole_lengths(soa.data(), n, length_m.data());
+            for (std::size_t k = 0; k < n; ++k) u[k] = length_m[k] * u_per_m[k];  // integrate()'s constant case
+        } else {
+            gauss_whole_segments(soa.data(), n, constant, u_per_m, u_scale, r0, r1, r2, r3, length_m.data(), u.data());
+        }
         if (with_tangents) {
             detail::boundary_tangents(soa.data(), n, tangent.data(), tangent.data() + n, tangent.data() + 2 * n,
                                       tangent.data() + 3 * n);
