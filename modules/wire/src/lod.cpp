@@ -216,22 +216,6 @@ uint32_t hysteresis_count(uint32_t old_count, uint32_t raw_count, double band) {
     return std::min(old_count, raw_count + 1 + raw_count / 8);
 }
 
-BoundingSphere curve_bounding_sphere(const Curve& curve) {
-    if (curve.segments.empty()) return {};
-    glm::dvec3 lo(std::numeric_limits<double>::infinity());
-    glm::dvec3 hi(-std::numeric_limits<double>::infinity());
-    for (const CubicBezier& c : curve.segments)
-        for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-    double radius = 0.0;
-    for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
-    const glm::dvec3 centre = 0.5 * (lo + hi);
-    // Round the radius up by a relative hair so rounding in the centre cannot leave a corner outside.
-    return {centre, (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
-}
-
 namespace {
 
 /// Tube, strip (2) or line (1) for a projected radius. Hysteresis: a thinner mode used last update is kept
@@ -501,6 +485,7 @@ struct SpanKernels {
     void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
     void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
     void (*ratios)(const double*, std::size_t, const RatioConstants&, double*);
+    void (*box)(const CubicBezier*, std::size_t, double*, double*);
 };
 // The widest the CPU has; WIRE_LOD_LANES=2 or 4 in the environment caps the width (to compare the paths: every
 // width gives the same bits).
@@ -511,13 +496,13 @@ SpanKernels choose_span_kernels() {
     __builtin_cpu_init();
     if (lanes >= 8 && __builtin_cpu_supports("avx512f"))
         return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::hull_depth_kernel,
-                span_avx512::wang_roots, span_avx512::span_ratios};
+                span_avx512::wang_roots, span_avx512::span_ratios, span_avx512::wire_box};
     if (lanes >= 4 && __builtin_cpu_supports("avx2"))
         return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel,
-                span_avx2::wang_roots, span_avx2::span_ratios};
+                span_avx2::wang_roots, span_avx2::span_ratios, span_avx2::wire_box};
 #endif
     return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::hull_depth_kernel,
-            span_sse2::wang_roots, span_sse2::span_ratios};
+            span_sse2::wang_roots, span_sse2::span_ratios, span_sse2::wire_box};
 }
 const SpanKernels& span_kernels() {
     static const SpanKernels kernels = choose_span_kernels();
@@ -1226,6 +1211,37 @@ double largest_radius(const std::vector<float>& radii) {
 }
 
 }  // namespace
+
+BoundingSphere curve_bounding_sphere(const Curve& curve) {
+    // The box of all control points: std::min / std::max (glm::min / glm::max) over b0, b1, b2, b3 of every
+    // segment in sequence from +inf (-inf), here as 12 lanes (wire_box), a zero redone in sequence; the radius
+    // std::max(0.0, r) over the radii in sequence. compute_lod_bounds() gets the same sphere from its boxes.
+    const std::size_t n = curve.segments.size();
+    if (n == 0) return {};
+    double lo12[12], hi12[12];
+    span_kernels().box(curve.segments.data(), n, lo12, hi12);
+    glm::dvec3 lo(0.0), hi(0.0);
+    for (int c = 0; c < 3; ++c) {
+        double l = min_of(min_of(lo12[c], lo12[c + 3]), min_of(lo12[c + 6], lo12[c + 9]));
+        double h = max_of(max_of(hi12[c], hi12[c + 3]), max_of(hi12[c + 6], hi12[c + 9]));
+        if (l == 0.0 || h == 0.0) {
+            double sl = std::numeric_limits<double>::infinity(), sh = -std::numeric_limits<double>::infinity();
+            for (const CubicBezier& s : curve.segments)
+                for (const glm::dvec3* q : {&s.b0, &s.b1, &s.b2, &s.b3}) {
+                    sl = min_of(sl, (*q)[c]);
+                    sh = max_of(sh, (*q)[c]);
+                }
+            l = sl;
+            h = sh;
+        }
+        lo[c] = l;
+        hi[c] = h;
+    }
+    const double radius = largest_radius(curve.radius_m);
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    // Round the radius up by a relative hair so rounding in the centre cannot leave a corner outside.
+    return {centre, (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
+}
 
 void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     const std::size_t n = curve.segment_count();

@@ -266,3 +266,43 @@ inline void span_ratios(const double* node, std::size_t w, const RatioConstants&
 #endif
     for (; j < w; ++j) run(j, L1{});
 }
+
+// The wire's box as curve_bounding_sphere() computes it, as 12 running minima and maxima (lo, hi): lane j of the
+// 12 takes double j of every segment (b0.x b0.y b0.z b1.x ... b3.z), from +inf (-inf), in segment order, two
+// accumulators for even and odd segments (two dependency chains), merged at the end. A coordinate's minimum over
+// its 4 lanes is then the sequence's value (a NaN is skipped as the sequence skips it) unless it is a zero: the
+// caller redoes a zero in order. 12 doubles are 6 L2 or 3 L4 vectors (L4 also serves the 8-lane build).
+inline void wire_box(const CubicBezier* seg, std::size_t n, double* lo, double* hi) {
+#if defined(WIRE_LOD_TAIL4)
+    using B = L4;
+#else
+    using B = W;
+#endif
+    static_assert(12 % B::width == 0);
+    constexpr std::size_t v = 12 / B::width;
+    const double* p = &seg[0].b0.x;
+    B lo0[v], hi0[v], lo1[v], hi1[v];
+    for (std::size_t k = 0; k < v; ++k) {
+        lo0[k] = lo1[k] = B::splat(std::numeric_limits<double>::infinity());
+        hi0[k] = hi1[k] = B::splat(-std::numeric_limits<double>::infinity());
+    }
+    std::size_t i = 0;
+    for (; i + 2 <= n; i += 2)
+        for (std::size_t k = 0; k < v; ++k) {
+            const B a = B::load(p + 12 * i + k * B::width), b = B::load(p + 12 * (i + 1) + k * B::width);
+            lo0[k] = min_of(lo0[k], a);
+            hi0[k] = max_of(hi0[k], a);
+            lo1[k] = min_of(lo1[k], b);
+            hi1[k] = max_of(hi1[k], b);
+        }
+    if (i < n)
+        for (std::size_t k = 0; k < v; ++k) {
+            const B a = B::load(p + 12 * i + k * B::width);
+            lo0[k] = min_of(lo0[k], a);
+            hi0[k] = max_of(hi0[k], a);
+        }
+    for (std::size_t k = 0; k < v; ++k) {
+        min_of(lo0[k], lo1[k]).store(lo + k * B::width);
+        max_of(hi0[k], hi1[k]).store(hi + k * B::width);
+    }
+}

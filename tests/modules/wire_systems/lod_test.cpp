@@ -18,6 +18,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -569,6 +570,71 @@ TEST(LodCulling, BoundingSphereCullGivesTheSameLodAsTheHullTest) {
     // Both outcomes occur, so the comparison means something.
     EXPECT_GT(culled_by_sphere, 60);
     EXPECT_GT(visible, 60);
+}
+
+// curve_bounding_sphere() runs in lanes (running minima per control-point slot, a zero redone in order); it must
+// give the bits of the plain sequence glm::min / glm::max over b0..b3 of every segment, over random control points
+// with signed zeros (the one value with two encodings), NaN, repeated values and every length from 1 to 70
+// segments (the lanes' tails), and compute_lod_bounds() the same sphere for the ones without NaN.
+TEST(LodBoundingSphere, EqualsTheSequenceBitForBit) {
+    Rng rng(77);
+    auto bits = [](double x) { return std::bit_cast<uint64_t>(x); };
+    std::size_t zeros = 0, nans = 0;
+    for (int i = 0; i < 2000; ++i) {
+        Curve curve;
+        const std::size_t n = 1 + static_cast<std::size_t>(i % 70);
+        curve.segments.resize(n);
+        const double scale = std::pow(10.0, uniform(rng, -3.0, 8.0));
+        // 0: plain, 1: many zeros of both signs, 2: few distinct values, 3: a NaN too, 4: only zeros and NaN (where
+        // the sign of a zero shows in the centre)
+        const int mode = i % 5;
+        bool has_nan = false;
+        for (CubicBezier& c : curve.segments)
+            for (glm::dvec3* p : {&c.b0, &c.b1, &c.b2, &c.b3})
+                for (int k = 0; k < 3; ++k) {
+                    double v = uniform(rng, -scale, scale);
+                    if (mode == 1) {
+                        // Zeros of both signs; x otherwise positive (a zero minimum), y negative (a zero maximum),
+                        // z only zeros (both).
+                        v = k == 0 ? std::abs(v) : k == 1 ? -std::abs(v) : 0.0;
+                        if (k == 2 || uniform(rng, 0.0, 1.0) < 0.3) v = uniform(rng, 0.0, 1.0) < 0.5 ? 0.0 : -0.0;
+                    }
+                    if (mode == 2) v = std::floor(uniform(rng, -2.0, 2.0));
+                    if (mode == 4) v = uniform(rng, 0.0, 1.0) < 0.5 ? 0.0 : -0.0;
+                    if ((mode == 3 && uniform(rng, 0.0, 1.0) < 0.02) || (mode == 4 && uniform(rng, 0.0, 1.0) < 0.3)) {
+                        v = std::numeric_limits<double>::quiet_NaN();
+                        has_nan = true;
+                    }
+                    (*p)[k] = v;
+                }
+        curve.radius_m.resize(n + 1);
+        for (float& r : curve.radius_m) r = static_cast<float>(uniform(rng, 0.0, 0.05));
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (const CubicBezier& c : curve.segments)
+            for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
+                lo = glm::min(lo, p);
+                hi = glm::max(hi, p);
+            }
+        double radius = 0.0;
+        for (const float r : curve.radius_m) radius = std::max(radius, static_cast<double>(r));
+        const glm::dvec3 centre = 0.5 * (lo + hi);
+        const double expected_r = (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius;
+        const BoundingSphere got = curve_bounding_sphere(curve);
+        for (int k = 0; k < 3; ++k) {
+            zeros += (lo[k] == 0.0 || hi[k] == 0.0) ? 1u : 0u;
+            ASSERT_EQ(bits(got.centre_m[k]), bits(centre[k])) << "case " << i << " axis " << k;
+        }
+        ASSERT_EQ(bits(got.radius_m), bits(expected_r)) << "case " << i;
+        nans += has_nan ? 1u : 0u;
+        if (!has_nan) {
+            LodBounds bounds;
+            compute_lod_bounds(curve, bounds);
+            for (int k = 0; k < 3; ++k) ASSERT_EQ(bits(bounds.sphere.centre_m[k]), bits(centre[k])) << "case " << i;
+            ASSERT_EQ(bits(bounds.sphere.radius_m), bits(expected_r)) << "case " << i;
+        }
+    }
+    EXPECT_GT(zeros, 1000u);  // the zero path is exercised
+    EXPECT_GT(nans, 200u);
 }
 
 // The cheap pass (per-wire bound, then per-segment work only where needed) leaves exactly the state of the
