@@ -1243,7 +1243,9 @@ BoundingSphere curve_bounding_sphere(const Curve& curve) {
     return {centre, (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
 }
 
-void compute_lod_bounds(const Curve& curve, LodBounds& out) {
+namespace {
+
+void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingSphere* known_sphere) {
     const std::size_t n = curve.segment_count();
     out.segments = n;
     out.sphere = BoundingSphere{};  // curve_bounding_sphere(curve), from the level-0 boxes below
@@ -1285,13 +1287,15 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     }
     const SpanKernels& kernels = span_kernels();
     kernels.level0(curve.segments.data(), n, out.level_data(0), wang, sc.boxes.data(), sc.ends[0].data());
-    {
-        // The wire's box and the largest M (M is never -0: a root of a sum of squares).
+    double unused = 0.0;
+    deviation_range(wang, n, unused, out.wang_m_max);  // the largest M (M is never -0: a root of a sum of squares)
+    if (known_sphere != nullptr) {
+        out.sphere = *known_sphere;
+    } else {
+        // The wire's box.
         const double* b = sc.boxes.data();
         const glm::dvec3 lo(ordered_min(b, n), ordered_min(b + n, n), ordered_min(b + 2 * n, n));
         const glm::dvec3 hi(ordered_max(b + 3 * n, n), ordered_max(b + 4 * n, n), ordered_max(b + 5 * n, n));
-        double unused = 0.0;
-        deviation_range(wang, n, unused, out.wang_m_max);
         // curve_bounding_sphere(curve): the same box (the same minima and maxima), the same rounding.
         const double radius = out.radius_max_m;
         out.sphere = {0.5 * (lo + hi), (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
@@ -1304,6 +1308,14 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out) {
     for (std::size_t l = 0; l < levels; ++l)
         deviation_range(out.level_data(l) + 4 * out.level_width(l), out.level_width(l), out.data[2 * l],
                         out.data[2 * l + 1]);
+}
+
+}  // namespace
+
+void compute_lod_bounds(const Curve& curve, LodBounds& out) { compute_lod_bounds_impl(curve, out, nullptr); }
+
+void compute_lod_bounds(const Curve& curve, LodBounds& out, const BoundingSphere& sphere) {
+    compute_lod_bounds_impl(curve, out, &sphere);
 }
 
 SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_m, const LodView& view,

@@ -575,7 +575,8 @@ TEST(LodCulling, BoundingSphereCullGivesTheSameLodAsTheHullTest) {
 // curve_bounding_sphere() runs in lanes (running minima per control-point slot, a zero redone in order); it must
 // give the bits of the plain sequence glm::min / glm::max over b0..b3 of every segment, over random control points
 // with signed zeros (the one value with two encodings), NaN, repeated values and every length from 1 to 70
-// segments (the lanes' tails), and compute_lod_bounds() the same sphere for the ones without NaN.
+// segments (the lanes' tails), and compute_lod_bounds() the same sphere for the ones without NaN (and the same
+// bounds when given that sphere).
 TEST(LodBoundingSphere, EqualsTheSequenceBitForBit) {
     Rng rng(77);
     auto bits = [](double x) { return std::bit_cast<uint64_t>(x); };
@@ -631,6 +632,18 @@ TEST(LodBoundingSphere, EqualsTheSequenceBitForBit) {
             compute_lod_bounds(curve, bounds);
             for (int k = 0; k < 3; ++k) ASSERT_EQ(bits(bounds.sphere.centre_m[k]), bits(centre[k])) << "case " << i;
             ASSERT_EQ(bits(bounds.sphere.radius_m), bits(expected_r)) << "case " << i;
+            // Given the sphere (as the LOD stage gives it the curve stage's), the same bounds.
+            LodBounds given;
+            compute_lod_bounds(curve, given, got);
+            ASSERT_EQ(given.segments, bounds.segments);
+            ASSERT_EQ(given.levels, bounds.levels);
+            ASSERT_EQ(bits(given.radius_max_m), bits(bounds.radius_max_m));
+            ASSERT_EQ(bits(given.wang_m_max), bits(bounds.wang_m_max));
+            ASSERT_EQ(bits(given.sphere.radius_m), bits(bounds.sphere.radius_m));
+            for (int k = 0; k < 3; ++k) ASSERT_EQ(bits(given.sphere.centre_m[k]), bits(bounds.sphere.centre_m[k]));
+            ASSERT_EQ(given.data.size(), bounds.data.size());
+            for (std::size_t j = 0; j < given.data.size(); ++j)
+                ASSERT_EQ(bits(given.data[j]), bits(bounds.data[j])) << "case " << i << " entry " << j;
         }
     }
     EXPECT_GT(zeros, 1000u);  // the zero path is exercised

@@ -222,6 +222,9 @@ struct LodBounds {
 
 /// Fills `out` for `curve` (reuses its capacity).
 void compute_lod_bounds(const Curve& curve, LodBounds& out);
+/// The same, given the wire's sphere: `sphere` must be curve_bounding_sphere(curve) (which is what the first form
+/// computes for LodBounds::sphere, bit for bit); it is taken as it is instead of being computed again.
+void compute_lod_bounds(const Curve& curve, LodBounds& out, const BoundingSphere& sphere);
 
 /// The per-wire conservative bound: what one sphere (centre_m, radius_m) tells about the view without looking
 /// inside it. Shared by the LOD pass and anything else that must decide a wire in O(1) per camera.

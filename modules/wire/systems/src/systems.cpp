@@ -256,11 +256,17 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             ++c.generation;
             // The LOD's O(1) cull test; its LodBounds are the LOD stage's (WireCurve::lod_bounds).
             c.bounds = sphere.radius_m >= 0.0 ? sphere : curve_bounding_sphere(c.curve);
+            c.bounds_generation = c.generation;
             job.changed = true;
             c.previous_nodes = nodes;
             c.released = stays_released;
             job.kept_released = stays_released;
-        } else if (c.released) {
+        } else {
+            // The multires path may have put its last state back into `curve` (or restore_curve below rebuilds
+            // it): `bounds` is not known to be its sphere.
+            c.bounds_generation = 0;
+        }
+        if (!job.status.ok && c.released) {
             // Invalid nodes: the wire keeps its last valid curve, which was released. The multires path has
             // already put it back (it shows its last state on failure); the fast path leaves it empty.
             if (!c.curve.segments.empty()) {
@@ -361,11 +367,17 @@ void lod_system(Registry& registry, WireContext& ctx) {
         } else if (curve_changed) {
             // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
             thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
-            compute_lod_bounds(c.curve, scratch);
+            if (c.bounds_generation == c.generation)
+                compute_lod_bounds(c.curve, scratch, c.bounds);  // the curve stage's sphere of this curve
+            else
+                compute_lod_bounds(c.curve, scratch);
             changed = update_lod(c.curve, ctx.view, settings, s.lod, scratch);
         } else {
             // Same curve as the last LOD update, new camera: keep the bounds for the next camera.
-            compute_lod_bounds(c.curve, c.lod_bounds);
+            if (c.bounds_generation == c.generation)
+                compute_lod_bounds(c.curve, c.lod_bounds, c.bounds);
+            else
+                compute_lod_bounds(c.curve, c.lod_bounds);
             c.lod_bounds_generation = c.generation;
             changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
         }

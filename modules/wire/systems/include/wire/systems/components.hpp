@@ -50,6 +50,9 @@ struct WireCurve {
     uint64_t generation = 0;           ///< +1 each time `curve` changes (or is rebuilt after a release)
     BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test); kept
                                        ///< while released
+    uint64_t bounds_generation = 0;    ///< `generation` whose curve `bounds` was computed from (0: none known; a
+                                       ///< failed update may rewrite `curve`): then the LOD stage takes `bounds`
+                                       ///< as the LodBounds' sphere instead of computing it again
     /// The LOD's per-wire bound and spans of `curve` (lod.hpp), kept only by a visible wire whose curve did not
     /// change since its last LOD update (a static wire that sees the camera move: WireLod::Coherence reuses them
     /// while their version stands). A wire whose curve changed this frame gets them in per-thread scratch of the
