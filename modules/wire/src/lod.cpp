@@ -549,7 +549,16 @@ public:
 
     // ratio() of every node of a level at once (a lane kernel), computed when the walk first needs the level.
     [[nodiscard]] double level_ratio(std::size_t level, std::size_t j) const {
-        if (((ready_ >> level) & 1u) == 0) {
+        if (((ready_ >> level) & 1u) == 0) fill_level_ratios(level);
+        const std::size_t s = first(level, j), e = last(level, j);
+        if (e - s > 1 && closed_ && 3 * (e - s) > b_.segments) {
+            return std::numeric_limits<double>::infinity();  // a loop keeps >= 3 intervals
+        }
+        return ratios_[b_.level_start[level] + j];
+    }
+    // Out of line: once per level, so the walk's own frame stays small.
+    [[gnu::noinline]] void fill_level_ratios(std::size_t level) const {
+        {
             if (ratios_.size() < b_.data.size()) ratios_.resize(b_.data.size());
             RatioConstants rc{};
             for (int c = 0; c < 3; ++c)
@@ -571,11 +580,6 @@ public:
                                   ratios_.data() + b_.level_start[level]);
             ready_ |= uint64_t{1} << level;
         }
-        const std::size_t s = first(level, j), e = last(level, j);
-        if (e - s > 1 && closed_ && 3 * (e - s) > b_.segments) {
-            return std::numeric_limits<double>::infinity();  // a loop keeps >= 3 intervals
-        }
-        return ratios_[b_.level_start[level] + j];
     }
 
     [[nodiscard]] std::size_t root_level() const { return b_.levels - 1; }
@@ -682,7 +686,7 @@ public:
     // counts intervals that cross more than one segment.
     uint32_t apply(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
         uint32_t spans = 0;
-        walk(root_level(), 0, false, required, counts, spans);
+        walk(root_level(), 0, false, required.data(), counts.data(), spans);
         return spans;
     }
 
@@ -693,35 +697,39 @@ private:
             if (old_[i] != 0) return false;
         return true;
     }
-    static void set_span(std::vector<uint32_t>& v, std::size_t s, std::size_t e) {
+    static void set_span(uint32_t* v, std::size_t s, std::size_t e) {
         v[s] = 1;
         for (std::size_t i = s + 1; i < e; ++i) v[i] = 0;
     }
-    void walk(std::size_t level, std::size_t j, bool required_done, std::vector<uint32_t>& required,
-              std::vector<uint32_t>& counts, uint32_t& spans) const {
-        const std::size_t s = first(level, j), e = last(level, j);
-        if (s >= e) return;
-        // Levels the wire-wide bounds decide: every node fits (at the strictest threshold), or none does.
-        double r = 0.0;
-        if (level >= fail_level_) {
-            r = std::numeric_limits<double>::infinity();
-        } else if (static_cast<std::ptrdiff_t>(level) > fit_level_) {
-            r = level_ratio(level, j);
-            note(r);
+    // Depth first, left child before right; the right child is walked by the loop (no second call).
+    void walk(std::size_t level, std::size_t j, bool required_done, uint32_t* required, uint32_t* counts,
+              uint32_t& spans) const {
+        for (;;) {
+            const std::size_t s = first(level, j), e = last(level, j);
+            if (s >= e) return;
+            // Levels the wire-wide bounds decide: every node fits (at the strictest threshold), or none does.
+            double r = 0.0;
+            if (level >= fail_level_) {
+                r = std::numeric_limits<double>::infinity();
+            } else if (static_cast<std::ptrdiff_t>(level) > fit_level_) {
+                r = level_ratio(level, j);
+                note(r);
+            }
+            if (!required_done && r <= 1.0) {
+                set_span(required, s, e);
+                required_done = true;
+            }
+            if (r <= new_scale_ ||
+                (r <= 1.0 && was_merged(s, e))) {  // counts_scale() without the scan when decided
+                set_span(counts, s, e);
+                spans += e - s > 1 ? 1u : 0u;
+                return;
+            }
+            if (level == 0) return;
+            walk(level - 1, 2 * j, required_done, required, counts, spans);
+            --level;
+            j = 2 * j + 1;
         }
-        if (!required_done && r <= 1.0) {
-            set_span(required, s, e);
-            required_done = true;
-        }
-        if (r <= new_scale_ ||
-            (r <= 1.0 && was_merged(s, e))) {  // counts_scale() without the scan when decided
-            set_span(counts, s, e);
-            spans += e - s > 1 ? 1u : 0u;
-            return;
-        }
-        if (level == 0) return;
-        walk(level - 1, 2 * j, required_done, required, counts, spans);
-        walk(level - 1, 2 * j + 1, required_done, required, counts, spans);
     }
 
     const LodBounds& b_;
