@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <vector>
@@ -235,6 +236,30 @@ WIRE_VECTOR_CLONES void boundary_tangents_kernel(const double* __restrict b, std
     }
 }
 }  // namespace
+
+WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
+    static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
+    using V = double __attribute__((vector_size(32)));  // 4 doubles (two SSE registers on the baseline)
+    if (n == 0) return;
+    const double* in = &segments[0].b0.x;
+    std::size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+        for (std::size_t g = 0; g < 3; ++g) {  // doubles 4g .. 4g + 3 of each of the four segments
+            V r[4];
+            for (std::size_t s = 0; s < 4; ++s) std::memcpy(&r[s], in + 12 * (k + s) + 4 * g, sizeof(V));
+            const V t0 = __builtin_shufflevector(r[0], r[1], 0, 4, 2, 6);
+            const V t1 = __builtin_shufflevector(r[0], r[1], 1, 5, 3, 7);
+            const V t2 = __builtin_shufflevector(r[2], r[3], 0, 4, 2, 6);
+            const V t3 = __builtin_shufflevector(r[2], r[3], 1, 5, 3, 7);
+            const V c[4] = {__builtin_shufflevector(t0, t2, 0, 1, 4, 5), __builtin_shufflevector(t1, t3, 0, 1, 4, 5),
+                            __builtin_shufflevector(t0, t2, 2, 3, 6, 7), __builtin_shufflevector(t1, t3, 2, 3, 6, 7)};
+            for (std::size_t j = 0; j < 4; ++j) std::memcpy(out + (4 * g + j) * n + k, &c[j], sizeof(V));
+        }
+    }
+    for (; k < n; ++k) {
+        for (std::size_t j = 0; j < 12; ++j) out[j * n + k] = in[12 * k + j];
+    }
+}
 
 void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty, double* tz, double* ok) {
     boundary_tangents_kernel(soa, n, tx, ty, tz, ok);

@@ -1,6 +1,7 @@
 // Tube mesh: counts, watertight (welded) with caps and on closed loops, outward CCW winding, flat caps, seam and
 // uv ranges, reuse without allocation, and a reference checksum.
 #include "ring_test_curves.hpp"
+#include "wire/detail/segment_soa.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -228,6 +229,30 @@ TEST(Tube, StripQuaternionsEqualTheOneRingFunction) {
             ++largest[static_cast<std::size_t>(std::max_element(f, f + 4) - f)];
         }
         for (int i = 0; i < 4; ++i) EXPECT_GT(largest[static_cast<std::size_t>(i)], 10) << "candidate " << i;
+    }
+}
+
+// The ring stage's structure-of-arrays copy of a curve's segments (four at a time by 4x4 transposes, the rest one
+// by one): every double lands where the per-segment kernels read it, for counts around the block size.
+TEST(SegmentSoa, TransposeMovesEveryControlPoint) {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> uni(-1e3, 1e3);
+    for (std::size_t n : {0u, 1u, 3u, 4u, 5u, 8u, 11u, 63u, 64u}) {
+        std::vector<CubicBezier> segments(n);
+        for (CubicBezier& c : segments) {
+            for (glm::dvec3* p : {&c.b0, &c.b1, &c.b2, &c.b3}) *p = {uni(rng), uni(rng), uni(rng)};
+        }
+        std::vector<double> out(12 * n, -1.0);
+        detail::transpose_segments(segments.data(), n, out.data());
+        for (std::size_t k = 0; k < n; ++k) {
+            const glm::dvec3* p[4] = {&segments[k].b0, &segments[k].b1, &segments[k].b2, &segments[k].b3};
+            for (std::size_t j = 0; j < 4; ++j) {
+                for (int a = 0; a < 3; ++a) {
+                    ASSERT_EQ(out[(3 * j + static_cast<std::size_t>(a)) * n + k], (*p[j])[a])
+                        << "n " << n << " segment " << k << " point " << j << " axis " << a;
+                }
+            }
+        }
     }
 }
 

@@ -30,18 +30,9 @@
 namespace wire::detail {
 
 /// Segments' control points as 12 arrays of `n` (b0.x, b0.y, b0.z, b1.x, ... b3.z): the layout the per-segment
-/// loops vectorize over (an array of 96-byte Bezier records is a gather the compiler does not vectorize).
-inline void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
-    for (std::size_t k = 0; k < n; ++k) {
-        const CubicBezier& c = segments[k];
-        const glm::dvec3* p[4] = {&c.b0, &c.b1, &c.b2, &c.b3};
-        for (int j = 0; j < 4; ++j) {
-            out[(3 * j + 0) * n + k] = p[j]->x;
-            out[(3 * j + 1) * n + k] = p[j]->y;
-            out[(3 * j + 2) * n + k] = p[j]->z;
-        }
-    }
-}
+/// loops vectorize over (an array of 96-byte Bezier records is a gather the compiler does not vectorize). Four
+/// segments at a time by three 4x4 transposes of their 12 doubles (in frames.cpp).
+void transpose_segments(const CubicBezier* segments, std::size_t n, double* out);
 
 /// Unit tangents at t = 0 of `n` segments given as transpose_segments() lays them out: B'(0) = 3 (b1 - b0) times
 /// the reciprocal of its length, the operations build_rings uses for a ring at t = 0 (a crossed segment boundary
