@@ -242,21 +242,29 @@ struct SegmentTables {
         double* const r1 = r0 + n;
         double* const r2 = r1 + n;
         double* const r3 = r2 + n;
-        const bool uniform = uniform_radius(curve);
+        uniform = uniform_radius(curve);
         if (uniform) {
             // One radius (or none): every segment is constant-radius (both node slopes 0, so r1 = r2 = r3 = 0
-            // exactly); SegmentCoeffs::load's u_per_m without its per-segment slope work.
-            const double r = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
-            const double r_safe = std::max(r, 1e-30);
+            // exactly); SegmentCoeffs::load's u_per_m without its per-segment slope work, and only it is kept.
+            uniform_r = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
+            const double r_safe = std::max(uniform_r, 1e-30);
             const std::size_t n_stretch = std::min(curve.stretch.size(), n);
-            for (std::size_t k = 0; k < n; ++k) {
-                double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
-                stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
-                constant[k] = 1.0;
-                u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * stretch * r_safe);
-                u_scale[k] = 0.0;
-                r0[k] = r;
-                r1[k] = r2[k] = r3[k] = 0.0;
+            bool plain = n_stretch == n;  // every stretch given, positive and finite (the common case)
+            for (std::size_t k = 0; k < n_stretch; ++k) {
+                const double stretch = curve.stretch[k];
+                plain &= stretch > 0.0 && stretch <= std::numeric_limits<double>::max();
+            }
+            if (plain) {  // no select: the loop vectorizes
+                const float* stretch = curve.stretch.data();
+                for (std::size_t k = 0; k < n; ++k) {
+                    u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * static_cast<double>(stretch[k]) * r_safe);
+                }
+            } else {
+                for (std::size_t k = 0; k < n; ++k) {
+                    double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
+                    stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;
+                    u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * stretch * r_safe);
+                }
             }
         } else {
             // SegmentCoeffs::load's radius polynomial and texture scale, segment by segment (the node slopes are
@@ -284,11 +292,17 @@ struct SegmentTables {
                                       tangent.data() + 3 * n);
         }
     }
+    bool uniform = false;     // uniform_radius(): only u_per_m is kept
+    double uniform_r = 0.0;   // its radius
     /// Segment k's radius polynomial and texture scale into c, as SegmentCoeffs::load() computes them.
     void load_radius(std::size_t k, SegmentCoeffs& c) const {
         const std::size_t n = length_m.size();
         const double* r = radius.data();
-        c.load_radius(r[3 * n + k], r[4 * n + k], r[5 * n + k], r[6 * n + k], r[2 * n + k], r[n + k], r[k] != 0.0);
+        if (uniform) {
+            c.load_radius(uniform_r, 0.0, 0.0, 0.0, 0.0, r[n + k], true);
+        } else {
+            c.load_radius(r[3 * n + k], r[4 * n + k], r[5 * n + k], r[6 * n + k], r[2 * n + k], r[n + k], r[k] != 0.0);
+        }
     }
 };
 
