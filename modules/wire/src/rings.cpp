@@ -152,25 +152,35 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     return out;
 }
 
+/// |B'| at the three Gauss points of whole segment k of n laid out by detail::transpose_segments(), with
+/// SegmentCoeffs::load's derivative coefficients and integrate()'s points (ta = 0, h = 1), the same operations.
+/// Always inlined: GCC inlines nothing else into a kernel compiled with other options (WIRE_SELECT_KERNEL).
+[[gnu::always_inline]] inline void whole_segment_speeds(const double* __restrict b, std::size_t n, std::size_t k,
+                                                        double (&speed)[kGlPoints]) {
+    double d0[3], d1[3], d2[3];
+    for (int a = 0; a < 3; ++a) {
+        const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
+        d0[a] = 3.0 * (p1 - p0);
+        d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
+        d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
+    }
+    for (int q = 0; q < kGlPoints; ++q) {
+        const double t = 0.0 + 1.0 * kGlX[q];
+        const double x = d0[0] + t * (d1[0] + t * d2[0]);
+        const double y = d0[1] + t * (d1[1] + t * d2[1]);
+        const double z = d0[2] + t * (d1[2] + t * d2[2]);
+        speed[q] = std::sqrt(x * x + y * y + z * z);
+    }
+}
+
 /// The lengths of gauss_whole_segments() alone (a wire of one radius: u is length times u_per_m). No select, so
 /// no WIRE_SELECT_KERNEL: that attribute keeps the loop from some of its -O3 treatment (15% slower on AVX-512).
 WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n, double* __restrict length_m) {
     for (std::size_t k = 0; k < n; ++k) {
-        double d0[3], d1[3], d2[3];
-        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
-            const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
-            d0[a] = 3.0 * (p1 - p0);
-            d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
-            d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
-        }
+        double speed[kGlPoints];
+        whole_segment_speeds(b, n, k, speed);
         double len = 0.0;
-        for (int q = 0; q < kGlPoints; ++q) {
-            const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
-            const double x = d0[0] + t * (d1[0] + t * d2[0]);
-            const double y = d0[1] + t * (d1[1] + t * d2[1]);
-            const double z = d0[2] + t * (d1[2] + t * d2[2]);
-            len += (1.0 * kGlW[q]) * std::sqrt(x * x + y * y + z * z);
-        }
+        for (int q = 0; q < kGlPoints; ++q) len += (1.0 * kGlW[q]) * speed[q];  // integrate()'s h w_q, h = 1
         length_m[k] = len;
     }
 }
@@ -184,21 +194,13 @@ WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void gauss_whole_segments(const double* __
                                              const double* __restrict r2, const double* __restrict r3,
                                              double* __restrict length_m, double* __restrict u) {
     for (std::size_t k = 0; k < n; ++k) {
-        double d0[3], d1[3], d2[3];
-        for (int a = 0; a < 3; ++a) {  // SegmentCoeffs::load's expressions, per component
-            const double p0 = b[a * n + k], p1 = b[(3 + a) * n + k], p2 = b[(6 + a) * n + k], p3 = b[(9 + a) * n + k];
-            d0[a] = 3.0 * (p1 - p0);
-            d1[a] = 2.0 * (3.0 * (p2 - 2.0 * p1 + p0));
-            d2[a] = 3.0 * (p3 - 3.0 * p2 + 3.0 * p1 - p0);
-        }
+        double speeds[kGlPoints];
+        whole_segment_speeds(b, n, k, speeds);
         double len = 0.0, u_varying = 0.0;
         for (int q = 0; q < kGlPoints; ++q) {
             const double t = 0.0 + 1.0 * kGlX[q];  // integrate()'s ta + h x_q with ta = 0, h = 1
-            const double x = d0[0] + t * (d1[0] + t * d2[0]);
-            const double y = d0[1] + t * (d1[1] + t * d2[1]);
-            const double z = d0[2] + t * (d1[2] + t * d2[2]);
             const double w = 1.0 * kGlW[q];
-            const double speed = std::sqrt(x * x + y * y + z * z);
+            const double speed = speeds[q];
             len += w * speed;
             const double radius = r0[k] + t * (r1[k] + t * (r2[k] + t * r3[k]));
             u_varying += w * speed / (radius < 1e-30 ? 1e-30 : radius);  // std::max(radius, 1e-30)
