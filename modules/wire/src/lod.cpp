@@ -516,6 +516,7 @@ struct Scratch {
     std::vector<double> ratios;        // per hierarchy node: SpanMerger's ratios
     std::vector<unsigned char> outside;
     std::vector<uint32_t> old_counts;
+    std::vector<uint32_t> walk_a, walk_b;  // SpanMerger::walk_levels: the undecided nodes of two levels
 };
 Scratch& scratch() {
     thread_local Scratch s;
@@ -685,9 +686,7 @@ public:
     // Writes the spans into `required` and `counts` (other segments keep their values). Returns the number of
     // counts intervals that cross more than one segment.
     uint32_t apply(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
-        uint32_t spans = 0;
-        walk(root_level(), 0, false, required.data(), counts.data(), spans);
-        return spans;
+        return walk_levels(required.data(), counts.data());
     }
 
 private:
@@ -701,35 +700,60 @@ private:
         v[s] = 1;
         for (std::size_t i = s + 1; i < e; ++i) v[i] = 0;
     }
-    // Depth first, left child before right; the right child is walked by the loop (no second call).
-    void walk(std::size_t level, std::size_t j, bool required_done, uint32_t* required, uint32_t* counts,
-              uint32_t& spans) const {
-        for (;;) {
-            const std::size_t s = first(level, j), e = last(level, j);
-            if (s >= e) return;
-            // Levels the wire-wide bounds decide: every node fits (at the strictest threshold), or none does.
-            double r = 0.0;
-            if (level >= fail_level_) {
-                r = std::numeric_limits<double>::infinity();
-            } else if (static_cast<std::ptrdiff_t>(level) > fit_level_) {
-                r = level_ratio(level, j);
-                note(r);
+    // Level by level from the top (breadth first): the nodes still undecided at a level are a list (node index
+    // times 2, plus 1 when an ancestor already set the required span), ascending; a node that does not take a
+    // counts span puts its children on the next level's list. The same nodes as the depth-first walk, the same
+    // decisions: a node's decision depends on its ancestors only, note() keeps minima and maxima (any order),
+    // and the spans written by different nodes do not overlap. Levels at or above fail_level_ (ratio infinite:
+    // descend, write nothing) are skipped: the walk starts with every node of the level below them.
+    uint32_t walk_levels(uint32_t* required, uint32_t* counts) const {
+        const std::size_t levels = b_.levels;
+        if (levels == 0 || fail_level_ == 0) return 0;  // no level decides a node: nothing is written
+        const std::size_t top = std::min(levels - 1, fail_level_ - 1);
+        Scratch& sc = scratch();
+        const std::size_t cap = b_.level_width(0) + 1;
+        if (sc.walk_a.size() < cap) sc.walk_a.resize(cap);
+        if (sc.walk_b.size() < cap) sc.walk_b.resize(cap);
+        uint32_t* cur = sc.walk_a.data();
+        uint32_t* next = sc.walk_b.data();
+        std::size_t count = b_.level_width(top);
+        for (std::size_t j = 0; j < count; ++j) cur[j] = static_cast<uint32_t>(2 * j);
+        uint32_t spans = 0;
+        for (std::size_t level = top;; --level) {
+            std::size_t out = 0;
+            const std::size_t child_width = level > 0 ? b_.level_width(level - 1) : 0;
+            const bool decided_fit = static_cast<std::ptrdiff_t>(level) <= fit_level_;  // ratio 0: every node
+            for (std::size_t i = 0; i < count; ++i) {
+                const uint32_t item = cur[i];
+                const std::size_t j = item >> 1;
+                bool required_done = (item & 1u) != 0;
+                const std::size_t s = first(level, j), e = last(level, j);
+                double r = 0.0;
+                if (!decided_fit) {
+                    r = level_ratio(level, j);
+                    note(r);
+                }
+                if (!required_done && r <= 1.0) {
+                    set_span(required, s, e);
+                    required_done = true;
+                }
+                if (r <= new_scale_ || (r <= 1.0 && was_merged(s, e))) {
+                    set_span(counts, s, e);
+                    spans += e - s > 1 ? 1u : 0u;
+                    continue;
+                }
+                if (level == 0) continue;
+                const uint32_t flag = required_done ? 1u : 0u;
+                next[out] = static_cast<uint32_t>(4 * j) | flag;
+                out += 1;
+                next[out] = static_cast<uint32_t>(4 * j + 2) | flag;  // the right child, kept if it exists
+                out += 2 * j + 1 < child_width ? 1 : 0;
             }
-            if (!required_done && r <= 1.0) {
-                set_span(required, s, e);
-                required_done = true;
-            }
-            if (r <= new_scale_ ||
-                (r <= 1.0 && was_merged(s, e))) {  // counts_scale() without the scan when decided
-                set_span(counts, s, e);
-                spans += e - s > 1 ? 1u : 0u;
-                return;
-            }
-            if (level == 0) return;
-            walk(level - 1, 2 * j, required_done, required, counts, spans);
-            --level;
-            j = 2 * j + 1;
+            if (level == 0 || out == 0) break;
+            std::swap(cur, next);
+            count = out;
         }
+        return spans;
     }
 
     const LodBounds& b_;
