@@ -1114,13 +1114,23 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     if (!whole) {
         // Per-segment hysteresis on the Wang counts (all >= 1), then the spans over both.
         lod.counts.resize(n);
-        for (std::size_t i = 0; i < n; ++i)
+        const uint32_t* req = lod.required.data();
+        uint32_t* cnt = lod.counts.data();
+        for (std::size_t i = 0; i < n; ++i) {
             // Hysteresis keeps an old count, but never above the cap in force now (it may have been lowered).
-            lod.counts[i] = std::min(hysteresis_count(old[i], lod.required[i], lim.band), lim.max_rings);
+            // hysteresis_count() is the new count unless the old one is larger: that test alone in the loop.
+            const uint32_t o = old[i], r = req[i];
+            cnt[i] = std::min(o > r ? hysteresis_count(o, r, lim.band) : r, lim.max_rings);
+        }
         if (merge) lod.spans = merger.apply(lod.required, lod.counts);
     }
     bool changed = restart;
-    for (std::size_t i = 0; i < n; ++i) lod.changed_counts += lod.counts[i] != old[i] ? 1u : 0u;
+    {
+        uint32_t changed_counts = 0;  // a local sum (not the member): the loop vectorizes
+        const uint32_t* cnt = lod.counts.data();
+        for (std::size_t i = 0; i < n; ++i) changed_counts += cnt[i] != old[i] ? 1u : 0u;
+        lod.changed_counts += changed_counts;
+    }
     changed = changed || lod.changed_counts != 0;
 
     if (lod.visible_segments == 0) {
