@@ -628,13 +628,15 @@ public:
     // 1/r below, both monotone in r (a correctly rounded quotient is monotone in its operands), so its smallest
     // value over the ratios is taken at the smallest r >= 1 or the largest r < 1; the same holds around s. The walk
     // keeps those four ratios (compares, no division per node) and margin() evaluates them: the same value.
-    void note(double r) const {
+    void note(double r) const { note_into(r, new_scale_, above_one_, below_one_, above_scale_, below_scale_); }
+    static void note_into(double r, double scale, double& above_one, double& below_one, double& above_scale,
+                          double& below_scale) {
         // Branch-free (the sides of 1 and s alternate unpredictably along the walk): std::min / std::max as selects.
         const bool ok = r > 0.0 && r <= std::numeric_limits<double>::max();  // positive and finite
-        above_one_ = ok && r >= 1.0 && r < above_one_ ? r : above_one_;
-        below_one_ = ok && r < 1.0 && below_one_ < r ? r : below_one_;
-        above_scale_ = ok && r >= new_scale_ && r < above_scale_ ? r : above_scale_;
-        below_scale_ = ok && r < new_scale_ && below_scale_ < r ? r : below_scale_;
+        above_one = ok && r >= 1.0 && r < above_one ? r : above_one;
+        below_one = ok && r < 1.0 && below_one < r ? r : below_one;
+        above_scale = ok && r >= scale && r < above_scale ? r : above_scale;
+        below_scale = ok && r < scale && below_scale < r ? r : below_scale;
     }
     // A level-wide ratio (set_depth_range) contributes max(r, 1/r) alone: kept the same way.
     void note_level(double r) {
@@ -719,6 +721,8 @@ private:
         std::size_t count = b_.level_width(top);
         for (std::size_t j = 0; j < count; ++j) cur[j] = static_cast<uint32_t>(2 * j);
         uint32_t spans = 0;
+        // note()'s four values in locals (registers) through the walk, stored back at the end.
+        double above_one = above_one_, below_one = below_one_, above_scale = above_scale_, below_scale = below_scale_;
         for (std::size_t level = top;; --level) {
             std::size_t out = 0;
             const std::size_t child_width = level > 0 ? b_.level_width(level - 1) : 0;
@@ -731,7 +735,7 @@ private:
                 double r = 0.0;
                 if (!decided_fit) {
                     r = level_ratio(level, j);
-                    note(r);
+                    note_into(r, new_scale_, above_one, below_one, above_scale, below_scale);
                 }
                 if (!required_done && r <= 1.0) {
                     set_span(required, s, e);
@@ -753,6 +757,10 @@ private:
             std::swap(cur, next);
             count = out;
         }
+        above_one_ = above_one;
+        below_one_ = below_one;
+        above_scale_ = above_scale;
+        below_scale_ = below_scale;
         return spans;
     }
 
