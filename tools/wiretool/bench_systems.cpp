@@ -666,27 +666,29 @@ int run_systems_bench(const Options& o) {
         }
         if (kind == SceneKind::offscreen) offscreen_cpu_ms = median(cpu_run.frame_cpu_ms);
 
-        // 1 vs 2 threads (wall time: the point of threads is to finish sooner), on the cpu-mesh path.
+        // 1 vs 2 threads (wall time: the point of threads is to finish sooner), on the cpu-mesh path. Both thread
+        // counts get runs of their own, alternated (1, 2, 1, 2) and at least 40 frames each, so that a short
+        // --quick scene or a moment of load on the machine does not decide the ratio; the median over the frames
+        // of both runs of a thread count.
         if (kind != SceneKind::offscreen &&
             (!o.quick || kind == SceneKind::standard || kind == SceneKind::swaying)) {
-            double wall[2] = {0.0, 0.0};
-            for (int t : {1, 2}) {
-                if (t == o.threads) {
-                    wall[t - 1] = median(cpu_run.frame_wall_ms);
-                    continue;
+            std::vector<double> walls[2];
+            for (int round = 0; round < 2; ++round) {
+                for (int t : {1, 2}) {
+                    std::fprintf(stderr, "bench: %s cpu-mesh, %d thread(s) (thread scaling)\n", name.c_str(), t);
+                    const SceneRun r = run_scene({.kind = kind,
+                                                  .path = wire::UploadPath::cpu_mesh,
+                                                  .threads = t,
+                                                  .frames = std::max(scene_frames, 40),
+                                                  .wires = wires,
+                                                  .sample_errors = false,
+                                                  .error_samples = 0,
+                                                  .after_frame = {},
+                                                  .spline = spline});
+                    walls[t - 1].insert(walls[t - 1].end(), r.frame_wall_ms.begin(), r.frame_wall_ms.end());
                 }
-                std::fprintf(stderr, "bench: %s cpu-mesh, %d thread(s) (thread scaling)\n", name.c_str(), t);
-                const SceneRun r = run_scene({.kind = kind,
-                                              .path = wire::UploadPath::cpu_mesh,
-                                              .threads = t,
-                                              .frames = scene_frames,
-                                              .wires = wires,
-                                              .sample_errors = false,
-                                              .error_samples = 0,
-                                              .after_frame = {},
-                                              .spline = spline});
-                wall[t - 1] = median(r.frame_wall_ms);
             }
+            const double wall[2] = {median(walls[0]), median(walls[1])};
             std::snprintf(buf, sizeof buf, "| %s | %.3f | %.3f | %.2fx |\n", name.c_str(), wall[0], wall[1],
                           wall[1] > 0 ? wall[0] / wall[1] : 0.0);
             thread_lines += buf;
@@ -824,7 +826,8 @@ int run_systems_bench(const Options& o) {
             std::fclose(f);
         }
         md +=
-            "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems; /proc/loadavg at "
+            "\n## 1 vs 2 threads (cpu-mesh, median wall ms per frame of the five systems over two runs of at least 40 "
+            "frames each, alternated; /proc/loadavg at "
             "the "
             "end: " +
             load +
