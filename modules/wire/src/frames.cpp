@@ -18,10 +18,10 @@ namespace {
 /// Steps whose tangent turns by more than 45 degrees are split (see Transporter::reflect).
 constexpr double kSplitCos = 0.70710678118654752;
 
-double max_abs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
-
 /// The largest of three magnitudes (no NaN; equal values are equal), without a branch.
 double max3(double a, double b, double c) { return std::max(std::max(a, b), c); }
+
+double max_abs(const glm::dvec3& v) { return max3(std::abs(v.x), std::abs(v.y), std::abs(v.z)); }
 
 /// r made orthogonal to unit t and normalized; `fallback` (also made orthogonal) if r is (nearly) parallel to t.
 glm::dvec3 orthonormalize(const glm::dvec3& r, const glm::dvec3& t) {
@@ -204,10 +204,9 @@ private:
 }  // namespace
 
 namespace detail {
-namespace {
-WIRE_VECTOR_CLONES void boundary_tangents_kernel(const double* __restrict b, std::size_t n, double* __restrict tx,
-                                                 double* __restrict ty, double* __restrict tz,
-                                                 double* __restrict ok) {
+
+WIRE_VECTOR_CLONES void boundary_tangents(const double* __restrict b, std::size_t n, double* __restrict tx,
+                                          double* __restrict ty, double* __restrict tz, double* __restrict ok) {
     const double* b0x = b;
     const double* b0y = b + n;
     const double* b0z = b + 2 * n;
@@ -235,7 +234,6 @@ WIRE_VECTOR_CLONES void boundary_tangents_kernel(const double* __restrict b, std
         ok[k] = speed > tiny ? 1.0 : 0.0;
     }
 }
-}  // namespace
 
 WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
@@ -261,9 +259,6 @@ WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::siz
     }
 }
 
-void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty, double* tz, double* ok) {
-    boundary_tangents_kernel(soa, n, tx, ty, tz, ok);
-}
 }  // namespace detail
 
 glm::dvec3 seed_normal(const glm::dvec3& t) {
@@ -309,7 +304,6 @@ glm::dvec3 unit_tangent(const CubicBezier& c, double t, bool* degenerate) {
     }
     return glm::dvec3(0.0);
 }
-
 
 FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, std::span<Frame> out) {
     FrameStats stats;
@@ -435,12 +429,9 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         double* const ptz = pty + m;
         double* const mat = ptz + m;      // 9 arrays: the step matrix into point j, column-major entries
         double* const special = mat + 9 * m;  // nonzero: the step into j takes the guarded path
-        // Boundary tangents of the crossed range: B'(0) = 3 (b1 - b0) times the reciprocal of its length, the same
-        // operations as build_rings uses for a ring at t = 0 (a crossed boundary and a ring there carry the same
-        // tangent), in a pass the compiler vectorizes; a vanishing derivative (flag 0) takes unit_tangent()'s
-        // one-sided limits below.
+        // Boundary tangents of the crossed range (detail::boundary_tangents): build_rings's, for every segment, or
+        // computed here; a vanishing derivative (flag 0) takes unit_tangent()'s one-sided limits below.
         double* const btan = special + m;  // 4 arrays: x, y, z, ok
-        // Boundary tangents of the crossed range: build_rings's (every segment's), or computed here.
         const double* bt = btan;
         std::size_t bt_stride = nb;
         if (nb != 0 && in.boundary_tangent.size() == 4 * n_seg) {

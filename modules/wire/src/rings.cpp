@@ -418,9 +418,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     }
     out.length_m = s;
 
-    const FrameInput in{&curve,           params,
-                        out.origin_m,     out.centre_m,
-                        out.tangent_scratch, out.arc_length_m,
+    const FrameInput in{&curve, params, out.origin_m, out.centre_m, out.tangent_scratch, out.arc_length_m,
                         tables.tangent};
     out.frame_stats = compute_frames(in, settings.frames, out.frames);
 

@@ -1,4 +1,5 @@
-// Internal: the ring stage's per-segment kernels over structure-of-arrays copies of a curve's segments.
+// Internal: building the per-segment and per-node kernels (instruction-set clones, select kernels) and the
+// structure-of-arrays copy of a curve's segments they read.
 #pragma once
 
 #include "wire/curve.hpp"
