@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <limits>
 #include <numbers>
+#include <string_view>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -491,8 +492,10 @@ struct SpanKernels {
 // width gives the same bits).
 SpanKernels choose_span_kernels() {
 #if defined(WIRE_LOD_AVX2)
+    // Only "2" and "4" cap the width; anything else (unset, or not one of those) leaves the widest.
     const char* cap = std::getenv("WIRE_LOD_LANES");
-    const int lanes = cap != nullptr ? std::atoi(cap) : 8;
+    const std::string_view lanes_text = cap != nullptr ? cap : "";
+    const int lanes = lanes_text == "2" ? 2 : lanes_text == "4" ? 4 : 8;
     __builtin_cpu_init();
     if (lanes >= 8 && __builtin_cpu_supports("avx512f"))
         return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::hull_depth_kernel,
@@ -512,7 +515,7 @@ const SpanKernels& span_kernels() {
 // Per-update working memory of one thread (grows once, then reused).
 struct Scratch {
     std::vector<double> z_min, k;  // per segment: hull depth and off-axis factor (hull_depths())
-    std::vector<double> m, eps, root;  // per segment: Wang's M, world tolerance, Wang's root
+    std::vector<double> eps, root;     // per segment: world tolerance, Wang's root
     std::vector<double> ratios;        // per hierarchy node: SpanMerger's ratios
     std::vector<unsigned char> outside;
     std::vector<uint32_t> old_counts;
@@ -795,10 +798,7 @@ struct Limits {
           band(settings.hysteresis_band == 0.0 ? default_band : settings.hysteresis_band) {}
 };
 
-// Per-segment pass: required Wang counts (and visibility, depth) of every segment, structure-of-arrays so the
-// transform and the depth/off-axis loops vectorize. Returns false if the wire is culled by the hull test.
-// Control points to view space (structure of arrays) and every segment's hull depth and off-axis factor, into
-// scratch(): x, y, z, z_min, k.
+// Every segment's hull depth, off-axis factor and plane mask, into scratch(): z_min, k, outside.
 void hull_depths(const Curve& curve, const LodView& view, double radius_m) {
     const std::size_t n = curve.segment_count();
     Scratch& sc = scratch();
@@ -821,8 +821,10 @@ void hull_depths(const Curve& curve, const LodView& view, double radius_m) {
     span_kernels().hull_depths(curve.segments.data(), n, h, sc.z_min.data(), sc.k.data(), sc.outside.data());
 }
 
+// Per-segment pass: required Wang counts (and visibility, depth) of every segment from the hull depths and the
+// bounds' cached Wang's M. Returns false if the wire is culled by the hull test.
 bool per_segment_required(const Curve& curve, const LodView& view, const LodSettings& settings,
-                          const Limits& lim, const LodBounds* bounds, double radius, WireLod& lod,
+                          const Limits& lim, const LodBounds& bounds, double radius, WireLod& lod,
                           double& wire_z, double& wire_k) {
     const std::size_t n = curve.segment_count();
     hull_depths(curve, view, radius);
@@ -839,16 +841,7 @@ bool per_segment_required(const Curve& curve, const LodView& view, const LodSett
     const double scale = lim.eps / view.focal_px;
     // Wang's M of every segment (cached in the bounds), then every segment's world tolerance and root in a lane
     // kernel (computed for all; used where the segment needs them).
-    const double* mm = nullptr;
-    if (bounds != nullptr) {
-        mm = &bounds->data[bounds->data.size() - bounds->segments];  // wang_m(0 .. n): segments == n here
-    } else {
-        sc.m.resize(n);
-        for (std::size_t i = 0; i < n; ++i)
-            sc.m[i] = std::max(glm::length(curve.segments[i].b0 - 2.0 * curve.segments[i].b1 + curve.segments[i].b2),
-                               glm::length(curve.segments[i].b1 - 2.0 * curve.segments[i].b2 + curve.segments[i].b3));
-        mm = sc.m.data();
-    }
+    const double* mm = &bounds.data[bounds.data.size() - bounds.segments];  // wang_m(0 .. n): segments == n here
     sc.eps.resize(n);
     sc.root.resize(n);
     span_kernels().wang_roots(zmin, ks, mm, n, scale, sc.eps.data(), sc.root.data());
@@ -1021,9 +1014,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     const std::size_t n = curve.segment_count();
     if (sphere_cull && sphere_outside_view(bounds.sphere, view)) return cull_lod(lod);
     if (n == 0) {
-        bool changed = false;
-        mark_culled(lod, changed);
-        return changed;
+        return cull_lod(lod);
     }
     const Limits lim(settings);
     const double radius = bounds.radius_max_m;
@@ -1098,9 +1089,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         sides_for_radius(radius, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) == 3) {
         const SegmentPass pass = per_segment_bounded(curve, view, lim, bounds, radius, lod, wire_z);
         if (pass == SegmentPass::culled) {
-            bool changed = false;
-            mark_culled(lod, changed);
-            return changed;
+            return cull_lod(lod);
         }
         if (pass == SegmentPass::done) {
             decided = true;
@@ -1112,10 +1101,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
             lod.clamped_segments = 0;
         }
     }
-    if (!decided && !per_segment_required(curve, view, settings, lim, &bounds, radius, lod, wire_z, wire_k)) {
-        bool changed = false;
-        mark_culled(lod, changed);
-        return changed;
+    if (!decided && !per_segment_required(curve, view, settings, lim, bounds, radius, lod, wire_z, wire_k)) {
+        return cull_lod(lod);
     }
 
     lod.visible = true;
@@ -1416,8 +1403,11 @@ bool one_ring_per_segment(const LodBounds& bounds, const SphereScreenBound& b) {
 bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
                 const BoundingSphere* bounds) {
     thread_local LodBounds lb;
-    compute_lod_bounds(curve, lb);
-    if (bounds != nullptr) lb.sphere = *bounds;
+    if (bounds != nullptr) {
+        compute_lod_bounds(curve, lb, *bounds);  // the caller's sphere, not the boxes' again
+    } else {
+        compute_lod_bounds(curve, lb);
+    }
     return update_lod_impl(curve, view, settings, lod, lb, bounds != nullptr && bounds->radius_m >= 0.0,
                            false);
 }

@@ -103,13 +103,11 @@ Status check_settings(const SplineSettings& s) {
 // Each kernel is also compiled for AVX-512 and AVX2 machines, picked at load time (WIRE_VECTOR_CLONES: 8 and 4
 // lanes where baseline x86-64 has 2; 1.44 -> 1.12 ms for the stage on 1,000 moving 64-node wires); every clone's
 // results are bit-identical to the baseline's (see the macro).
-#define WIRE_KERNEL WIRE_VECTOR_CLONES
 
 // all_within has a second version for AVX2 machines, chosen at load time like the kernels' clones (the compiler
 // does not vectorize this reduction, and GCC's vector types split slowly on the SSE2 baseline); the same condition
 // as WIRE_VECTOR_CLONES'.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(WIRE_NO_VECTOR_CLONES) && \
-    !defined(__SANITIZE_ADDRESS__)
+#if defined(WIRE_HAS_VECTOR_CLONES)
 #define WIRE_RANGE_VERSIONS 1
 #define WIRE_RANGE_DEFAULT __attribute__((target("default")))
 #else
@@ -261,7 +259,7 @@ struct Chords {
 };
 
 // Chords k = 0 .. count-1 from node coordinates a (3 per node, node k at 3k) to b (node k + 1's at 3k).
-WIRE_KERNEL
+WIRE_VECTOR_CLONES
 void chords_kernel(std::size_t count, const double* __restrict a, const double* __restrict b, double* __restrict dx,
                    double* __restrict dy, double* __restrict dz, double* __restrict len, double* __restrict ex,
                    double* __restrict ey, double* __restrict ez) {
@@ -295,7 +293,7 @@ void fill_chords(const dvec3* P, std::size_t n, bool closed, Chords& ch) {
 // Bounding box of n nodes (3 finite coordinates each, node i's at 3i) into lo and hi (3 each, HUGE_VAL and
 // -HUGE_VAL on entry). Minima and maxima are exact in any order (only the sign of a zero could depend on it, and
 // the merge reads the box only through lengths), so two nodes at a time.
-WIRE_KERNEL
+WIRE_VECTOR_CLONES
 void bbox_kernel(const double* p, std::size_t n, double* lo, double* hi) {
     std::size_t i = 0;
 #if defined(__GNUC__)
@@ -519,7 +517,7 @@ constexpr double kStraightTension = 30.0;
 constexpr double kReversal = -1.0 + 1e-12;
 
 // Per node i (incoming chord at index i, outgoing at i + 1): curvature vector k_i and chord-bisector tangent t_i.
-WIRE_KERNEL WIRE_SELECT_KERNEL
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
 void curvature_kernel(std::size_t n, const double* __restrict ex, const double* __restrict ey,
                       const double* __restrict ez, const double* __restrict len, double* __restrict kx,
                       double* __restrict ky, double* __restrict kz, double* __restrict tx, double* __restrict ty,
@@ -540,7 +538,7 @@ void curvature_kernel(std::size_t n, const double* __restrict ex, const double* 
 }
 
 // Per edge j (tangents t_j, t_j+1): the rotation's axis, cosine and 1 / (1 + cos) (0 at a reversal).
-WIRE_KERNEL WIRE_SELECT_KERNEL
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
 void edge_kernel(std::size_t n, const double* __restrict tx, const double* __restrict ty, const double* __restrict tz,
                  double* __restrict ax, double* __restrict ay, double* __restrict az, double* __restrict ec,
                  double* __restrict eq) {
@@ -559,7 +557,7 @@ void edge_kernel(std::size_t n, const double* __restrict tx, const double* __res
 // at index i, its own at i + 1, the next node's curvature at i + 2): the turn its neighbours predict, the spread's
 // ingredients |k|, |k| + |k~| and |k - k~|^2, and flag 1 where the spread must be decided (0: the neighbours
 // predict this turn, d <= kSpreadLo, decided on squares without the root; or straight here and around).
-WIRE_KERNEL WIRE_SELECT_KERNEL
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
 void spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
                    const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
                    const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
@@ -685,7 +683,7 @@ void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
 }
 
 // Interior rows of the tangent system (node j: incoming chord at index j, outgoing at j + 1; diagonal 2 + w_j).
-WIRE_KERNEL
+WIRE_VECTOR_CLONES
 void rows_kernel(std::size_t rows, const double* __restrict w, const double* __restrict ex, const double* __restrict ey,
                  const double* __restrict ez, const double* __restrict len, double* __restrict a, double* __restrict b,
                  double* __restrict c, double* __restrict rx, double* __restrict ry, double* __restrict rz) {
@@ -700,7 +698,7 @@ void rows_kernel(std::size_t rows, const double* __restrict w, const double* __r
 }
 
 // Segment tangents from node tangents per unit chord (D: node k's at k, k + 1's at k + 1) and chord lengths.
-WIRE_KERNEL
+WIRE_VECTOR_CLONES
 void tangents_kernel(std::size_t segs, const double* __restrict D, const double* __restrict len, double* __restrict t0,
                      double* __restrict t1) {
     for (std::size_t k = 0; k < segs; ++k) {
@@ -711,7 +709,7 @@ void tangents_kernel(std::size_t segs, const double* __restrict D, const double*
 
 // Inner Bezier control points of segments k = 0 .. count-1, in place of their tangents: B1 = P0 + t0/3 from
 // node coordinates p0 (3 per node, segment k's start at 3k), B2 = P1 - t1/3 from p1 (its end at 3k).
-WIRE_KERNEL
+WIRE_VECTOR_CLONES
 void controls_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
                      double* __restrict b1x, double* __restrict b1y, double* __restrict b1z, double* __restrict b2x,
                      double* __restrict b2y, double* __restrict b2z) {
@@ -727,7 +725,7 @@ void controls_kernel(std::size_t count, const double* __restrict p0, const doubl
 
 // Bezier segments k = 0 .. count-1 (12 doubles each, out at 12k) from node coordinates p0 (3 per node, segment
 // k's start at 3k), p1 (its end at 3k) and the inner control points.
-WIRE_KERNEL
+WIRE_VECTOR_CLONES
 void segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
                      const double* __restrict b1x, const double* __restrict b1y, const double* __restrict b1z,
                      const double* __restrict b2x, const double* __restrict b2y, const double* __restrict b2z,

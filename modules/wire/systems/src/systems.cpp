@@ -102,6 +102,15 @@ std::vector<T>& reused() {
 
 /// What a wire keeps of build_rings' output (see WireRings): the float records (swapped, so no copy and no
 /// allocation once both buffers are large enough), ring 0's frame, scalars.
+/// The LOD's bounds of the wire's curve, with the curve stage's sphere when it is of this curve.
+void bounds_of(const WireCurve& c, LodBounds& out) {
+    if (c.bounds_generation == c.generation) {
+        compute_lod_bounds(c.curve, out, c.bounds);
+    } else {
+        compute_lod_bounds(c.curve, out);
+    }
+}
+
 void keep_rings(RingSet& built, WireRings& r) {
     RingSet& k = r.rings;
     std::swap(k.rings, built.rings);
@@ -367,17 +376,11 @@ void lod_system(Registry& registry, WireContext& ctx) {
         } else if (curve_changed) {
             // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
             thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
-            if (c.bounds_generation == c.generation)
-                compute_lod_bounds(c.curve, scratch, c.bounds);  // the curve stage's sphere of this curve
-            else
-                compute_lod_bounds(c.curve, scratch);
+            bounds_of(c, scratch);
             changed = update_lod(c.curve, ctx.view, settings, s.lod, scratch);
         } else {
             // Same curve as the last LOD update, new camera: keep the bounds for the next camera.
-            if (c.bounds_generation == c.generation)
-                compute_lod_bounds(c.curve, c.lod_bounds, c.bounds);
-            else
-                compute_lod_bounds(c.curve, c.lod_bounds);
+            bounds_of(c, c.lod_bounds);
             c.lod_bounds_generation = c.generation;
             changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
         }

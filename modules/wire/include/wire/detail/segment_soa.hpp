@@ -13,6 +13,7 @@
 /// max, comparisons). Elsewhere (Clang, sanitizers, other CPUs): one plain function.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(WIRE_NO_VECTOR_CLONES) && \
     !defined(__SANITIZE_ADDRESS__)
+#define WIRE_HAS_VECTOR_CLONES 1  // also for hand-made versions chosen at load time (spline.cpp's all_within)
 #define WIRE_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define WIRE_VECTOR_CLONES
