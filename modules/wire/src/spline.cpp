@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <cassert>
 #include <cfloat>
 #include <cmath>
 #include <cstdint>
@@ -173,15 +174,17 @@ bool all_above(const double* v, std::size_t count, double limit) {
 
 Status check_nodes(const WireNodes& w, bool use_physics) {
     static const char* const kAxis[3] = {"x", "y", "z"};
-    // The common case in one branch-free pass: positions only, every coordinate finite and in range (NaN and
-    // Inf fail the comparison). Anything else, or a bad value, takes the per-node checks and their messages.
-    if (!w.positions.empty() && w.stretch.empty() && w.radius_m.empty() && w.kb_tension.empty() &&
-        w.kb_bias.empty() && w.kb_continuity.empty() && !use_physics) {
-        // 3 coordinates a node, contiguous
-        if (all_within(&w.positions[0].x, 3 * w.positions.size(), kMaxCoordinate_m)) return Status::success();
+    // Positions in one branch-free pass: every coordinate finite and in range (NaN and Inf fail the comparison).
+    // When they pass, the per-node checks below skip them; a bad one is found there, with its message.
+    static_assert(sizeof(glm::dvec3) == 3 * sizeof(double), "positions: 3 contiguous doubles a node");
+    const bool positions_ok =
+        !w.positions.empty() && all_within(&w.positions[0].x, 3 * w.positions.size(), kMaxCoordinate_m);
+    if (positions_ok && w.stretch.empty() && w.radius_m.empty() && w.kb_tension.empty() && w.kb_bias.empty() &&
+        w.kb_continuity.empty() && !use_physics) {
+        return Status::success();
     }
     for (std::size_t i = 0; i < w.positions.size(); ++i) {
-        for (int a = 0; a < 3; ++a) {
+        for (int a = 0; a < 3 && !positions_ok; ++a) {
             const double v = w.positions[i][a];
             if (!std::isfinite(v)) return Status::error(node_prefix(i) + "position." + kAxis[a] + " is " + describe(v), static_cast<int>(i));
             if (std::abs(v) > kMaxCoordinate_m)
@@ -232,6 +235,7 @@ struct Pool {
         used = 0;
     }
     double* carve(std::size_t k) {
+        assert(used + k <= buf.size() && "Pool::carve: more than reset() asked for");
         double* p = buf.data() + used;
         used += k;
         return p;
