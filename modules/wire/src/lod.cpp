@@ -14,6 +14,7 @@
 #include <limits>
 #include <numbers>
 #include <string_view>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -206,6 +207,11 @@ uint32_t sides_for_radius(double radius_m, double z_m, double k, const LodView& 
     if (!(r_px > 0.0)) return 3;
     const double x = eps / r_px;
     if (x >= 2.0) return 3;  // the whole tube is within eps of its centre line
+    // Three sides, the usual answer, without the acos: n <= 3 iff acos(1 - x) >= pi / 3 iff x >= 1/2. Above
+    // 1/2 by the relative margin below, 1 - x (exact: Sterbenz) is below 1/2 by 5e-10, so acos(1 - x) exceeds
+    // pi / 3 by ~6e-10 relative, far more than the rounding of acos and of the quotient (a few 1e-16): the
+    // formula's n is at most 3 there and the result 3. Nearer 1/2 the formula decides (tested on dense radii).
+    if (x > 0.5 * (1.0 + 1e-9)) return 3;
     const double n = std::ceil(std::numbers::pi / std::acos(1.0 - x));
     if (!(n < static_cast<double>(max_sides))) return max_sides;
     return std::max<uint32_t>(3, static_cast<uint32_t>(n));
@@ -481,8 +487,8 @@ using W = L8;
 
 // The span kernels for this CPU.
 struct SpanKernels {
-    void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*);
-    void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t);
+    void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*, double*);
+    void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t, double*);
     void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
     void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
     void (*ratios)(const double*, std::size_t, const RatioConstants&, double*);
@@ -1182,32 +1188,6 @@ BoundsScratch& bounds_scratch() {
     return s;
 }
 
-// Smallest and largest of v[0..w) as std::min / std::max in sequence give them, for values that are never -0
-// (a deviation is a sum of square roots): four lanes, a NaN skipped as the sequence skips it.
-void deviation_range(const double* v, std::size_t w, double& lo_out, double& hi_out) {
-    double lo[4], hi[4];
-    for (int k = 0; k < 4; ++k) {
-        lo[k] = std::numeric_limits<double>::infinity();
-        hi[k] = 0.0;
-    }
-    std::size_t j = 0;
-    for (; j + 4 <= w; j += 4)
-        for (int k = 0; k < 4; ++k) {
-            lo[k] = min_of(lo[k], v[j + k]);
-            hi[k] = max_of(hi[k], v[j + k]);
-        }
-    for (; j < w; ++j) {
-        lo[0] = min_of(lo[0], v[j]);
-        hi[0] = max_of(hi[0], v[j]);
-    }
-    for (int k = 1; k < 4; ++k) {
-        lo[0] = min_of(lo[0], lo[k]);
-        hi[0] = max_of(hi[0], hi[k]);
-    }
-    lo_out = lo[0];
-    hi_out = hi[0];
-}
-
 // std::min (std::max) of init and v[0..n) in sequence, which keeps the first of equal values: in four lanes,
 // exact unless the result is a zero (the one value with two encodings, -0 and +0: then in sequence).
 template <bool Max>
@@ -1317,15 +1297,20 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
     if (out.data.size() != 2 * levels + 5 * nodes + n) out.data.assign(2 * levels + 5 * nodes + n, 0.0);
     double* wang = out.data.data() + 2 * levels + 5 * nodes;
     BoundsScratch& sc = bounds_scratch();
-    if (sc.boxes.size() < 6 * n) {
-        sc.boxes.resize(6 * n);
+    if (sc.ends[0].size() < 6 * n) {
         sc.ends[0].resize(6 * n);
         sc.ends[1].resize(6 * n);
     }
+    // The level-0 boxes only where the wire's box is not known already (as its sphere).
+    if (known_sphere == nullptr && sc.boxes.size() < 6 * n) sc.boxes.resize(6 * n);
     const SpanKernels& kernels = span_kernels();
-    kernels.level0(curve.segments.data(), n, out.level_data(0), wang, sc.boxes.data(), sc.ends[0].data());
-    double unused = 0.0;
-    deviation_range(wang, n, unused, out.wang_m_max);  // the largest M (M is never -0: a root of a sum of squares)
+    // Level 0 with its deviation range (out.data[0], [1]) and the largest M (never -0: a root of a sum of squares).
+    double range0[3];
+    kernels.level0(curve.segments.data(), n, out.level_data(0), wang, known_sphere == nullptr ? sc.boxes.data() : nullptr,
+                   sc.ends[0].data(), range0);
+    out.data[0] = range0[0];
+    out.data[1] = range0[1];
+    out.wang_m_max = range0[2];
     if (known_sphere != nullptr) {
         out.sphere = *known_sphere;
     } else {
@@ -1337,14 +1322,13 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
         const double radius = out.radius_max_m;
         out.sphere = {0.5 * (lo + hi), (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
     }
-    // Levels 1 and up, each from the one below; the chord ends alternate between two buffers.
+    // Levels 1 and up, each from the one below, with their deviation ranges; the chord ends alternate between two
+    // buffers.
     for (std::size_t level = 1; level < levels; ++level) {
         kernels.merge_level(out.level_data(level - 1), sc.ends[(level - 1) & 1].data(), out.level_width(level - 1),
-                         out.level_data(level), sc.ends[level & 1].data(), out.level_width(level));
+                            out.level_data(level), sc.ends[level & 1].data(), out.level_width(level),
+                            out.data.data() + 2 * level);
     }
-    for (std::size_t l = 0; l < levels; ++l)
-        deviation_range(out.level_data(l) + 4 * out.level_width(l), out.level_width(l), out.data[2 * l],
-                        out.data[2 * l + 1]);
 }
 
 }  // namespace

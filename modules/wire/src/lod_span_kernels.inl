@@ -72,21 +72,64 @@ struct Merge {
     }
 };
 
-// Level 0: every segment's node (5 arrays: centre x, y, z, radius, deviation), Wang's M, box (6 arrays: lo, hi) and
-// chord ends (6 arrays: b0, b3), W::width segments at a time, the rest one by one.
+// The smallest and largest of a level's deviations (or of Wang's M), as std::min from +inf and std::max from 0 over
+// them in sequence give them: the lanes' running min_of / max_of (a NaN skipped as the sequence skips it), then
+// the lanes together. Exact in any order: the values are never -0 (square roots of sums of squares, and sums of
+// those), so the one pair of equal values with two encodings cannot occur.
+struct Range {
+    W lo = W::splat(std::numeric_limits<double>::infinity()), hi = W::splat(0.0);
+    double slo = std::numeric_limits<double>::infinity(), shi = 0.0;
+    void add(W v) {
+        lo = min_of(lo, v);
+        hi = max_of(hi, v);
+    }
+    template <class L>
+    void add_lanes(L v) {  // a narrower tail: lane by lane
+        double t[L::width];
+        v.store(t);
+        for (std::size_t k = 0; k < L::width; ++k) {
+            slo = min_of(slo, t[k]);
+            shi = max_of(shi, t[k]);
+        }
+    }
+    void finish(double& lo_out, double& hi_out) {
+        double l[W::width], h[W::width];
+        lo.store(l);
+        hi.store(h);
+        for (std::size_t k = 0; k < W::width; ++k) {
+            slo = min_of(slo, l[k]);
+            shi = max_of(shi, h[k]);
+        }
+        lo_out = slo;
+        hi_out = shi;
+    }
+};
+
+// Level 0: every segment's node (5 arrays: centre x, y, z, radius, deviation), Wang's M, box (6 arrays: lo, hi;
+// skipped where `box` is null) and chord ends (6 arrays: b0, b3), W::width segments at a time, the rest one by one;
+// range: the deviations' smallest and largest, and the largest M.
 inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, double* wang, double* box,
-                        double* ends) {
+                        double* ends, double* range) {
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double));  // b0 .. b3, x y z each, no padding
+    Range dev, m;
     auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
         L x[4], y[4], z[4];
         L::points(&seg[i].b0.x, x, y, z);  // b0 x y z, b1 x y z, b2 ..., b3 ... of each lane's segment
         const Level0<L> q(x, y, z);
         q.wang.store(wang + i);
-        for (int k = 0; k < 3; ++k) {
-            q.c[k].store(node + k * n + i);
-            q.lo[k].store(box + k * n + i);
-            q.hi[k].store(box + (3 + k) * n + i);
+        if constexpr (std::is_same_v<L, W>) {
+            dev.add(q.deviation);
+            m.add(q.wang);
+        } else {
+            dev.add_lanes(q.deviation);
+            m.add_lanes(q.wang);
         }
+        for (int k = 0; k < 3; ++k) q.c[k].store(node + k * n + i);
+        if (box != nullptr)
+            for (int k = 0; k < 3; ++k) {
+                q.lo[k].store(box + k * n + i);
+                q.hi[k].store(box + (3 + k) * n + i);
+            }
         q.r.store(node + 3 * n + i);
         q.deviation.store(node + 4 * n + i);
         x[0].store(ends + i);
@@ -106,15 +149,20 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
         for (; i + 2 <= n; i += 2) run(i, L2{});
 #endif
     for (; i < n; ++i) run(i, L1{});
+    dev.finish(range[0], range[1]);
+    double unused = 0.0;
+    m.finish(unused, range[2]);
 }
 
 // Level l from level l - 1 (child: 5 arrays of cw nodes, e: their chord ends, 6 arrays of cw; parent: 5 arrays of
 // w nodes, f: their chord ends): a parent's chord runs from its left child's first point to its right child's
 // last. W::width parents at a time (their left children are the even nodes of 2 W::width children, their right
-// ones the odd nodes), the rest one by one; an odd child count leaves the last child alone in its parent.
+// ones the odd nodes), the rest one by one; an odd child count leaves the last child alone in its parent. range:
+// the parents' smallest and largest deviation.
 inline void span_merge_level(const double* child, const double* e, std::size_t cw, double* parent, double* f,
-                             std::size_t w) {
+                             std::size_t w, double* range) {
     const std::size_t pairs = cw / 2;
+    Range dev;
     auto run = [&]<class L>(std::size_t j, L) __attribute__((always_inline)) {
         const std::size_t at = 2 * j;
         const L a[3] = {L::evens(e + at), L::evens(e + cw + at), L::evens(e + 2 * cw + at)};
@@ -131,6 +179,11 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
         }
         q.r.store(parent + 3 * w + j);
         q.deviation.store(parent + 4 * w + j);
+        if constexpr (std::is_same_v<L, W>) {
+            dev.add(q.deviation);
+        } else {
+            dev.add_lanes(q.deviation);
+        }
     };
     std::size_t j = 0;
     for (; j + W::width <= pairs; j += W::width) run(j, W{});
@@ -146,7 +199,9 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
         const std::size_t l = cw - 1;
         for (int k = 0; k < 5; ++k) parent[k * w + pairs] = child[k * cw + l];
         for (int k = 0; k < 6; ++k) f[k * w + pairs] = e[k * cw + l];
+        dev.add_lanes(L1{child[4 * cw + l]});
     }
+    dev.finish(range[0], range[1]);
 }
 
 // Every segment's hull depth (nearest control point depth, clamped to near), off-axis factor k and plane mask

@@ -333,6 +333,53 @@ TEST(LodProof, SidesPolygonErrorWithinTolerance) {
     }
 }
 
+// sides_for_radius() answers 3 without its acos well above x = eps / R_px = 1/2: it must give the formula's count
+// n = ceil(pi / acos(1 - x)) (clamped to [3, max_sides]) everywhere, most of all on the radii nearest the switch.
+uint32_t formula_sides(double radius_m, double z_m, double k, const LodView& view, double eps, uint32_t max_sides) {
+    const double r_px = radius_m * view.focal_px * k / std::max(z_m, view.near_m);
+    if (!(r_px > 0.0)) return 3;
+    const double x = eps / r_px;
+    if (x >= 2.0) return 3;
+    const double n = std::ceil(std::numbers::pi / std::acos(1.0 - x));
+    if (!(n < static_cast<double>(max_sides))) return max_sides;
+    return std::max<uint32_t>(3, static_cast<uint32_t>(n));
+}
+
+TEST(LodSides, ThreeSidesShortcutEqualsTheFormula) {
+    Rng rng(19);
+    const LodView view = LodView::perspective(glm::dvec3(0, 0, 5), glm::dvec3(0.0), glm::dvec3(0, 1, 0), kFov, kWidth,
+                                              kHeight, 0.05, 1e4);
+    std::size_t checked = 0, three = 0, more = 0;
+    for (int c = 0; c < 40; ++c) {
+        const double z = std::pow(10.0, uniform(rng, -1.5, 3.0));
+        const double k = uniform(rng, 1.0, 1.6);
+        const double eps = c % 4 == 0 ? 0.5 : std::pow(10.0, uniform(rng, -2.0, 0.5));
+        const uint32_t max_sides = c % 5 == 0 ? 3u : c % 5 == 1 ? 4u : 32u;
+        // The radius at which x = 1/2, then radii around it: every double within 3000 ulps, and relative steps of
+        // 1e-12 out to 1e-8 (past the shortcut's margin on both sides).
+        const double r0 = eps / 0.5 * std::max(z, view.near_m) / (view.focal_px * k);
+        auto check = [&](double radius) {
+            const uint32_t got = sides_for_radius(radius, z, k, view, eps, max_sides);
+            ASSERT_EQ(got, formula_sides(radius, z, k, view, eps, max_sides))
+                << "radius " << radius << " z " << z << " k " << k << " eps " << eps;
+            ++checked;
+            (got == 3 ? three : more) += 1;
+        };
+        double up = r0, down = r0;
+        for (int i = 0; i < 3000; ++i) {
+            check(up);
+            check(down);
+            up = std::nextafter(up, 1e300);
+            down = std::nextafter(down, 0.0);
+        }
+        for (int i = -10000; i <= 10000; ++i) check(r0 * (1.0 + 1e-12 * i));
+        // And the whole range: from far below the switch (x up to 2 and beyond) to far above it.
+        for (int i = 0; i < 2000; ++i) check(r0 * std::pow(10.0, uniform(rng, -2.0, 2.0)));
+    }
+    EXPECT_GT(three, checked / 4);
+    EXPECT_GT(more, checked / 4);
+}
+
 LodView orbit_camera(double angle, double distance) {
     const glm::dvec3 eye(distance * std::sin(angle), 1.0, distance * std::cos(angle));
     return LodView::perspective(eye, glm::dvec3(0.0), glm::dvec3(0, 1, 0), kFov, kWidth, kHeight, 0.05, 1e4);
