@@ -637,7 +637,11 @@ public:
     // 1/r below, both monotone in r (a correctly rounded quotient is monotone in its operands), so its smallest
     // value over the ratios is taken at the smallest r >= 1 or the largest r < 1; the same holds around s. The walk
     // keeps those four ratios (compares, no division per node) and margin() evaluates them: the same value.
-    void note(double r) const { note_into(r, new_scale_, above_one_, below_one_, above_scale_, below_scale_); }
+    void note(double r) const {
+        if (noting_) note_into(r, new_scale_, above_one_, below_one_, above_scale_, below_scale_);
+    }
+    // No margin() wanted (no Coherence is kept): the ratios are not noted.
+    void skip_margin() { noting_ = false; }
     static void note_into(double r, double scale, double& above_one, double& below_one, double& above_scale,
                           double& below_scale) {
         // Branch-free (the sides of 1 and s alternate unpredictably along the walk): std::min / std::max as selects.
@@ -649,7 +653,7 @@ public:
     }
     // A level-wide ratio (set_depth_range) contributes max(r, 1/r) alone: kept the same way.
     void note_level(double r) {
-        if (!(r > 0.0) || !std::isfinite(r)) return;
+        if (!noting_ || !(r > 0.0) || !std::isfinite(r)) return;
         if (r >= 1.0) {
             level_above_one_ = std::min(level_above_one_, r);
         } else {
@@ -697,7 +701,16 @@ public:
     // Writes the spans into `required` and `counts` (other segments keep their values). Returns the number of
     // counts intervals that cross more than one segment.
     uint32_t apply(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
-        return walk_levels(required.data(), counts.data());
+        return noting_ ? walk_levels<false, true>(required.data(), counts.data())
+                       : walk_levels<false, false>(required.data(), counts.data());
+    }
+    // True when the walk writes every segment of both arrays (a span over each): the depth range decided a level
+    // (every node that reaches it takes a span) and the walk runs. apply_zeroed() may then be used instead.
+    [[nodiscard]] bool writes_every_segment() const { return fit_level_ >= 0 && fail_level_ != 0 && b_.levels > 0; }
+    // apply() on arrays that are all 0: only the spans' first entries are written (the rest already hold 0).
+    uint32_t apply_zeroed(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
+        return noting_ ? walk_levels<true, true>(required.data(), counts.data())
+                       : walk_levels<true, false>(required.data(), counts.data());
     }
 
 private:
@@ -707,9 +720,11 @@ private:
             if (old_[i] != 0) return false;
         return true;
     }
+    template <bool Zeroed>
     static void set_span(uint32_t* v, std::size_t s, std::size_t e) {
         v[s] = 1;
-        for (std::size_t i = s + 1; i < e; ++i) v[i] = 0;
+        if constexpr (!Zeroed)
+            for (std::size_t i = s + 1; i < e; ++i) v[i] = 0;
     }
     // Level by level from the top (breadth first): the nodes still undecided at a level are a list (node index
     // times 2, plus 1 when an ancestor already set the required span), ascending; a node that does not take a
@@ -717,6 +732,7 @@ private:
     // decisions: a node's decision depends on its ancestors only, note() keeps minima and maxima (any order),
     // and the spans written by different nodes do not overlap. Levels at or above fail_level_ (ratio infinite:
     // descend, write nothing) are skipped: the walk starts with every node of the level below them.
+    template <bool Zeroed, bool Noting>
     uint32_t walk_levels(uint32_t* required, uint32_t* counts) const {
         const std::size_t levels = b_.levels;
         if (levels == 0 || fail_level_ == 0) return 0;  // no level decides a node: nothing is written
@@ -744,14 +760,14 @@ private:
                 double r = 0.0;
                 if (!decided_fit) {
                     r = level_ratio(level, j);
-                    note_into(r, new_scale_, above_one, below_one, above_scale, below_scale);
+                    if constexpr (Noting) note_into(r, new_scale_, above_one, below_one, above_scale, below_scale);
                 }
                 if (!required_done && r <= 1.0) {
-                    set_span(required, s, e);
+                    set_span<Zeroed>(required, s, e);
                     required_done = true;
                 }
                 if (r <= new_scale_ || (r <= 1.0 && was_merged(s, e))) {
-                    set_span(counts, s, e);
+                    set_span<Zeroed>(counts, s, e);
                     spans += e - s > 1 ? 1u : 0u;
                     continue;
                 }
@@ -784,6 +800,7 @@ private:
     mutable double above_one_ = std::numeric_limits<double>::infinity(), below_one_ = 0.0;
     mutable double above_scale_ = std::numeric_limits<double>::infinity(), below_scale_ = 0.0;
     std::ptrdiff_t fit_level_ = -1;
+    bool noting_ = true;
     std::size_t fail_level_ = std::numeric_limits<std::size_t>::max();
     bool closed_;
     bool inside_;
@@ -1050,6 +1067,9 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     }
     SpanMerger merger(bounds, view, lim.eps, sb.inside, sb.k, curve.closed,
                       settings.coarse_offscreen_segments, lim.band < 0.0 ? 1.0 : 1.0 / (1.0 + lim.band), old);
+    // The margin only serves a Coherence, which is kept for bounds that outlive this update and a wire inside.
+    const bool keeps_coherence = use_bound && !bounds.transient && sb.inside;
+    if (!keeps_coherence) merger.skip_margin();
     merger.set_depth_range(sb.z_lo_m, sb.z_hi_m);
 
     // A sphere inside the frustum whose conservative side count is 3 (so the exact one is too) is decided
@@ -1112,7 +1132,13 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     }
 
     lod.visible = true;
-    if (!whole) {
+    if (!whole && merge && merger.writes_every_segment()) {
+        // Every segment lies in a span of both kinds (the common case on screen): the walk writes each span's
+        // first entry over zeros, and the per-segment counts (and the hysteresis on them) are never read.
+        lod.required.assign(n, 0);
+        lod.counts.assign(n, 0);
+        lod.spans = merger.apply_zeroed(lod.required, lod.counts);
+    } else if (!whole) {
         // Per-segment hysteresis on the Wang counts (all >= 1), then the spans over both.
         lod.counts.resize(n);
         const uint32_t* req = lod.required.data();
@@ -1149,7 +1175,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     lod.sides = sides;
     lod.radius_px = std::isfinite(wire_z) ? radius * view.focal_px * wire_k / std::max(wire_z, view.near_m) : 0.0;
     lod.drawn_sides = drawn_sides_for(lod.radius_px, lod.sides, lod.drawn_sides, settings, lim.band);
-    if (use_bound && lod.bounded && sb.inside && merger.margin() > 1.0) {
+    if (keeps_coherence && lod.bounded && merger.margin() > 1.0) {
         WireLod::Coherence& c = lod.coherence;
         c.valid = true;
         c.bounds = &bounds;

@@ -193,6 +193,10 @@ struct LodBounds {
     std::size_t segments = 0;
     uint32_t levels = 0;                        ///< hierarchy levels (0 for an empty curve)
     uint64_t version = 0;                       ///< new (unique) each time compute_lod_bounds() fills it
+    /// Set by a caller that computes the bounds for one update_lod() only (a wire whose curve changes every
+    /// frame): no WireLod::Coherence is kept for them (it could never be used: the next update has new bounds),
+    /// so the update skips its bookkeeping. compute_lod_bounds() leaves it as it is.
+    bool transient = false;
     std::array<uint32_t, 34> level_start{};     ///< index of node 0 of each level (root level first in memory)
     /// Per level (min, max) deviation; per level (root first) five arrays of level_width() values: centre x,
     /// centre y, centre z, radius, deviation (structure of arrays: built and read by vectorized loops); Wang's M

@@ -376,6 +376,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
         } else if (curve_changed) {
             // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
             thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
+            scratch.transient = true;        // so none is made
             bounds_of(c, scratch);
             changed = update_lod(c.curve, ctx.view, settings, s.lod, scratch);
         } else {
