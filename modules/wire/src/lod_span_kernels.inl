@@ -2,6 +2,31 @@
 // type (L1, L2, L4 or L8 of lod.cpp); narrower lanes do the tail (L4 where WIRE_LOD_TAIL4 is defined, L2, L1). Not
 // a header: no include guard, no namespace of its own.
 
+// Runs run(i, L{}) over [0, n) in groups of L::width consecutive items, the widest lanes first: full groups, then
+// one last group that ends at n and overlaps the one before (its items are computed again, bit for bit, and stored
+// again: every kernel here writes each item's own outputs from its own inputs, and min / max accumulators do not
+// mind an item twice). Where n is below a width, the next narrower lanes do the same. So a tail costs one more group,
+// not one of each narrower width in sequence.
+template <class Run>
+__attribute__((always_inline)) inline void over_lanes(std::size_t n, Run&& run) {
+    auto width = [&]<class L>(L) __attribute__((always_inline)) {
+        if (n < L::width) return false;
+        std::size_t i = 0;
+        for (; i + L::width <= n; i += L::width) run(i, L{});
+        if (i < n) run(n - L::width, L{});
+        return true;
+    };
+    if (width(W{})) return;
+#if defined(WIRE_LOD_TAIL4)
+    if (width(L4{})) return;
+#endif
+#if defined(__SSE2__)
+    if constexpr (W::width > 2)
+        if (width(L2{})) return;
+#endif
+    width(L1{});
+}
+
 // Level 0 of the span hierarchy for one segment per lane: x, y, z of its four control points in; Wang's M, the
 // box (lo, hi), the sphere (centre c, radius r) and the deviation out. A larger of two lengths is the root of the
 // larger squared length (the root is monotone and correctly rounded: the same value, one root fewer). The hull's
@@ -139,16 +164,7 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
         y[3].store(ends + 4 * n + i);
         z[3].store(ends + 5 * n + i);
     };
-    std::size_t i = 0;
-    for (; i + W::width <= n; i += W::width) run(i, W{});
-#if defined(WIRE_LOD_TAIL4)
-    for (; i + 4 <= n; i += 4) run(i, L4{});
-#endif
-#if defined(__SSE2__)
-    if constexpr (W::width > 2)
-        for (; i + 2 <= n; i += 2) run(i, L2{});
-#endif
-    for (; i < n; ++i) run(i, L1{});
+    over_lanes(n, run);
     dev.finish(range[0], range[1]);
     double unused = 0.0;
     m.finish(unused, range[2]);
@@ -185,16 +201,7 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
             dev.add_lanes(q.deviation);
         }
     };
-    std::size_t j = 0;
-    for (; j + W::width <= pairs; j += W::width) run(j, W{});
-#if defined(WIRE_LOD_TAIL4)
-    for (; j + 4 <= pairs; j += 4) run(j, L4{});
-#endif
-#if defined(__SSE2__)
-    if constexpr (W::width > 2)
-        for (; j + 2 <= pairs; j += 2) run(j, L2{});
-#endif
-    for (; j < pairs; ++j) run(j, L1{});
+    over_lanes(pairs, run);
     if (pairs < w) {
         const std::size_t l = cw - 1;
         for (int k = 0; k < 5; ++k) parent[k * w + pairs] = child[k * cw + l];
@@ -244,16 +251,7 @@ inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullC
             outside[i + lane] = static_cast<unsigned char>(o);
         }
     };
-    std::size_t i = 0;
-    for (; i + W::width <= n; i += W::width) run(i, W{});
-#if defined(WIRE_LOD_TAIL4)
-    for (; i + 4 <= n; i += 4) run(i, L4{});
-#endif
-#if defined(__SSE2__)
-    if constexpr (W::width > 2)
-        for (; i + 2 <= n; i += 2) run(i, L2{});
-#endif
-    for (; i < n; ++i) run(i, L1{});
+    over_lanes(n, run);
 }
 
 // Per segment: the world tolerance at its hull depth, eps = scale z_min / k, and Wang's root sqrt(3 M / (4 eps))
@@ -265,16 +263,7 @@ inline void wang_roots(const double* z_min, const double* k, const double* m, st
         eps.store(eps_out + i);
         sqrt_of((L::splat(3.0) * L::load(m + i)) / (L::splat(4.0) * eps)).store(root_out + i);
     };
-    std::size_t i = 0;
-    for (; i + W::width <= n; i += W::width) run(i, W{});
-#if defined(WIRE_LOD_TAIL4)
-    for (; i + 4 <= n; i += 4) run(i, L4{});
-#endif
-#if defined(__SSE2__)
-    if constexpr (W::width > 2)
-        for (; i + 2 <= n; i += 2) run(i, L2{});
-#endif
-    for (; i < n; ++i) run(i, L1{});
+    over_lanes(n, run);
 }
 
 // SpanMerger::ratio() (without the loop limit, which the caller applies) of the w nodes of one level (`node`: its
@@ -310,16 +299,7 @@ inline void span_ratios(const double* node, std::size_t w, const RatioConstants&
         }
         ratio.store(out + j);
     };
-    std::size_t j = 0;
-    for (; j + W::width <= w; j += W::width) run(j, W{});
-#if defined(WIRE_LOD_TAIL4)
-    for (; j + 4 <= w; j += 4) run(j, L4{});
-#endif
-#if defined(__SSE2__)
-    if constexpr (W::width > 2)
-        for (; j + 2 <= w; j += 2) run(j, L2{});
-#endif
-    for (; j < w; ++j) run(j, L1{});
+    over_lanes(w, run);
 }
 
 // The wire's box as curve_bounding_sphere() computes it, as 12 running minima and maxima (lo, hi): lane j of the
