@@ -211,6 +211,12 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
     dev.finish(range[0], range[1]);
 }
 
+// Bit k of an 8-bit mask to bit 0 of byte k: the low 7 bits by one multiplication (the shifted copies of the mask
+// land 7 bits apart, so bit k reaches byte k alone), bit 7 by a shift.
+inline uint64_t spread_bits(unsigned m) {
+    return ((uint64_t{m & 0x7Fu} * 0x0002040810204081ull) & 0x0101010101010101ull) | (uint64_t{(m >> 7) & 1u} << 56);
+}
+
 // Every segment's hull depth (nearest control point depth, clamped to near), off-axis factor k and plane mask
 // (bit i: all four control points farther than the radius outside plane i): hull_depth() and PlaneTest::outside()
 // W::width segments at a time, the same arithmetic per lane (world -> view as ViewTransform computes it).
@@ -243,13 +249,11 @@ inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullC
         b = select(in_front, min_of(b, ty), ty);
         max_of(zm, near).store(z_min + i);
         sqrt_of((L::splat(1.0) + a * a) + b * b).store(k_out + i);
-        unsigned bits[6];
-        for (int p = 0; p < 6; ++p) bits[p] = out[p].bits();
-        for (std::size_t lane = 0; lane < L::width; ++lane) {
-            unsigned o = 0;
-            for (int p = 0; p < 6; ++p) o |= ((bits[p] >> lane) & 1u) << p;
-            outside[i + lane] = static_cast<unsigned char>(o);
-        }
+        // Transpose the six planes' lane masks into one byte per lane: byte k of `bytes` holds lane k's planes.
+        uint64_t bytes = 0;
+        for (int p = 0; p < 6; ++p) bytes |= spread_bits(out[p].bits()) << p;
+        for (std::size_t lane = 0; lane < L::width; ++lane)
+            outside[i + lane] = static_cast<unsigned char>(bytes >> (8 * lane));
     };
     over_lanes(n, run);
 }
