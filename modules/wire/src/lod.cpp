@@ -1283,7 +1283,7 @@ BoundingSphere curve_bounding_sphere(const Curve& curve) {
     const double radius = largest_radius(curve.radius_m);
     const glm::dvec3 centre = 0.5 * (lo + hi);
     // Round the radius up by a relative hair so rounding in the centre cannot leave a corner outside.
-    return {centre, (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
+    return {centre, (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius, radius};
 }
 
 namespace {
@@ -1292,7 +1292,9 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
     const std::size_t n = curve.segment_count();
     out.segments = n;
     out.sphere = BoundingSphere{};  // curve_bounding_sphere(curve), from the level-0 boxes below
-    out.radius_max_m = largest_radius(curve.radius_m);
+    // largest_radius() of the same curve, as the given sphere keeps it (or again).
+    out.radius_max_m = known_sphere != nullptr && known_sphere->tube_radius_m >= 0.0 ? known_sphere->tube_radius_m
+                                                                                  : largest_radius(curve.radius_m);
     out.wang_m_max = 0.0;
     out.levels = 0;
     // Unique over all curves (a state made for other bounds never matches): each thread takes blocks of 2^16
@@ -1346,7 +1348,7 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
         const glm::dvec3 hi(ordered_max(b + 3 * n, n), ordered_max(b + 4 * n, n), ordered_max(b + 5 * n, n));
         // curve_bounding_sphere(curve): the same box (the same minima and maxima), the same rounding.
         const double radius = out.radius_max_m;
-        out.sphere = {0.5 * (lo + hi), (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius};
+        out.sphere = {0.5 * (lo + hi), (0.5 * glm::length(hi - lo)) * (1.0 + 1e-12) + radius, radius};
     }
     // Levels 1 and up, each from the one below, with their deviation ranges; the chord ends alternate between two
     // buffers.

@@ -673,6 +673,7 @@ TEST(LodBoundingSphere, EqualsTheSequenceBitForBit) {
             ASSERT_EQ(bits(got.centre_m[k]), bits(centre[k])) << "case " << i << " axis " << k;
         }
         ASSERT_EQ(bits(got.radius_m), bits(expected_r)) << "case " << i;
+        ASSERT_EQ(bits(got.tube_radius_m), bits(radius)) << "case " << i;  // what compute_lod_bounds() reuses
         nans += has_nan ? 1u : 0u;
         if (!has_nan) {
             LodBounds bounds;

@@ -166,10 +166,13 @@ struct WireLod {
 struct BoundingSphere {
     glm::dvec3 centre_m{};   ///< world metres
     double radius_m = -1.0;  ///< < 0: unknown (update_lod then skips the quick test)
+    /// The largest tube radius of the curve (what radius_m was inflated by), where known (< 0: not known);
+    /// compute_lod_bounds() given the sphere takes it as LodBounds::radius_max_m instead of computing it again.
+    double tube_radius_m = -1.0;
 };
 
 /// The bounding sphere of `curve` (centre of the control points' box, radius its half diagonal plus the largest
-/// tube radius). An empty curve gives radius -1.
+/// tube radius, which it keeps as tube_radius_m). An empty curve gives radius -1.
 [[nodiscard]] BoundingSphere curve_bounding_sphere(const Curve& curve);
 
 /// A node of the span hierarchy: a sphere around the span's control points (not inflated by the tube radius)
