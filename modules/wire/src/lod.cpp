@@ -685,32 +685,55 @@ public:
         fit_level_ = -1;
         fail_level_ = levels;
         const double zh = std::max(z_hi, view_.near_m);
+        const double fit_den = new_scale_ * z_lo;
         for (std::size_t l = 0; l < levels; ++l) {
             const bool loop_limit = l > 0 && closed_ && 3 * (std::size_t{1} << l) > b_.segments;
-            const double fit = b_.level_deviation_max(l) * c_ * k_ / (new_scale_ * z_lo);
-            if (!loop_limit && fit <= 1.0) {
+            // fit = fit_num / fit_den, fail = fail_num / zh, compared with 1 (divided only when noted).
+            const double fit_num = b_.level_deviation_max(l) * c_ * k_;
+            const double fail_num = b_.level_deviation_min(l) * c_ * k_;
+            if (!loop_limit && quotient_at_most_one(fit_num, fit_den)) {
                 fit_level_ = static_cast<std::ptrdiff_t>(l);
             }
-            if (!loop_limit) note_level(fit);
-            const double fail = b_.level_deviation_min(l) * c_ * k_ / zh;
-            if (fail > 1.0 && fail_level_ == levels) fail_level_ = l;
-            note_level(fail);
+            if (quotient_above_one(fail_num, zh) && fail_level_ == levels) fail_level_ = l;
+            if (noting_) {
+                if (!loop_limit) note_level(fit_num / fit_den);
+                note_level(fail_num / zh);
+            }
         }
+    }
+    // The rounded quotient num / den against 1 without dividing where den is positive and finite: num <= den then
+    // decides it exactly. If num > den, num is at least den's next double, so num / den >= 1 + ulp(den) / den >
+    // 1 + 2^-53 and rounds above 1; if num <= den the quotient is <= 1 and so is its rounding; NaN fails both ways.
+    static bool quotient_at_most_one(double num, double den) {
+        if (den > 0.0 && den <= std::numeric_limits<double>::max()) return num <= den;
+        return num / den <= 1.0;
+    }
+    static bool quotient_above_one(double num, double den) {
+        if (den > 0.0 && den <= std::numeric_limits<double>::max()) return num > den;
+        return num / den > 1.0;
     }
 
     // Writes the spans into `required` and `counts` (other segments keep their values). Returns the number of
     // counts intervals that cross more than one segment.
     uint32_t apply(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
-        return noting_ ? walk_levels<false, true>(required.data(), counts.data())
-                       : walk_levels<false, false>(required.data(), counts.data());
+        return noting_ ? walk_levels<false, true>(required.data(), counts.data(), nullptr)
+                       : walk_levels<false, false>(required.data(), counts.data(), nullptr);
     }
     // True when the walk writes every segment of both arrays (a span over each): the depth range decided a level
     // (every node that reaches it takes a span) and the walk runs. apply_zeroed() may then be used instead.
     [[nodiscard]] bool writes_every_segment() const { return fit_level_ >= 0 && fail_level_ != 0 && b_.levels > 0; }
     // apply() on arrays that are all 0: only the spans' first entries are written (the rest already hold 0).
-    uint32_t apply_zeroed(std::vector<uint32_t>& required, std::vector<uint32_t>& counts) const {
-        return noting_ ? walk_levels<true, true>(required.data(), counts.data())
-                       : walk_levels<true, false>(required.data(), counts.data());
+    // `changed`: the entries of counts that now differ from the old counts (each old entry is a new 0 but a span's
+    // first, which is a 1): the old non-zero entries, corrected at the spans' first entries during the walk, so
+    // that the counts just written are not read back.
+    uint32_t apply_zeroed(std::vector<uint32_t>& required, std::vector<uint32_t>& counts, uint32_t& changed) const {
+        uint32_t nonzero = 0;
+        for (const uint32_t o : old_) nonzero += o != 0 ? 1u : 0u;
+        int64_t at_starts = 0;
+        const uint32_t spans = noting_ ? walk_levels<true, true>(required.data(), counts.data(), &at_starts)
+                                       : walk_levels<true, false>(required.data(), counts.data(), &at_starts);
+        changed = static_cast<uint32_t>(static_cast<int64_t>(nonzero) + at_starts);
+        return spans;
     }
 
 private:
@@ -732,8 +755,10 @@ private:
     // decisions: a node's decision depends on its ancestors only, note() keeps minima and maxima (any order),
     // and the spans written by different nodes do not overlap. Levels at or above fail_level_ (ratio infinite:
     // descend, write nothing) are skipped: the walk starts with every node of the level below them.
+    // Zeroed: `at_starts` gets, over the counts spans' first entries s, [old s == 0] - [old s == 1] (what the span's
+    // 1 changes in the count of entries that differ from the old counts).
     template <bool Zeroed, bool Noting>
-    uint32_t walk_levels(uint32_t* required, uint32_t* counts) const {
+    uint32_t walk_levels(uint32_t* required, uint32_t* counts, int64_t* at_starts) const {
         const std::size_t levels = b_.levels;
         if (levels == 0 || fail_level_ == 0) return 0;  // no level decides a node: nothing is written
         const std::size_t top = std::min(levels - 1, fail_level_ - 1);
@@ -769,6 +794,10 @@ private:
                 if (r <= new_scale_ || (r <= 1.0 && was_merged(s, e))) {
                     set_span<Zeroed>(counts, s, e);
                     spans += e - s > 1 ? 1u : 0u;
+                    if constexpr (Zeroed) {
+                        const uint32_t o = s < old_.size() ? old_[s] : 0u;
+                        *at_starts += (o == 0 ? 1 : 0) - (o == 1 ? 1 : 0);
+                    }
                     continue;
                 }
                 if (level == 0) continue;
@@ -1132,12 +1161,15 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     }
 
     lod.visible = true;
+    bool zeroed = false;
+    uint32_t zeroed_changed = 0;
     if (!whole && merge && merger.writes_every_segment()) {
         // Every segment lies in a span of both kinds (the common case on screen): the walk writes each span's
         // first entry over zeros, and the per-segment counts (and the hysteresis on them) are never read.
         lod.required.assign(n, 0);
         lod.counts.assign(n, 0);
-        lod.spans = merger.apply_zeroed(lod.required, lod.counts);
+        lod.spans = merger.apply_zeroed(lod.required, lod.counts, zeroed_changed);
+        zeroed = true;
     } else if (!whole) {
         // Per-segment hysteresis on the Wang counts (all >= 1), then the spans over both.
         lod.counts.resize(n);
@@ -1152,7 +1184,9 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         if (merge) lod.spans = merger.apply(lod.required, lod.counts);
     }
     bool changed = restart;
-    {
+    if (zeroed) {
+        lod.changed_counts += zeroed_changed;
+    } else {
         uint32_t changed_counts = 0;  // a local sum (not the member): the loop vectorizes
         const uint32_t* cnt = lod.counts.data();
         for (std::size_t i = 0; i < n; ++i) changed_counts += cnt[i] != old[i] ? 1u : 0u;

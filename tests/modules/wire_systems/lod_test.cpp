@@ -741,9 +741,20 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
             glm::dvec3 up(0, 1, 0);
             if (glm::length(glm::cross(glm::normalize(look - eye), up)) < 1e-3) up = glm::dvec3(1, 0, 0);
             const LodView view = LodView::perspective(eye, look, up, kFov, kWidth, kHeight, 0.05, 1e6);
+            const std::vector<uint32_t> cheap_before = cheap.counts, reference_before = reference.counts;
             const bool c1 = update_lod(curve, view, settings, cheap, bounds);
             const bool c2 = update_lod(curve, view, settings, reference, &sphere);
             ++updates;
+            // changed_counts: the entries that differ from the last update's (all non-zero ones after a restart).
+            auto changed_entries = [](const std::vector<uint32_t>& before, const std::vector<uint32_t>& after) {
+                uint32_t d = 0;
+                for (std::size_t k = 0; k < after.size(); ++k)
+                    d += after[k] != (before.size() == after.size() ? before[k] : 0u) ? 1u : 0u;
+                return d;
+            };
+            ASSERT_EQ(cheap.changed_counts, changed_entries(cheap_before, cheap.counts)) << "case " << i << " frame " << f;
+            ASSERT_EQ(reference.changed_counts, changed_entries(reference_before, reference.counts))
+                << "case " << i << " frame " << f;
             ASSERT_EQ(cheap.visible, reference.visible) << "case " << i << " frame " << f;
             ASSERT_EQ(cheap.counts, reference.counts) << "case " << i << " frame " << f;
             ASSERT_EQ(cheap.required, reference.required) << "case " << i << " frame " << f;
