@@ -446,13 +446,26 @@ struct L8 {
         return {_mm512_permutex2var_pd(_mm512_loadu_pd(p), idx, _mm512_loadu_pd(p + 8))};
     }
     void store(double* p) const { _mm512_storeu_pd(p, v); }
-    // Two groups of four segments, each by L4's transposes (AVX-512F includes AVX2's shuffles).
+    // L4's 4 x 4 transposes on segments s and s + 4 at once: row s holds doubles k .. k + 3 of segment s in its
+    // low half and of segment s + 4 in its high half; the in-lane unpacks transpose both halves' 2 x 2 blocks,
+    // and one two-source permute per output puts the blocks of segments 0 .. 7 in order.
     static void points(const double* p, L8 (&x)[4], L8 (&y)[4], L8 (&z)[4]) {
-        L4 x0[4], y0[4], z0[4], x1[4], y1[4], z1[4];
-        L4::points(p, x0, y0, z0);
-        L4::points(p + 48, x1, y1, z1);
-        auto join = [](L4 a, L4 b) { return L8{_mm512_insertf64x4(_mm512_castpd256_pd512(a.v), b.v, 1)}; };
-        for (int k = 0; k < 4; ++k) x[k] = join(x0[k], x1[k]), y[k] = join(y0[k], y1[k]), z[k] = join(z0[k], z1[k]);
+        const __m512i even_blocks = _mm512_set_epi64(13, 12, 5, 4, 9, 8, 1, 0);  // a0 b0 a2 b2 (2-double blocks)
+        const __m512i odd_blocks = _mm512_set_epi64(15, 14, 7, 6, 11, 10, 3, 2);  // a1 b1 a3 b3
+        L8 c[12];
+        for (int k = 0; k < 12; k += 4) {
+            __m512d r[4];
+            for (int s = 0; s < 4; ++s)
+                r[s] = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_loadu_pd(p + 12 * s + k)),
+                                          _mm256_loadu_pd(p + 12 * (s + 4) + k), 1);
+            const __m512d t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
+            const __m512d t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
+            c[k] = {_mm512_permutex2var_pd(t0, even_blocks, t2)};
+            c[k + 1] = {_mm512_permutex2var_pd(t1, even_blocks, t3)};
+            c[k + 2] = {_mm512_permutex2var_pd(t0, odd_blocks, t2)};
+            c[k + 3] = {_mm512_permutex2var_pd(t1, odd_blocks, t3)};
+        }
+        for (int k = 0; k < 4; ++k) x[k] = c[3 * k], y[k] = c[3 * k + 1], z[k] = c[3 * k + 2];
     }
 };
 struct M8 {
