@@ -91,13 +91,30 @@ HullDepth hull_depth(const ViewHull& p, const LodView& view) {
     return h;
 }
 
+// The screen edges' factors of a view: sqrt(1 + t^2) of each half angle's tangent (a distance to a side plane
+// per unit of inflation) and the off-axis factor at the corner, sqrt(1 + tx^2 + ty^2). Every wire of a frame
+// asks for the same view's: the last view's are kept (the same operations on the same tangents: the same bits).
+struct EdgeFactors {
+    double tx = std::numeric_limits<double>::quiet_NaN(), ty = std::numeric_limits<double>::quiet_NaN();
+    double sx = 1.0, sy = 1.0, corner = 1.0;
+};
+const EdgeFactors& edge_factors(const LodView& view) {
+    thread_local EdgeFactors e;
+    if (!(e.tx == view.tan_half_x && e.ty == view.tan_half_y)) {
+        const double tx = view.tan_half_x, ty = view.tan_half_y;
+        e = {tx, ty, std::sqrt(1.0 + tx * tx), std::sqrt(1.0 + ty * ty), std::sqrt(1.0 + tx * tx + ty * ty)};
+    }
+    return e;
+}
+
 // The frustum planes in view space, tested against points inflated by a radius: bit i is set when the point is
 // farther than radius_m outside plane i (left, right, bottom, top, near, far: the planes of LodView::planes).
 struct PlaneTest {
     double tx, ty, rx, ry, r, near, far;
-    PlaneTest(const LodView& view, double radius_m)
-        : tx(view.tan_half_x), ty(view.tan_half_y), rx(radius_m * std::sqrt(1.0 + tx * tx)),
-          ry(radius_m * std::sqrt(1.0 + ty * ty)), r(radius_m), near(view.near_m), far(view.far_m) {}
+    PlaneTest(const LodView& view, double radius_m) : PlaneTest(view, radius_m, edge_factors(view)) {}
+    PlaneTest(const LodView& view, double radius_m, const EdgeFactors& f)
+        : tx(view.tan_half_x), ty(view.tan_half_y), rx(radius_m * f.sx), ry(radius_m * f.sy), r(radius_m),
+          near(view.near_m), far(view.far_m) {}
     [[nodiscard]] unsigned outside(const glm::dvec3& q) const {
         unsigned m = 0;
         m |= (q.x + q.z * tx < -rx) ? 1u : 0u;
@@ -561,14 +578,14 @@ public:
           tf_(view),
           c_(view.focal_px / eps),
           k_(k),
-          k_cap_(std::sqrt(1.0 + view.tan_half_x * view.tan_half_x + view.tan_half_y * view.tan_half_y)),
+          k_cap_(edge_factors(view).corner),
           closed_(closed),
           inside_(inside),
           coarse_offscreen_(coarse_offscreen),
           new_scale_(new_span_scale),
           old_(old),
-          sx_(std::sqrt(1.0 + view.tan_half_x * view.tan_half_x)),
-          sy_(std::sqrt(1.0 + view.tan_half_y * view.tan_half_y)) {}
+          sx_(edge_factors(view).sx),
+          sy_(edge_factors(view).sy) {}
 
     // ratio() of every node of a level at once (a lane kernel), computed when the walk first needs the level.
     [[nodiscard]] double level_ratio(std::size_t level, std::size_t j) const {
@@ -1018,7 +1035,7 @@ SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const L
     const ViewTransform tf(view);
     const PlaneTest planes(view, radius);
     const double tx = view.tan_half_x, ty = view.tan_half_y;
-    const double sx = std::sqrt(1.0 + tx * tx), sy = std::sqrt(1.0 + ty * ty);
+    const double sx = edge_factors(view).sx, sy = edge_factors(view).sy;
     const double scale = lim.eps / view.focal_px;
     lod.required.resize(n);
     unsigned wire_outside = 63u;
@@ -1105,7 +1122,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     if (bounds.sphere.radius_m >= 0.0) {
         sb = sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
     } else {
-        sb.k = std::sqrt(1.0 + view.tan_half_x * view.tan_half_x + view.tan_half_y * view.tan_half_y);
+        sb.k = edge_factors(view).corner;
     }
     SpanMerger merger(bounds, view, lim.eps, sb.inside, sb.k, curve.closed,
                       settings.coarse_offscreen_segments, lim.band < 0.0 ? 1.0 : 1.0 / (1.0 + lim.band), old);
