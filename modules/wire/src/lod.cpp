@@ -1398,8 +1398,8 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
     const SpanKernels& kernels = span_kernels();
     // Level 0 with its deviation range (out.data[0], [1]) and the largest M (never -0: a root of a sum of squares).
     double range0[3];
-    kernels.level0(curve.segments.data(), n, out.level_data(0), wang, known_sphere == nullptr ? sc.boxes.data() : nullptr,
-                   sc.ends[0].data(), range0);
+    double* boxes = known_sphere == nullptr ? sc.boxes.data() : nullptr;
+    kernels.level0(curve.segments.data(), n, out.level_data(0), wang, boxes, sc.ends[0].data(), range0);
     out.data[0] = range0[0];
     out.data[1] = range0[1];
     out.wang_m_max = range0[2];

@@ -752,7 +752,8 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
                     d += after[k] != (before.size() == after.size() ? before[k] : 0u) ? 1u : 0u;
                 return d;
             };
-            ASSERT_EQ(cheap.changed_counts, changed_entries(cheap_before, cheap.counts)) << "case " << i << " frame " << f;
+            ASSERT_EQ(cheap.changed_counts, changed_entries(cheap_before, cheap.counts))
+                << "case " << i << " frame " << f;
             ASSERT_EQ(reference.changed_counts, changed_entries(reference_before, reference.counts))
                 << "case " << i << " frame " << f;
             ASSERT_EQ(cheap.visible, reference.visible) << "case " << i << " frame " << f;
