@@ -58,6 +58,13 @@ bool size_ok(const std::vector<T>& v, std::size_t n) { return v.empty() || v.siz
 
 Status check_sizes(const WireNodes& w) {
     const std::size_t n = w.positions.size();
+    // The common case in one branch-free test (every array empty or one per node); the messages below.
+    const auto fits = [n](std::size_t size) { return (size == 0) | (size == n); };
+    if (fits(w.ids.size()) & fits(w.stretch.size()) & fits(w.radius_m.size()) & fits(w.theta_rad.size()) &
+        fits(w.iz_m4.size()) & fits(w.length_m.size()) & fits(w.delta_length_m.size()) & fits(w.area_m2.size()) &
+        fits(w.kb_tension.size()) & fits(w.kb_bias.size()) & fits(w.kb_continuity.size())) {
+        return Status::success();
+    }
     struct Named { const char* name; std::size_t size; bool ok; };
     const Named arrays[] = {
         {"ids", w.ids.size(), size_ok(w.ids, n)},
@@ -610,11 +617,11 @@ void spread_kernel(std::size_t count, const double* __restrict len, const double
 
 /// Per-node tension weights from the turning pattern (see the constants above): g in [0, 1] (concentrated
 /// turn), straight in [0, 1] (end of a load-free span), and the diagonal addition w they give (0 where both are 0).
-/// n curve nodes; every output resized to n.
-void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vector<double>& g,
+/// n curve nodes. Returns false when every weight is 0 (no node to decide: most wires), leaving the outputs
+/// untouched (not zero-filled); else every output is resized to n.
+bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vector<double>& g,
                         std::vector<double>& straight, std::vector<double>& w) {
-    g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
-    if (n < 3) return;
+    if (n < 3) return false;
     thread_local Pool pool;
     pool.reset(3 * (n + 2) + 3 * (n + 1) + 5 * (n + 1) + 4 * n);
     // Curvature vectors k_i = (e_out - e_in) / (mean of the two elements): |k| ~ 2 sin(phi/2) / h. Node i's at
@@ -665,7 +672,8 @@ void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
                   ec + first, eq + first, lkv + first, sumv + first, miss2v + first, flag + first);
     // The rare nodes whose turn the neighbours do not predict (the common case, d <= kSpreadLo: g = 0 and
     // straight = 0), and not straight here and around: none in most wires (one vector test).
-    if (all_within(flag + first, end - first, 0.5)) return;
+    if (all_within(flag + first, end - first, 0.5)) return false;
+    g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
     static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
     for (std::size_t i = first; i < end; ++i) {
         if (flag[i] == 0.0) continue;
@@ -684,6 +692,14 @@ void concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
         const double ws = straight[i] != 0.0 ? std::expm1(straight[i] * log_straight) : 0.0;
         w[i] = wc + ws;
     }
+    return true;
+}
+
+// n zeros (per thread; grown when needed, never written): the weights of a wire with no tensed node.
+const double* zeros(std::size_t n) {
+    thread_local std::vector<double> z;
+    if (z.size() < n) z.resize(n);
+    return z.data();
 }
 
 // Interior rows of the tangent system (node j: incoming chord at index j, outgoing at j + 1; diagonal 2 + w_j).
@@ -711,35 +727,22 @@ void tangents_kernel(std::size_t segs, const double* __restrict D, const double*
     }
 }
 
-// Inner Bezier control points of segments k = 0 .. count-1, in place of their tangents: B1 = P0 + t0/3 from
-// node coordinates p0 (3 per node, segment k's start at 3k), B2 = P1 - t1/3 from p1 (its end at 3k).
-WIRE_VECTOR_CLONES
-void controls_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
-                     double* __restrict b1x, double* __restrict b1y, double* __restrict b1z, double* __restrict b2x,
-                     double* __restrict b2y, double* __restrict b2z) {
-    for (std::size_t k = 0; k < count; ++k) {
-        b1x[k] = p0[3 * k] + b1x[k] * (1.0 / 3.0);
-        b1y[k] = p0[3 * k + 1] + b1y[k] * (1.0 / 3.0);
-        b1z[k] = p0[3 * k + 2] + b1z[k] * (1.0 / 3.0);
-        b2x[k] = p1[3 * k] - b2x[k] * (1.0 / 3.0);
-        b2y[k] = p1[3 * k + 1] - b2y[k] * (1.0 / 3.0);
-        b2z[k] = p1[3 * k + 2] - b2z[k] * (1.0 / 3.0);
-    }
-}
-
 // Bezier segments k = 0 .. count-1 (12 doubles each, out at 12k) from node coordinates p0 (3 per node, segment
-// k's start at 3k), p1 (its end at 3k) and the inner control points.
+// k's start at 3k), p1 (its end at 3k) and the segment tangents: inner control points B1 = P0 + t0/3 and
+// B2 = P1 - t1/3, written straight into the records (one pass: the control points are not stored apart first).
 WIRE_VECTOR_CLONES
 void segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
-                     const double* __restrict b1x, const double* __restrict b1y, const double* __restrict b1z,
-                     const double* __restrict b2x, const double* __restrict b2y, const double* __restrict b2z,
+                     const double* __restrict t0x, const double* __restrict t0y, const double* __restrict t0z,
+                     const double* __restrict t1x, const double* __restrict t1y, const double* __restrict t1z,
                      double* __restrict out) {
     for (std::size_t k = 0; k < count; ++k) {
         double* o = out + 12 * k;
-        o[0] = p0[3 * k], o[1] = p0[3 * k + 1], o[2] = p0[3 * k + 2];
-        o[3] = b1x[k], o[4] = b1y[k], o[5] = b1z[k];
-        o[6] = b2x[k], o[7] = b2y[k], o[8] = b2z[k];
-        o[9] = p1[3 * k], o[10] = p1[3 * k + 1], o[11] = p1[3 * k + 2];
+        const double ax = p0[3 * k], ay = p0[3 * k + 1], az = p0[3 * k + 2];
+        const double bx = p1[3 * k], by = p1[3 * k + 1], bz = p1[3 * k + 2];
+        o[0] = ax, o[1] = ay, o[2] = az;
+        o[3] = ax + t0x[k] * (1.0 / 3.0), o[4] = ay + t0y[k] * (1.0 / 3.0), o[5] = az + t0z[k] * (1.0 / 3.0);
+        o[6] = bx - t1x[k] * (1.0 / 3.0), o[7] = by - t1y[k] * (1.0 / 3.0), o[8] = bz - t1z[k] * (1.0 / 3.0);
+        o[9] = bx, o[10] = by, o[11] = bz;
     }
 }
 
@@ -747,8 +750,8 @@ void segments_kernel(std::size_t count, const double* __restrict p0, const doubl
 /// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
 /// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
 /// the neighbouring node gets tensed.
-void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const std::vector<double>& g,
-                        const std::vector<double>& gs, const std::vector<double>& w, Tangents& tg) {
+void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
+                        const double* w, Tangents& tg) {
     const std::size_t segs = ch.segs;
     const double* __restrict ex = ch.ex.data();  // node i: incoming chord at i, outgoing at i + 1
     const double* __restrict ey = ch.ey.data();
@@ -764,7 +767,7 @@ void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const std:
     double* __restrict c = pool.carve(n);
     // Rows i0 .. i0 + rows - 1 of the interior system, their right-hand sides in place in D.
     const auto fill_rows = [&](std::size_t i0, std::size_t rows) {
-        rows_kernel(rows, w.data() + i0, ex + i0, ey + i0, ez + i0, len + i0, a, b, c, D[0] + i0, D[1] + i0, D[2] + i0);
+        rows_kernel(rows, w + i0, ex + i0, ey + i0, ez + i0, len + i0, a, b, c, D[0] + i0, D[1] + i0, D[2] + i0);
     };
     const auto node = [&](std::size_t i) { return dvec3(D[0][i], D[1][i], D[2][i]); };
     const auto set_node = [&](std::size_t i, const dvec3& v) { D[0][i] = v.x, D[1][i] = v.y, D[2][i] = v.z; };
@@ -819,8 +822,7 @@ void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const std:
 // C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the automatic
 // spline's solve with no node tensed (w = 0 everywhere, ends purely not-a-knot), so the two share one solver.
 void c2_tangents(const Chords& ch, std::size_t n, bool closed, Tangents& tg) {
-    thread_local std::vector<double> untensed;
-    untensed.assign(n, 0.0);
+    const double* const untensed = zeros(n);
     automatic_tangents(ch, n, closed, untensed, untensed, untensed, tg);
 }
 
@@ -883,8 +885,12 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
         c2_tangents(ch, n, closed, tg);
     } else if (kind == SplineKind::automatic) {
         thread_local std::vector<double> g, gs, w;
-        concentrated_turns(ch, n, closed, g, gs, w);
-        automatic_tangents(ch, n, closed, g, gs, w, tg);
+        if (concentrated_turns(ch, n, closed, g, gs, w)) {
+            automatic_tangents(ch, n, closed, g.data(), gs.data(), w.data(), tg);
+        } else {
+            const double* const untensed = zeros(n);
+            automatic_tangents(ch, n, closed, untensed, untensed, untensed, tg);
+        }
         // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
         // C2 only where it is 0). Nothing to scale with the wire's tension 0 and no per-node or physics input.
         if (!nodes.kb_tension.empty() || physics || settings.tension != 0.0) {
@@ -944,27 +950,11 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
         }
     }
 
-    // Inner control points B1 = P0 + t0/3, B2 = P1 - t1/3, in place of the tangents, and their range check.
+    // The Bezier records (inner control points B1 = P0 + t0/3, B2 = P1 - t1/3), then their range check.
     // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the tube's
-    // float vertices downstream.
+    // float vertices downstream. The end points passed check_nodes' tighter range, so one check of the whole
+    // records is the check of the inner control points.
     constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
-    const auto controls = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
-        controls_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0,
-                        tg.t1x + k0, tg.t1y + k0, tg.t1z + k0);
-    };
-    controls(0, n - 1, P, P + 1);
-    if (closed) controls(n - 1, 1, P + (n - 1), P);
-    if (!all_within(tg.buf.data(), 6 * segs, kMaxControl_m)) {
-        for (std::size_t k = 0; k < segs; ++k) {
-            const double v[6] = {tg.t0x[k], tg.t0y[k], tg.t0z[k], tg.t1x[k], tg.t1y[k], tg.t1z[k]};
-            if (all_within(v, 6, kMaxControl_m)) continue;
-            const uint32_t src = m.first[k];
-            clear_curve(out);
-            return Status::error(node_prefix(src) + "tangent overflowed (alpha " + describe(settings.alpha) +
-                                     " is too extreme for this node spacing)", static_cast<int>(src));
-        }
-    }
-    out.closed = closed;
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
     out.segments.resize(segs);
     CubicBezier* const seg = out.segments.data();
@@ -974,6 +964,16 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
     };
     segments(0, n - 1, P, P + 1);
     if (closed) segments(n - 1, 1, P + (n - 1), P);
+    if (!all_within(&seg[0].b0.x, 12 * segs, kMaxControl_m)) {
+        for (std::size_t k = 0; k < segs; ++k) {
+            if (all_within(&seg[k].b1.x, 6, kMaxControl_m)) continue;
+            const uint32_t src = m.first[k];
+            clear_curve(out);
+            return Status::error(node_prefix(src) + "tangent overflowed (alpha " + describe(settings.alpha) +
+                                     " is too extreme for this node spacing)", static_cast<int>(src));
+        }
+    }
+    out.closed = closed;
     out.source_node = m.first;
     const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : 0.01f;
     if (nodes.radius_m.empty()) {
