@@ -746,12 +746,47 @@ void segments_kernel(std::size_t count, const double* __restrict p0, const doubl
     }
 }
 
+// The same records from node tangents per unit chord (D: segment k's start node at k, its end node at k + 1) and
+// the chord lengths: t0 = D[k] len[k], t1 = D[k + 1] len[k] (tangents_kernel's values) taken straight into the
+// control points, with no pass through segment tangents (the spline kinds whose tangents are a node's).
+WIRE_VECTOR_CLONES
+void node_segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
+                          const double* __restrict Dx, const double* __restrict Dy, const double* __restrict Dz,
+                          const double* __restrict len, double* __restrict out) {
+    for (std::size_t k = 0; k < count; ++k) {
+        double* o = out + 12 * k;
+        const double ax = p0[3 * k], ay = p0[3 * k + 1], az = p0[3 * k + 2];
+        const double bx = p1[3 * k], by = p1[3 * k + 1], bz = p1[3 * k + 2];
+        const double h = len[k];
+        o[0] = ax, o[1] = ay, o[2] = az;
+        o[3] = ax + (Dx[k] * h) * (1.0 / 3.0), o[4] = ay + (Dy[k] * h) * (1.0 / 3.0);
+        o[5] = az + (Dz[k] * h) * (1.0 / 3.0);
+        o[6] = bx - (Dx[k + 1] * h) * (1.0 / 3.0), o[7] = by - (Dy[k + 1] * h) * (1.0 / 3.0);
+        o[8] = bz - (Dz[k + 1] * h) * (1.0 / 3.0);
+        o[9] = bx, o[10] = by, o[11] = bz;
+    }
+}
+
+// Node tangents per unit chord, node i's at i and index n repeating node 0's (x, y, z arrays, per-thread memory
+// valid until the next solve).
+struct NodeTangents {
+    const double *x = nullptr, *y = nullptr, *z = nullptr;
+};
+
+// Segment tangents from node tangents (for the kinds that then scale them per node).
+void segment_tangents(const NodeTangents& D, const Chords& ch, Tangents& tg) {
+    const double* const len = ch.len.data() + 1;  // segment k's length
+    tangents_kernel(ch.segs, D.x, len, tg.t0x, tg.t1x);
+    tangents_kernel(ch.segs, D.y, len, tg.t0y, tg.t1y);
+    tangents_kernel(ch.segs, D.z, len, tg.t0z, tg.t1z);
+}
+
 /// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
 /// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
 /// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
 /// the neighbouring node gets tensed.
-void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
-                        const double* w, Tangents& tg) {
+NodeTangents automatic_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
+                                const double* w) {
     const std::size_t segs = ch.segs;
     const double* __restrict ex = ch.ex.data();  // node i: incoming chord at i, outgoing at i + 1
     const double* __restrict ey = ch.ey.data();
@@ -814,16 +849,14 @@ void automatic_tangents(const Chords& ch, std::size_t n, bool closed, const doub
         }
     }
     D[0][n] = D[0][0], D[1][n] = D[1][0], D[2][n] = D[2][0];
-    tangents_kernel(segs, D[0], len + 1, tg.t0x, tg.t1x);
-    tangents_kernel(segs, D[1], len + 1, tg.t0y, tg.t1y);
-    tangents_kernel(segs, D[2], len + 1, tg.t0z, tg.t1z);
+    return {D[0], D[1], D[2]};
 }
 
 // C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the automatic
 // spline's solve with no node tensed (w = 0 everywhere, ends purely not-a-knot), so the two share one solver.
-void c2_tangents(const Chords& ch, std::size_t n, bool closed, Tangents& tg) {
+NodeTangents c2_tangents(const Chords& ch, std::size_t n, bool closed) {
     const double* const untensed = zeros(n);
-    automatic_tangents(ch, n, closed, untensed, untensed, untensed, tg);
+    return automatic_tangents(ch, n, closed, untensed, untensed, untensed);
 }
 
 }  // namespace
@@ -876,24 +909,29 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
         for (std::size_t k = 0; k < segs; ++k) seg_stretch[k] = nodes.stretch[m.last[k]];
     }
 
+    // Segment tangents (t0 at a segment's start, t1 at its end), or the node tangents they come from (node
+    // form: c2 and an automatic spline that no tension scales; the records are then written from those).
     thread_local Tangents tg;
     tg.resize(segs);
+    NodeTangents node_form{};
     const SplineKind kind = settings.kind;
     if (kind == SplineKind::linear) {
         for (std::size_t k = 0; k < segs; ++k) tg.set0(k, ch.d(k)), tg.set1(k, ch.d(k));
     } else if (kind == SplineKind::c2) {
-        c2_tangents(ch, n, closed, tg);
+        node_form = c2_tangents(ch, n, closed);
     } else if (kind == SplineKind::automatic) {
         thread_local std::vector<double> g, gs, w;
         if (concentrated_turns(ch, n, closed, g, gs, w)) {
-            automatic_tangents(ch, n, closed, g.data(), gs.data(), w.data(), tg);
+            node_form = automatic_tangents(ch, n, closed, g.data(), gs.data(), w.data());
         } else {
             const double* const untensed = zeros(n);
-            automatic_tangents(ch, n, closed, untensed, untensed, untensed, tg);
+            node_form = automatic_tangents(ch, n, closed, untensed, untensed, untensed);
         }
         // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
         // C2 only where it is 0). Nothing to scale with the wire's tension 0 and no per-node or physics input.
         if (!nodes.kb_tension.empty() || physics || settings.tension != 0.0) {
+            segment_tangents(node_form, ch, tg);
+            node_form = {};
             for (std::size_t j = 0; j < n; ++j) {
                 const uint32_t src = m.first[j];
                 const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
@@ -959,8 +997,13 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
     out.segments.resize(segs);
     CubicBezier* const seg = out.segments.data();
     const auto segments = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
-        segments_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0,
-                        tg.t1x + k0, tg.t1y + k0, tg.t1z + k0, &seg[k0].b0.x);
+        if (node_form.x != nullptr) {
+            node_segments_kernel(count, &p0->x, &p1->x, node_form.x + k0, node_form.y + k0, node_form.z + k0,
+                                 ch.len.data() + 1 + k0, &seg[k0].b0.x);
+        } else {
+            segments_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0,
+                            tg.t1x + k0, tg.t1y + k0, tg.t1z + k0, &seg[k0].b0.x);
+        }
     };
     segments(0, n - 1, P, P + 1);
     if (closed) segments(n - 1, 1, P + (n - 1), P);
