@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -781,25 +782,105 @@ void segment_tangents(const NodeTangents& D, const Chords& ch, Tangents& tg) {
     tangents_kernel(ch.segs, D.z, len, tg.t0z, tg.t1z);
 }
 
+// An automatic (or c2) spline's tangent system between its setup and its solution, so that the tridiagonal
+// solves of two wires can run side by side (thomas_pair): the solve is a serial chain of divisions per wire, and
+// two independent chains take the time of one.
+struct TangentSolve {
+    double* D[3] = {};        // node tangents per unit chord (n + 1 each; index n repeats node 0's)
+    double *a = nullptr, *b = nullptr, *c = nullptr, *f = nullptr;  // interior rows (of nodes 1 .. m); f: factors
+    std::size_t n = 0, m = 0;  // nodes; interior rows
+    bool pending = false;      // the interior rows still to solve (an open wire of >= 4 nodes), then the ends
+    dvec3 r0{}, rl{};          // the end rows' right-hand sides and diagonals (beta D0 + D1 = r0, ...)
+    double beta0 = 0.0, betal = 0.0;
+    double* r(int q) const { return D[q] + 1; }  // right-hand sides of the interior rows, solved in place
+};
+
+// Solves a pending system alone.
+void solve(TangentSolve& ts) {
+    thomas_kernel<3>(ts.a, ts.b, ts.c, ts.m, ts.f, ts.r(0), ts.r(1), ts.r(2));
+}
+
+// thomas_kernel<3> for two systems of the same size (>= 4 rows) at once: system s in lane s of two-double
+// vectors (native on every x86-64), so every row gets exactly the operations thomas_kernel gives it (each lane
+// is rounded as the scalar operation; the results are bit for bit its) and the two systems' division chains
+// run side by side, in the registers (scalar code for two systems spilled its chain values).
+void thomas_pair(TangentSolve& s0, TangentSolve& s1) {
+    using v2 = double __attribute__((vector_size(16)));
+    const std::size_t n = s0.m, p = n / 2;  // the meeting row, as thomas_kernel's
+    assert(s1.m == n && n >= 4);
+    const double *const a0 = s0.a, *const a1 = s1.a, *const b0 = s0.b, *const b1 = s1.b;
+    const double *const c0 = s0.c, *const c1 = s1.c;
+    double *const f0 = s0.f, *const f1 = s1.f;
+    double* const r0[3] = {s0.r(0), s0.r(1), s0.r(2)};
+    double* const r1[3] = {s1.r(0), s1.r(1), s1.r(2)};
+    const auto a = [&](std::size_t i) { return v2{a0[i], a1[i]}; };
+    const auto b = [&](std::size_t i) { return v2{b0[i], b1[i]}; };
+    const auto c = [&](std::size_t i) { return v2{c0[i], c1[i]}; };
+    const auto r = [&](int q, std::size_t i) { return v2{r0[q][i], r1[q][i]}; };
+    const auto put_f = [&](std::size_t i, v2 v) { f0[i] = v[0], f1[i] = v[1]; };
+    const auto put_r = [&](int q, std::size_t i, v2 v) { r0[q][i] = v[0], r1[q][i] = v[1]; };
+    const v2 one = {1.0, 1.0};
+    v2 t[3], u[3];  // the top and bottom chains' last rows
+    v2 inv = one / b(0);
+    v2 ft = c(0) * inv;
+    put_f(0, ft);
+    for (int q = 0; q < 3; ++q) t[q] = r(q, 0) * inv, put_r(q, 0, t[q]);
+    inv = one / b(n - 1);
+    v2 fb = a(n - 1) * inv;
+    put_f(n - 1, fb);
+    for (int q = 0; q < 3; ++q) u[q] = r(q, n - 1) * inv, put_r(q, n - 1, u[q]);
+    const auto top = [&](std::size_t i) {
+        const v2 ai = a(i), it = one / (b(i) - ai * ft);
+        ft = c(i) * it;
+        put_f(i, ft);
+        for (int q = 0; q < 3; ++q) t[q] = (r(q, i) - ai * t[q]) * it, put_r(q, i, t[q]);
+    };
+    const auto bottom = [&](std::size_t j) {
+        const v2 cj = c(j), ib = one / (b(j) - cj * fb);
+        fb = a(j) * ib;
+        put_f(j, fb);
+        for (int q = 0; q < 3; ++q) u[q] = (r(q, j) - cj * u[q]) * ib, put_r(q, j, u[q]);
+    };
+    const auto back = [&](std::size_t i, v2* v) {
+        const v2 fi = {f0[i], f1[i]};
+        for (int q = 0; q < 3; ++q) v[q] = r(q, i) - fi * v[q], put_r(q, i, v[q]);
+    };
+    std::size_t i = 1, j = n - 2;
+    for (; i < p && j > p; ++i, --j) top(i), bottom(j);
+    for (; i < p; ++i) top(i);
+    for (; j > p; --j) bottom(j);
+    // Row p, as thomas_kernel's.
+    inv = one / (b(p) - a(p) * ft - c(p) * fb);
+    for (int q = 0; q < 3; ++q) t[q] = (r(q, p) - a(p) * t[q] - c(p) * u[q]) * inv, put_r(q, p, t[q]), u[q] = t[q];
+    for (i = p, j = p; i > 0 && j + 1 < n;) {
+        --i, ++j;
+        back(i, t), back(j, u);
+    }
+    while (i > 0) --i, back(i, t);
+    while (j + 1 < n) ++j, back(j, u);
+}
+
 /// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
 /// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
 /// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
 /// the neighbouring node gets tensed.
-NodeTangents automatic_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
-                                const double* w) {
+/// The setup: everything but the solve of an open wire's interior rows (ts.pending), which solve() or
+/// thomas_pair() does before finish_tangents(). `pool` holds the system until then.
+void start_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
+                    const double* w, Pool& pool, TangentSolve& ts) {
     const std::size_t segs = ch.segs;
     const double* __restrict ex = ch.ex.data();  // node i: incoming chord at i, outgoing at i + 1
     const double* __restrict ey = ch.ey.data();
     const double* __restrict ez = ch.ez.data();
     const double* __restrict len = ch.len.data();
-    // Working memory: per thread, reused (no allocation per call once large enough). D (node tangents per unit
-    // chord) has index n repeating node 0's.
-    thread_local Pool pool;
-    pool.reset(3 * (n + 1) + 3 * n);
+    // Working memory: the caller's, reused (no allocation per call once large enough). D (node tangents per
+    // unit chord) has index n repeating node 0's.
+    pool.reset(3 * (n + 1) + 4 * n);
     double* const D[3] = {pool.carve(n + 1), pool.carve(n + 1), pool.carve(n + 1)};
     double* __restrict a = pool.carve(n);
     double* __restrict b = pool.carve(n);
     double* __restrict c = pool.carve(n);
+    ts = TangentSolve{{D[0], D[1], D[2]}, a, b, c, pool.carve(n), n, 0, false};
     // Rows i0 .. i0 + rows - 1 of the interior system, their right-hand sides in place in D.
     const auto fill_rows = [&](std::size_t i0, std::size_t rows) {
         rows_kernel(rows, w + i0, ex + i0, ey + i0, ez + i0, len + i0, a, b, c, D[0] + i0, D[1] + i0, D[2] + i0);
@@ -839,24 +920,27 @@ NodeTangents automatic_tangents(const Chords& ch, std::size_t n, bool closed, co
             set_node(1, (1.0 - g1) * p1 + g1 * t1);
             set_node(2, (1.0 - g1) * p2 + g1 * t2);
         } else {
-            // Eliminate D0 and D[n-1] (pivots stay >= 1: a/beta <= 1).
+            // Eliminate D0 and D[n-1] (pivots stay >= 1: a/beta <= 1); the interior rows are solved next.
             set_node(1, node(1) - (a[0] / beta0) * r0), b[0] -= a[0] / beta0, a[0] = 0.0;
             set_node(m, node(m) - (c[m - 1] / betal) * rl), b[m - 1] -= c[m - 1] / betal, c[m - 1] = 0.0;
-            double* const r[3] = {D[0] + 1, D[1] + 1, D[2] + 1};
-            thomas<3>(a, b, c, m, r);
-            set_node(0, (r0 - node(1)) / beta0);
-            set_node(n - 1, (rl - node(n - 2)) / betal);
+            ts.m = m, ts.pending = true;
+            ts.r0 = r0, ts.rl = rl, ts.beta0 = beta0, ts.betal = betal;
         }
+    }
+}
+
+// The end nodes from the solved interior (an open wire's), and index n; the node tangents.
+NodeTangents finish_tangents(const TangentSolve& ts) {
+    double* const* D = ts.D;
+    const std::size_t n = ts.n;
+    const auto node = [&](std::size_t i) { return dvec3(D[0][i], D[1][i], D[2][i]); };
+    const auto set_node = [&](std::size_t i, const dvec3& v) { D[0][i] = v.x, D[1][i] = v.y, D[2][i] = v.z; };
+    if (ts.pending) {
+        set_node(0, (ts.r0 - node(1)) / ts.beta0);
+        set_node(n - 1, (ts.rl - node(n - 2)) / ts.betal);
     }
     D[0][n] = D[0][0], D[1][n] = D[1][0], D[2][n] = D[2][0];
     return {D[0], D[1], D[2]};
-}
-
-// C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the automatic
-// spline's solve with no node tensed (w = 0 everywhere, ends purely not-a-knot), so the two share one solver.
-NodeTangents c2_tangents(const Chords& ch, std::size_t n, bool closed) {
-    const double* const untensed = zeros(n);
-    return automatic_tangents(ch, n, closed, untensed, untensed, untensed);
 }
 
 }  // namespace
@@ -877,19 +961,85 @@ void clear_curve(Curve& c) {
 
 namespace {
 
-// build_curve without its clearing of `out` on entry: every field is overwritten on success (the segments
-// resized, not cleared first: a curve reused for the same wire is not zero-filled before it is written), and
-// build_curve clears it on failure.
-Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
+// One wire's working memory in the curve stage (per thread, reused: no allocation per call once it is large
+// enough), and what its build carries from begin_curve to end_curve.
+struct CurveBuild {
+    Merged m;
+    Chords ch;
+    Tangents tg;
+    std::vector<double> g, gs, w;  // automatic: tension weights
+    Pool pool;                     // c2, automatic: the tangent system
+    TangentSolve ts;
+    const dvec3* P = nullptr;      // the curve's nodes (merged)
+    std::size_t n = 0, segs = 0;
+    bool physics = false;          // the physics arrays drive a curvature tension
+    bool solved = false;           // c2, automatic: node tangents in ts (once ts.pending is solved)
+};
+
+// Catmull-Rom / Kochanek-Bartels segment tangents into build.tg (see spline.hpp).
+void catmull_rom_tangents(const WireNodes& nodes, const SplineSettings& settings, CurveBuild& build) {
+    const Merged& m = build.m;
+    const Chords& ch = build.ch;
+    Tangents& tg = build.tg;
+    const std::size_t n = build.n, segs = build.segs;
+    const bool closed = settings.closed, physics = build.physics;
+    const double alpha = settings.alpha;
+    for (std::size_t j = 0; j < n; ++j) {
+        const uint32_t src = m.first[j];
+        const bool has_in = closed || j > 0, has_out = closed || j + 1 < n;
+        const std::size_t kin = has_in ? (j == 0 ? segs - 1 : j - 1) : 0;
+        const std::size_t kout = has_out ? (j == segs ? 0 : j) : segs - 1;
+        // Open ends reflect the missing neighbour (P[-1] = 2P[0]-P[1]): the missing chord equals the other.
+        const dvec3 din = has_in ? ch.d(kin) : ch.d(kout);
+        const dvec3 dout = has_out ? ch.d(kout) : ch.d(kin);
+        const double lin = has_in ? ch.l(kin) : ch.l(kout);
+        const double lout = has_out ? ch.l(kout) : ch.l(kin);
+
+        const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
+        const double b = nodes.kb_bias.empty() ? settings.bias : nodes.kb_bias[src];
+        const double c = nodes.kb_continuity.empty() ? settings.continuity : nodes.kb_continuity[src];
+        double t_curv = 0.0;
+        if (physics) {
+            t_curv = curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
+                                       nodes.delta_length_m[src], nodes.area_m2[src]);
+        }
+        const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
+        const double keep = 1.0 - t;
+
+        // Only the knot ratio matters; computed in the log domain so extreme alpha or spacing cannot give 0/0.
+        // alpha 1 and 0.5 (chordal, centripetal): the ratio itself and its square root, no log/exp; the
+        // same clamp as the log domain's (both lengths are > 0 and finite, so the ratio is never 0/0).
+        double rho;
+        if (alpha == 1.0 || alpha == 0.5) {
+            rho = lout / lin;
+            if (alpha == 0.5) rho = std::sqrt(rho);
+            rho = std::clamp(rho, kMinKnotRatio, kMaxKnotRatio);
+        } else {
+            const double lr = alpha == 0.0 ? 0.0 : std::clamp(alpha * (std::log(lout) - std::log(lin)), -300.0, 300.0);
+            rho = std::exp(lr);
+        }
+        const double w = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);  // w + iw = 1
+        const dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
+        const dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
+        if (has_out) tg.set0(kout, start);
+        if (has_in) tg.set1(kin, end);
+    }
+}
+
+// build_curve without its clearing of `out` on entry, in two halves around the tridiagonal solve of c2 and
+// automatic curves (b.ts.pending: solve() or thomas_pair() runs it in between). Every field of `out` is
+// overwritten on success (the segments resized, not cleared first: a curve reused for the same wire is not
+// zero-filled before it is written), and build_curve clears it on failure.
+Status begin_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out, CurveBuild& b) {
+    b.ts.pending = false, b.solved = false;
     if (Status st = check_settings(settings); !st) return st;
     if (Status st = check_sizes(nodes); !st) return st;
     const bool physics = settings.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
                          !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
     if (Status st = check_nodes(nodes, physics); !st) return st;
 
-    // Working memory, reused: no allocation per call once it is large enough.
-    thread_local Merged m;
-    thread_local Chords ch;
+    Merged& m = b.m;
+    Chords& ch = b.ch;
     std::size_t n = 0;
     const dvec3* const P = merge_nodes(nodes, settings, m, ch, n);
     const bool closed = settings.closed;
@@ -909,24 +1059,47 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
         for (std::size_t k = 0; k < segs; ++k) seg_stretch[k] = nodes.stretch[m.last[k]];
     }
 
-    // Segment tangents (t0 at a segment's start, t1 at its end), or the node tangents they come from (node
-    // form: c2 and an automatic spline that no tension scales; the records are then written from those).
-    thread_local Tangents tg;
+    b.P = P, b.n = n, b.segs = segs, b.physics = physics;
+
+    // Segment tangents (t0 at a segment's start, t1 at its end); c2 and automatic: node tangents, from the
+    // tangent system set up here and solved before end_curve.
+    Tangents& tg = b.tg;
     tg.resize(segs);
-    NodeTangents node_form{};
     const SplineKind kind = settings.kind;
     if (kind == SplineKind::linear) {
         for (std::size_t k = 0; k < segs; ++k) tg.set0(k, ch.d(k)), tg.set1(k, ch.d(k));
     } else if (kind == SplineKind::c2) {
-        node_form = c2_tangents(ch, n, closed);
+        // C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the
+        // automatic spline's system with no node tensed (w = 0 everywhere, ends purely not-a-knot).
+        const double* const untensed = zeros(n);
+        start_tangents(ch, n, closed, untensed, untensed, untensed, b.pool, b.ts);
+        b.solved = true;
     } else if (kind == SplineKind::automatic) {
-        thread_local std::vector<double> g, gs, w;
-        if (concentrated_turns(ch, n, closed, g, gs, w)) {
-            node_form = automatic_tangents(ch, n, closed, g.data(), gs.data(), w.data());
+        if (concentrated_turns(ch, n, closed, b.g, b.gs, b.w)) {
+            start_tangents(ch, n, closed, b.g.data(), b.gs.data(), b.w.data(), b.pool, b.ts);
         } else {
             const double* const untensed = zeros(n);
-            node_form = automatic_tangents(ch, n, closed, untensed, untensed, untensed);
+            start_tangents(ch, n, closed, untensed, untensed, untensed, b.pool, b.ts);
         }
+        b.solved = true;
+    } else {
+        catmull_rom_tangents(nodes, settings, b);
+    }
+    return Status::success();
+}
+
+Status end_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out, CurveBuild& b) {
+    const Merged& m = b.m;
+    const Chords& ch = b.ch;
+    Tangents& tg = b.tg;
+    const dvec3* const P = b.P;
+    const std::size_t n = b.n, segs = b.segs;
+    const bool closed = settings.closed, physics = b.physics;
+    // The records are written from the node tangents (c2, and an automatic spline that no tension scales) or
+    // from segment tangents.
+    NodeTangents node_form{};
+    if (b.solved) node_form = finish_tangents(b.ts);
+    if (settings.kind == SplineKind::automatic) {
         // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
         // C2 only where it is 0). Nothing to scale with the wire's tension 0 and no per-node or physics input.
         if (!nodes.kb_tension.empty() || physics || settings.tension != 0.0) {
@@ -944,49 +1117,8 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
                 if (closed || j > 0) tg.scale1(j == 0 ? segs - 1 : j - 1, keep);
             }
         }
-    } else {
-        const double alpha = settings.alpha;
-        for (std::size_t j = 0; j < n; ++j) {
-            const uint32_t src = m.first[j];
-            const bool has_in = closed || j > 0, has_out = closed || j + 1 < n;
-            const std::size_t kin = has_in ? (j == 0 ? segs - 1 : j - 1) : 0;
-            const std::size_t kout = has_out ? (j == segs ? 0 : j) : segs - 1;
-            // Open ends reflect the missing neighbour (P[-1] = 2P[0]-P[1]): the missing chord equals the other.
-            const dvec3 din = has_in ? ch.d(kin) : ch.d(kout);
-            const dvec3 dout = has_out ? ch.d(kout) : ch.d(kin);
-            const double lin = has_in ? ch.l(kin) : ch.l(kout);
-            const double lout = has_out ? ch.l(kout) : ch.l(kin);
-
-            const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
-            const double b = nodes.kb_bias.empty() ? settings.bias : nodes.kb_bias[src];
-            const double c = nodes.kb_continuity.empty() ? settings.continuity : nodes.kb_continuity[src];
-            double t_curv = 0.0;
-            if (physics) {
-                t_curv = curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
-                                           nodes.delta_length_m[src], nodes.area_m2[src]);
-            }
-            const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
-            const double keep = 1.0 - t;
-
-            // Only the knot ratio matters; computed in the log domain so extreme alpha or spacing cannot give 0/0.
-            // alpha 1 and 0.5 (chordal, centripetal): the ratio itself and its square root, no log/exp; the
-            // same clamp as the log domain's (both lengths are > 0 and finite, so the ratio is never 0/0).
-            double rho;
-            if (alpha == 1.0 || alpha == 0.5) {
-                rho = lout / lin;
-                if (alpha == 0.5) rho = std::sqrt(rho);
-                rho = std::clamp(rho, kMinKnotRatio, kMaxKnotRatio);
-            } else {
-                const double lr = alpha == 0.0 ? 0.0 : std::clamp(alpha * (std::log(lout) - std::log(lin)), -300.0, 300.0);
-                rho = std::exp(lr);
-            }
-            const double w = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);  // w + iw = 1
-            const dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
-            const dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
-            if (has_out) tg.set0(kout, start);
-            if (has_in) tg.set1(kin, end);
-        }
     }
+
 
     // The Bezier records (inner control points B1 = P0 + t0/3, B2 = P1 - t1/3), then their range check.
     // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the tube's
@@ -1034,9 +1166,32 @@ Status build_curve_into(const WireNodes& nodes, const SplineSettings& settings, 
 }  // namespace
 
 Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
-    Status st = build_curve_into(nodes, settings, out);
+    thread_local CurveBuild b;
+    Status st = begin_curve(nodes, settings, out, b);
+    if (st && b.ts.pending) solve(b.ts);
+    if (st) st = end_curve(nodes, settings, out, b);
     if (!st) clear_curve(out);
     return st;
+}
+
+std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0, Curve& out0,
+                                           const WireNodes& nodes1, const SplineSettings& settings1, Curve& out1) {
+    assert(&out0 != &out1);
+    thread_local CurveBuild b0, b1;  // not build_curve's: each build keeps its own memory until its end
+    Status st0 = begin_curve(nodes0, settings0, out0, b0);
+    Status st1 = begin_curve(nodes1, settings1, out1, b1);
+    const bool pair = st0 && st1 && b0.ts.pending && b1.ts.pending && b0.ts.m == b1.ts.m && b0.ts.m >= 4;
+    if (pair) {
+        thomas_pair(b0.ts, b1.ts);
+    } else {
+        if (st0 && b0.ts.pending) solve(b0.ts);
+        if (st1 && b1.ts.pending) solve(b1.ts);
+    }
+    if (st0) st0 = end_curve(nodes0, settings0, out0, b0);
+    if (st1) st1 = end_curve(nodes1, settings1, out1, b1);
+    if (!st0) clear_curve(out0);
+    if (!st1) clear_curve(out1);
+    return {std::move(st0), std::move(st1)};
 }
 
 }  // namespace wire

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -177,4 +178,68 @@ TEST(WireCurveFamilies, AutoIsG1AndMovesContinuouslyWithItsNodesOnEveryFamily) {
     }
     std::printf("\nauto on all %zu cases: worst kink %.3g rad, worst curve move / node move %.3g\n", all.size(),
                 worst_kink, worst_gain);
+}
+
+namespace {
+bool same_curve(const Curve& a, const Curve& b) {
+    const auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+    const auto eq = [&](const auto& x, const auto& y) {
+        return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), bytes(x)) == 0);
+    };
+    return a.closed == b.closed && eq(a.segments, b.segments) && eq(a.source_node, b.source_node) &&
+           eq(a.radius_m, b.radius_m) && eq(a.stretch, b.stretch);
+}
+}  // namespace
+
+TEST(WireCurveFamilies, PairBuildsEqualSingleBuildsBitForBit) {
+    // build_curve_pair interleaves two wires' tridiagonal solves (open c2 / automatic wires of the same node
+    // count) and must give exactly build_curve's outputs and statuses: every family, each case paired with a
+    // moved copy of itself (same size: the interleaved solve) and with the next case (mostly another size),
+    // open and closed, c2, automatic and catmull_rom, a wire-wide tension, and an invalid wire in either slot.
+    std::vector<Case> all = catenaries(kSeed, 60);
+    for (auto* more : {&zigzags, &helices, &wrapped}) {
+        std::vector<Case> f = (*more)(kSeed, 30);
+        all.insert(all.end(), f.begin(), f.end());
+    }
+    uint64_t state = 777;
+    auto next = [&state] { state = state * 6364136223846793005ull + 1442695040888963407ull; return static_cast<double>(state >> 11) * 0x1.0p-53; };
+    SplineSettings tensioned{.kind = SplineKind::automatic};
+    tensioned.tension = 0.3;
+    SplineSettings closed_auto{.kind = SplineKind::automatic};
+    closed_auto.closed = true;
+    const SplineSettings settings[] = {kMethods[kAuto].settings, kMethods[2].settings, kMethods[kChordal].settings,
+                                       tensioned, closed_auto};
+    Curve p0, p1, s0, s1;  // reused across cases, as the systems reuse them
+    int pairs = 0, interleaved = 0;
+    for (std::size_t ci = 0; ci < all.size(); ++ci) {
+        WireNodes moved = all[ci].nodes;
+        for (glm::dvec3& p : moved.positions) p += 1e-3 * glm::dvec3(next() - 0.5, next() - 0.5, next() - 0.5);
+        WireNodes bad = moved;
+        bad.positions[moved.positions.size() / 2].y = std::nan("");
+        const WireNodes* partners[] = {&moved, &all[(ci + 1) % all.size()].nodes, &bad};
+        for (const WireNodes* other : partners) {
+            for (const SplineSettings& sa : settings) {
+                const SplineSettings& sb = settings[(&sa - settings + ci) % std::size(settings)];
+                for (int swap = 0; swap < 2; ++swap) {
+                    const WireNodes& na = swap ? *other : all[ci].nodes;
+                    const WireNodes& nb = swap ? all[ci].nodes : *other;
+                    const Status single0 = build_curve(na, sa, s0), single1 = build_curve(nb, sb, s1);
+                    const auto [pair0, pair1] = build_curve_pair(na, sa, p0, nb, sb, p1);
+                    ++pairs;
+                    interleaved += single0.ok && single1.ok && sa.kind == sb.kind && !sa.closed && !sb.closed &&
+                                   sa.kind != SplineKind::catmull_rom && na.size() == nb.size();
+                    EXPECT_EQ(pair0.ok, single0.ok) << all[ci].label;
+                    EXPECT_EQ(pair0.message, single0.message) << all[ci].label;
+                    EXPECT_EQ(pair0.node, single0.node) << all[ci].label;
+                    EXPECT_EQ(pair1.ok, single1.ok) << all[ci].label;
+                    EXPECT_EQ(pair1.message, single1.message) << all[ci].label;
+                    EXPECT_EQ(pair1.node, single1.node) << all[ci].label;
+                    EXPECT_TRUE(same_curve(p0, s0)) << all[ci].family << " #" << ci << " " << all[ci].label;
+                    EXPECT_TRUE(same_curve(p1, s1)) << all[ci].family << " #" << ci << " " << all[ci].label;
+                }
+            }
+        }
+    }
+    EXPECT_GT(interleaved, 100);  // the interleaved solve did run
+    std::printf("\n%d pairs, %d of them two valid open same-size c2/automatic wires\n", pairs, interleaved);
 }

@@ -47,6 +47,8 @@
 #include "wire/nodes.hpp"
 #include "wire/status.hpp"
 
+#include <utility>
+
 namespace wire {
 
 /// Builds the curve for `nodes`. On success `out` holds node_count() = merged nodes, segment_count() =
@@ -54,6 +56,13 @@ namespace wire {
 /// the offending input node and field, e.g. "node 3: position.y is NaN". Never throws on bad input.
 /// Cost O(n) time and memory for every kind (100,000 nodes: a few ms).
 [[nodiscard]] Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out);
+
+/// build_curve for two wires (into two different curves): the same outputs and statuses, bit for bit, as two
+/// build_curve calls. Faster where both are open c2 or automatic wires with the same number of curve nodes: the
+/// tridiagonal solve, a serial chain of divisions per wire, runs for both side by side.
+[[nodiscard]] std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0,
+                                                         Curve& out0, const WireNodes& nodes1,
+                                                         const SplineSettings& settings1, Curve& out1);
 
 /// The thesis' curvature-driven tension for one node: R = theta*Iz*L / (A*dL^2); 0 if R > 100 (or dL = 0),
 /// else 1 - tanh(R/50). Non-finite or non-positive denominators give 0.

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -207,11 +208,18 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     // The view the LOD stage will see (unless the camera changes in between: the LOD stage then restores what
     // needs restoring). A released wire that moved and is still outside it stays released (below).
     const LodView cull_view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
-    parallel_over(jobs.size(), [&](std::size_t i) {
-        CurveJob& job = jobs[i];
+    // One wire's update in two steps around its build, so that two wires building their exact curves share
+    // build_curve_pair (their tridiagonal solves, a serial chain of divisions each, run side by side).
+    struct Step {
+        SplineSettings spline;           // the wire's settings now
+        SplineSettings released_spline;  // what a released curve was built with
+        bool exact = false;              // the exact curve is built (no pop-free blending)
+    };
+    const auto prepare = [&](CurveJob& job, Step& step) {
         WireCurve& c = *job.curve;
-        const SplineSettings spline = spline_of(*job.style);
-        const SplineSettings released_spline = c.spline;  // what a released curve was built with
+        step.spline = spline_of(*job.style);
+        step.released_spline = c.spline;
+        const SplineSettings& spline = step.spline;
         if (c.builds == 0 || !same_spline(spline, c.spline) || c.geomorph != pop_free || c.blend_s != job.style->blend_s) {
             c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
             c.spline = spline;
@@ -222,16 +230,22 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         const WireNodes& prev = c.previous_nodes;
         const bool same_ids = c.generation > 0 && !c.blending && nodes.ids == prev.ids &&
                               (!nodes.ids.empty() || nodes.size() == prev.size());
-        // build_curve's output: one buffer per thread (swapped with the wire's curve), not one per wire.
-        thread_local Curve scratch;
         // The first valid state has nothing to blend from: the multires would show its exact curve too (and is
         // primed from previous_nodes if the next state changes ids, as after any fast-path frame).
         const bool first = c.generation == 0;
+        // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
+        step.exact = !pop_free || same_ids || first;
+    };
+    // After the build (exact: job.status is build_curve's, its curve in `scratch`, a per-thread buffer swapped
+    // with the wire's curve, not one per wire).
+    const auto finish = [&](CurveJob& job, const Step& step, Curve& scratch) {
+        WireCurve& c = *job.curve;
+        const SplineSettings& spline = step.spline;
+        const WireNodes& nodes = *job.nodes;
+        const WireNodes& prev = c.previous_nodes;
         bool stays_released = false;
         BoundingSphere sphere{};  // of the new curve, once computed (radius >= 0)
-        if (!pop_free || same_ids || first) {
-            // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
-            job.status = build_curve(nodes, spline, scratch);
+        if (step.exact) {
             if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
             if (job.status.ok) {
                 if (c.curve.segments.capacity() == 0) {
@@ -280,11 +294,30 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             // already put it back (it shows its last state on failure); the fast path leaves it empty.
             if (!c.curve.segments.empty()) {
                 c.released = false;
-            } else if (restore_curve(c, released_spline)) {
+            } else if (restore_curve(c, step.released_spline)) {
                 job.restored = true;
             }
         }
         c.blending = job.status.ok && !c.multires_stale && c.multires.blending();
+    };
+    parallel_over((jobs.size() + 1) / 2, [&](std::size_t pair) {
+        thread_local Curve scratch[2];
+        CurveJob* const job[2] = {&jobs[2 * pair], 2 * pair + 1 < jobs.size() ? &jobs[2 * pair + 1] : nullptr};
+        Step step[2];
+        for (int k = 0; k < 2; ++k) {
+            if (job[k] != nullptr) prepare(*job[k], step[k]);
+        }
+        if (job[1] != nullptr && step[0].exact && step[1].exact) {
+            std::tie(job[0]->status, job[1]->status) = build_curve_pair(
+                *job[0]->nodes, step[0].spline, scratch[0], *job[1]->nodes, step[1].spline, scratch[1]);
+        } else {
+            for (int k = 0; k < 2; ++k) {
+                if (job[k] != nullptr && step[k].exact) job[k]->status = build_curve(*job[k]->nodes, step[k].spline, scratch[k]);
+            }
+        }
+        for (int k = 0; k < 2; ++k) {
+            if (job[k] != nullptr) finish(*job[k], step[k], scratch[k]);
+        }
     });
 
     // Serial, in entity order: errors (reported once per distinct message), work lists.
