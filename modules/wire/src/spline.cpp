@@ -164,6 +164,7 @@ __attribute__((target("avx2"))) bool all_within(const double* v, std::size_t cou
     for (; i < count; ++i) all &= std::abs(v[i]) <= limit;
     return all;
 }
+
 #endif
 
 // True when v[i] > limit for every i < count (false for NaN).
@@ -731,41 +732,56 @@ void tangents_kernel(std::size_t segs, const double* __restrict D, const double*
 // Bezier segments k = 0 .. count-1 (12 doubles each, out at 12k) from node coordinates p0 (3 per node, segment
 // k's start at 3k), p1 (its end at 3k) and the segment tangents: inner control points B1 = P0 + t0/3 and
 // B2 = P1 - t1/3, written straight into the records (one pass: the control points are not stored apart first).
-WIRE_VECTOR_CLONES
-void segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
+// Returns whether every inner control point is within +-limit (false for NaN), tested on the values in the
+// registers (a pass over the records just written would wait for the stores).
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
+bool segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
                      const double* __restrict t0x, const double* __restrict t0y, const double* __restrict t0z,
                      const double* __restrict t1x, const double* __restrict t1y, const double* __restrict t1z,
-                     double* __restrict out) {
+                     double* __restrict out, double limit) {
+    double ok = 1.0;  // 0 once a value is out of range (a select, which vectorizes where a bool reduction does not)
     for (std::size_t k = 0; k < count; ++k) {
         double* o = out + 12 * k;
         const double ax = p0[3 * k], ay = p0[3 * k + 1], az = p0[3 * k + 2];
         const double bx = p1[3 * k], by = p1[3 * k + 1], bz = p1[3 * k + 2];
-        o[0] = ax, o[1] = ay, o[2] = az;
-        o[3] = ax + t0x[k] * (1.0 / 3.0), o[4] = ay + t0y[k] * (1.0 / 3.0), o[5] = az + t0z[k] * (1.0 / 3.0);
-        o[6] = bx - t1x[k] * (1.0 / 3.0), o[7] = by - t1y[k] * (1.0 / 3.0), o[8] = bz - t1z[k] * (1.0 / 3.0);
-        o[9] = bx, o[10] = by, o[11] = bz;
+        const double c0 = ax + t0x[k] * (1.0 / 3.0), c1 = ay + t0y[k] * (1.0 / 3.0), c2 = az + t0z[k] * (1.0 / 3.0);
+        const double c3 = bx - t1x[k] * (1.0 / 3.0), c4 = by - t1y[k] * (1.0 / 3.0), c5 = bz - t1z[k] * (1.0 / 3.0);
+        o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
+        o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
+        // __builtin_fabs: a kernel with its own optimize attribute does not inline std::abs.
+        ok = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
+                     (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit)
+                 ? ok
+                 : 0.0;
     }
+    return ok == 1.0;
 }
 
 // The same records from node tangents per unit chord (D: segment k's start node at k, its end node at k + 1) and
 // the chord lengths: t0 = D[k] len[k], t1 = D[k + 1] len[k] (tangents_kernel's values) taken straight into the
 // control points, with no pass through segment tangents (the spline kinds whose tangents are a node's).
-WIRE_VECTOR_CLONES
-void node_segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
+// Returns segments_kernel's range test.
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
+bool node_segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
                           const double* __restrict Dx, const double* __restrict Dy, const double* __restrict Dz,
-                          const double* __restrict len, double* __restrict out) {
+                          const double* __restrict len, double* __restrict out, double limit) {
+    double ok = 1.0;
     for (std::size_t k = 0; k < count; ++k) {
         double* o = out + 12 * k;
         const double ax = p0[3 * k], ay = p0[3 * k + 1], az = p0[3 * k + 2];
         const double bx = p1[3 * k], by = p1[3 * k + 1], bz = p1[3 * k + 2];
         const double h = len[k];
-        o[0] = ax, o[1] = ay, o[2] = az;
-        o[3] = ax + (Dx[k] * h) * (1.0 / 3.0), o[4] = ay + (Dy[k] * h) * (1.0 / 3.0);
-        o[5] = az + (Dz[k] * h) * (1.0 / 3.0);
-        o[6] = bx - (Dx[k + 1] * h) * (1.0 / 3.0), o[7] = by - (Dy[k + 1] * h) * (1.0 / 3.0);
-        o[8] = bz - (Dz[k + 1] * h) * (1.0 / 3.0);
-        o[9] = bx, o[10] = by, o[11] = bz;
+        const double c0 = ax + (Dx[k] * h) * (1.0 / 3.0), c1 = ay + (Dy[k] * h) * (1.0 / 3.0);
+        const double c2 = az + (Dz[k] * h) * (1.0 / 3.0), c3 = bx - (Dx[k + 1] * h) * (1.0 / 3.0);
+        const double c4 = by - (Dy[k + 1] * h) * (1.0 / 3.0), c5 = bz - (Dz[k + 1] * h) * (1.0 / 3.0);
+        o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
+        o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
+        ok = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
+                     (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit)
+                 ? ok
+                 : 0.0;
     }
+    return ok == 1.0;
 }
 
 // Node tangents per unit chord, node i's at i and index n repeating node 0's (x, y, z arrays, per-thread memory
@@ -1120,26 +1136,24 @@ Status end_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& 
     }
 
 
-    // The Bezier records (inner control points B1 = P0 + t0/3, B2 = P1 - t1/3), then their range check.
-    // Finite is not enough: a control point past the coordinate range (an extreme alpha) overflows the tube's
-    // float vertices downstream. The end points passed check_nodes' tighter range, so one check of the whole
-    // records is the check of the inner control points.
+    // The Bezier records (inner control points B1 = P0 + t0/3, B2 = P1 - t1/3) and the range check of the inner
+    // control points. Finite is not enough: a control point past the coordinate range (an extreme alpha)
+    // overflows the tube's float vertices downstream.
     constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
     out.segments.resize(segs);
     CubicBezier* const seg = out.segments.data();
     const auto segments = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
         if (node_form.x != nullptr) {
-            node_segments_kernel(count, &p0->x, &p1->x, node_form.x + k0, node_form.y + k0, node_form.z + k0,
-                                 ch.len.data() + 1 + k0, &seg[k0].b0.x);
-        } else {
-            segments_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0,
-                            tg.t1x + k0, tg.t1y + k0, tg.t1z + k0, &seg[k0].b0.x);
+            return node_segments_kernel(count, &p0->x, &p1->x, node_form.x + k0, node_form.y + k0,
+                                        node_form.z + k0, ch.len.data() + 1 + k0, &seg[k0].b0.x, kMaxControl_m);
         }
+        return segments_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0, tg.t1x + k0,
+                               tg.t1y + k0, tg.t1z + k0, &seg[k0].b0.x, kMaxControl_m);
     };
-    segments(0, n - 1, P, P + 1);
-    if (closed) segments(n - 1, 1, P + (n - 1), P);
-    if (!all_within(&seg[0].b0.x, 12 * segs, kMaxControl_m)) {
+    bool in_range = segments(0, n - 1, P, P + 1);
+    if (closed) in_range &= segments(n - 1, 1, P + (n - 1), P);
+    if (!in_range) {
         for (std::size_t k = 0; k < segs; ++k) {
             if (all_within(&seg[k].b1.x, 6, kMaxControl_m)) continue;
             const uint32_t src = m.first[k];

@@ -12,6 +12,8 @@
 
 #include <glm/geometric.hpp>
 
+#include <cstring>
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -546,6 +548,38 @@ TEST(WireCurveHardCases, AlphaToZeroInABend) {
     ASSERT_TRUE(build_curve(n, {.alpha = 0.0}, zero).ok);
     ASSERT_TRUE(build_curve(n, {.alpha = 1e-12}, tiny).ok);
     EXPECT_LT(curve_jump_m(zero, tiny), 1e-9);
+}
+
+TEST(WireCurveHardCases, ControlPointOverflowIsAnErrorNamingItsNode) {
+    // An extreme alpha at a 1000:1 spacing jump (node 2 to 3) pushes segment 1's second inner control point far
+    // past the coordinate range (knot ratio e^-300 at node 2): an error naming node 1, the segment's first
+    // node, the curve left empty; the same from build_curve_pair in either slot, the other wire built as alone.
+    WireNodes w;
+    for (double x : {0.0, 1.0, 2.0, 2.001, 3.0, 4.0}) w.positions.emplace_back(x, 0.1 * x * x, 0.0);
+    const SplineSettings s{.kind = SplineKind::catmull_rom, .alpha = 40.0};
+    Curve c;
+    const Status st = build_curve(w, s, c);
+    EXPECT_FALSE(st.ok);
+    EXPECT_EQ(st.node, 1);
+    EXPECT_EQ(st.message.rfind("node 1: tangent overflowed", 0), 0u) << st.message;
+    EXPECT_EQ(c.segment_count(), 0u);
+    WireNodes good = w;
+    good.positions[3].x = 2.5;
+    Curve alone, p0, p1;
+    ASSERT_TRUE(build_curve(good, s, alone).ok);
+    for (int slot = 0; slot < 2; ++slot) {
+        const auto [st0, st1] = slot == 0 ? build_curve_pair(w, s, p0, good, s, p1) : build_curve_pair(good, s, p0, w, s, p1);
+        const Status& bad = slot == 0 ? st0 : st1;
+        const Status& ok = slot == 0 ? st1 : st0;
+        EXPECT_EQ(bad.message, st.message);
+        EXPECT_EQ(bad.node, 1);
+        EXPECT_TRUE(ok.ok);
+        const Curve& bad_curve = slot == 0 ? p0 : p1;
+        const Curve& ok_curve = slot == 0 ? p1 : p0;
+        EXPECT_EQ(bad_curve.segment_count(), 0u);
+        ASSERT_EQ(ok_curve.segment_count(), alone.segment_count());
+        EXPECT_EQ(std::memcmp(ok_curve.segments.data(), alone.segments.data(), alone.segments.size() * sizeof(CubicBezier)), 0);
+    }
 }
 
 TEST(WireCurveHardCases, HundredThousandNodesInLinearTime) {
