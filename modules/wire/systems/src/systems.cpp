@@ -147,6 +147,20 @@ void release_curve(WireCurve& c) {
 /// Rebuilds a released curve from the last valid nodes with the settings it was built with. It was built by
 /// build_curve from the same nodes and settings (the fast path), which is deterministic: the same curve, bit for
 /// bit. False (still released) if that fails, which cannot happen for nodes that built once.
+// to = from. The optional per-node arrays are usually empty on both sides: they are assigned only when either
+// has entries (a vector assignment is a call even for two empty vectors, 11 a wire a frame otherwise).
+void copy_nodes(WireNodes& to, const WireNodes& from) {
+    static_assert(sizeof(WireNodes) == 12 * sizeof(std::vector<double>), "copy_nodes: a WireNodes array added?");
+    to.positions = from.positions;
+    const auto copy = [](auto& t, const auto& f) {
+        if (!t.empty() || !f.empty()) t = f;
+    };
+    copy(to.ids, from.ids), copy(to.stretch, from.stretch), copy(to.radius_m, from.radius_m);
+    copy(to.theta_rad, from.theta_rad), copy(to.iz_m4, from.iz_m4), copy(to.length_m, from.length_m);
+    copy(to.delta_length_m, from.delta_length_m), copy(to.area_m2, from.area_m2);
+    copy(to.kb_tension, from.kb_tension), copy(to.kb_bias, from.kb_bias), copy(to.kb_continuity, from.kb_continuity);
+}
+
 bool restore_curve(WireCurve& c, const SplineSettings& spline) {
     if (!build_curve(c.previous_nodes, spline, c.curve).ok) return false;
     c.released = false;
@@ -281,7 +295,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             c.bounds = sphere.radius_m >= 0.0 ? sphere : curve_bounding_sphere(c.curve);
             c.bounds_generation = c.generation;
             job.changed = true;
-            c.previous_nodes = nodes;
+            copy_nodes(c.previous_nodes, nodes);
             c.released = stays_released;
             job.kept_released = stays_released;
         } else {
