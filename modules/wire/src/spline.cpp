@@ -749,10 +749,9 @@ bool segments_kernel(std::size_t count, const double* __restrict p0, const doubl
         o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
         o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
         // __builtin_fabs: a kernel with its own optimize attribute does not inline std::abs.
-        ok = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
-                     (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit)
-                 ? ok
-                 : 0.0;
+        const bool in = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
+                        (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit);
+        ok = in ? ok : 0.0;
     }
     return ok == 1.0;
 }
@@ -776,10 +775,9 @@ bool node_segments_kernel(std::size_t count, const double* __restrict p0, const 
         const double c4 = by - (Dy[k + 1] * h) * (1.0 / 3.0), c5 = bz - (Dz[k + 1] * h) * (1.0 / 3.0);
         o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
         o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
-        ok = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
-                     (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit)
-                 ? ok
-                 : 0.0;
+        const bool in = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
+                        (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit);
+        ok = in ? ok : 0.0;
     }
     return ok == 1.0;
 }
