@@ -875,9 +875,9 @@ void thomas_pair(TangentSolve& s0, TangentSolve& s1) {
 }
 
 /// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
-/// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as
-/// c2_tangents' with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero curvature) as
-/// the neighbouring node gets tensed.
+/// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as the C2
+/// spline's (w = 0: c2) with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero
+/// curvature) as the neighbouring node gets tensed.
 /// The setup: everything but the solve of an open wire's interior rows (ts.pending), which solve() or
 /// thomas_pair() does before finish_tangents(). `pool` holds the system until then.
 void start_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
