@@ -1046,11 +1046,6 @@ void catmull_rom_tangents(const WireNodes& nodes, const SplineSettings& settings
 // zero-filled before it is written), and build_curve clears it on failure.
 Status begin_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out, CurveBuild& b) {
     b.ts.pending = false, b.solved = false;
-    // The records will be written at the end: start fetching the lines they go to now (a reused curve's buffer
-    // is usually out of the cache; the writes would wait for each line in turn), while the tangents are built.
-    const std::size_t records = std::min(out.segments.capacity(), nodes.size());
-    const char* const first = reinterpret_cast<const char*>(out.segments.data());
-    for (std::size_t at = 0; at < records * sizeof(CubicBezier); at += 64) __builtin_prefetch(first + at, 1);
     if (Status st = check_settings(settings); !st) return st;
     if (Status st = check_sizes(nodes); !st) return st;
     const bool physics = settings.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&

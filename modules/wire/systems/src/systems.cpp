@@ -319,7 +319,14 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         CurveJob* const job[2] = {&jobs[2 * pair], 2 * pair + 1 < jobs.size() ? &jobs[2 * pair + 1] : nullptr};
         Step step[2];
         for (int k = 0; k < 2; ++k) {
-            if (job[k] != nullptr) prepare(*job[k], step[k]);
+            if (job[k] == nullptr) continue;
+            prepare(*job[k], step[k]);
+            // The curve's records are written at the end of its build into this buffer, another wire's curve
+            // before (swapped), out of the cache since the last frame: start fetching its lines now, while the
+            // tangents are built, not one by one as the records are written (values unchanged).
+            const std::size_t bytes = std::min(scratch[k].segments.capacity(), job[k]->nodes->size()) * sizeof(CubicBezier);
+            const char* const first = reinterpret_cast<const char*>(scratch[k].segments.data());
+            for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(first + at, 1);
         }
         if (job[1] != nullptr && step[0].exact && step[1].exact) {
             std::tie(job[0]->status, job[1]->status) = build_curve_pair(
