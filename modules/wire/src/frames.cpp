@@ -235,16 +235,19 @@ WIRE_VECTOR_CLONES void boundary_tangents(const double* __restrict b, std::size_
     }
 }
 
-WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
+namespace {
+
+/// transpose_segments() of the segments segment(0) .. segment(n - 1): four at a time by three 4x4 transposes.
+template <class Segment>
+[[gnu::always_inline]] inline void transpose_of(Segment segment, std::size_t n, double* out) {
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
     using V = double __attribute__((vector_size(32)));  // 4 doubles (two SSE registers on the baseline)
-    if (n == 0) return;
-    const double* in = &segments[0].b0.x;
     std::size_t k = 0;
     for (; k + 4 <= n; k += 4) {
+        const double* in[4] = {&segment(k).b0.x, &segment(k + 1).b0.x, &segment(k + 2).b0.x, &segment(k + 3).b0.x};
         for (std::size_t g = 0; g < 3; ++g) {  // doubles 4g .. 4g + 3 of each of the four segments
             V r[4];
-            for (std::size_t s = 0; s < 4; ++s) std::memcpy(&r[s], in + 12 * (k + s) + 4 * g, sizeof(V));
+            for (std::size_t s = 0; s < 4; ++s) std::memcpy(&r[s], in[s] + 4 * g, sizeof(V));
             const V t0 = __builtin_shufflevector(r[0], r[1], 0, 4, 2, 6);
             const V t1 = __builtin_shufflevector(r[0], r[1], 1, 5, 3, 7);
             const V t2 = __builtin_shufflevector(r[2], r[3], 0, 4, 2, 6);
@@ -255,8 +258,20 @@ WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::siz
         }
     }
     for (; k < n; ++k) {
-        for (std::size_t j = 0; j < 12; ++j) out[j * n + k] = in[12 * k + j];
+        const double* in = &segment(k).b0.x;
+        for (std::size_t j = 0; j < 12; ++j) out[j * n + k] = in[j];
     }
+}
+
+}  // namespace
+
+WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
+    transpose_of([segments](std::size_t k) -> const CubicBezier& { return segments[k]; }, n, out);
+}
+
+WIRE_VECTOR_CLONES void gather_segments(const CubicBezier* segments, const uint32_t* index, std::size_t n,
+                                        double* out) {
+    transpose_of([segments, index](std::size_t k) -> const CubicBezier& { return segments[index[k]]; }, n, out);
 }
 
 }  // namespace detail

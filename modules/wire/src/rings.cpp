@@ -210,6 +210,58 @@ WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void gauss_whole_segments(const double* __
     }
 }
 
+/// What build_rings computes at every ring, for `count` rings whose segments' control points are laid out by
+/// detail::gather_segments() in b and whose radius polynomials are in r (4 arrays: r0 .. r3): SegmentCoeffs'
+/// load_geometry(), position(), derivative(), second_derivative() and radius() at t[i], the same operations in the
+/// same order, in lanes. Out: the centre minus the origin o (b0 at t = 0, b3 at t = 1), B'(t) times the reciprocal
+/// of its length, the radius, fold (1: radius >= curvature radius, see build_rings) and slow (1: |B'| not above
+/// SegmentCoeffs::tiny_bound: the caller decides the tangent as build_rings does there).
+WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void ring_samples(
+    const double* __restrict b, std::size_t count, const double* __restrict t, const double* __restrict r, double ox,
+    double oy, double oz, double* __restrict cx, double* __restrict cy, double* __restrict cz, double* __restrict tx,
+    double* __restrict ty, double* __restrict tz, double* __restrict radius_out, double* __restrict fold,
+    double* __restrict slow) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const double ti = t[i];
+        double c[3], d[3], e[3], norm0 = 0.0, norm1 = 0.0, norm2 = 0.0;
+        for (int a = 0; a < 3; ++a) {
+            const double b0 = b[a * count + i], b1 = b[(3 + a) * count + i];
+            const double b2 = b[(6 + a) * count + i], b3 = b[(9 + a) * count + i];
+            const double p1 = 3.0 * (b1 - b0);
+            const double p2 = 3.0 * (b2 - 2.0 * b1 + b0);
+            const double p3 = b3 - 3.0 * b2 + 3.0 * b1 - b0;
+            const double d0 = p1, d1 = 2.0 * p2, d2 = 3.0 * p3;
+            const double position = b0 + ti * (p1 + ti * (p2 + ti * p3));
+            c[a] = ti == 0.0 ? b0 : (ti == 1.0 ? b3 : position);
+            d[a] = d0 + ti * (d1 + ti * d2);
+            e[a] = d1 + ti * (2.0 * d2);
+            // norm1() of d0, d1, d2: |x| + |y| + |z| (0 + |x| is |x|, bit for bit). std::fabs, not std::abs: a
+            // C++ function, not inlined into this kernel (WIRE_SELECT_KERNEL), where the C library's builtin is.
+            norm0 += std::fabs(d0);
+            norm1 += std::fabs(d1);
+            norm2 += std::fabs(d2);
+        }
+        cx[i] = c[0] - ox;
+        cy[i] = c[1] - oy;
+        cz[i] = c[2] - oz;
+        const double tiny_bound = 1e-9 * (norm0 + norm1 + norm2);
+        const double speed2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        const double speed = std::sqrt(speed2);
+        const double inv = 1.0 / speed;
+        tx[i] = d[0] * inv;
+        ty[i] = d[1] * inv;
+        tz[i] = d[2] * inv;
+        const double radius = r[i] + ti * (r[count + i] + ti * (r[2 * count + i] + ti * r[3 * count + i]));
+        radius_out[i] = radius;
+        const double bx = d[1] * e[2] - e[1] * d[2];  // glm::cross(d, e)
+        const double by = d[2] * e[0] - e[2] * d[0];
+        const double bz = d[0] * e[1] - e[0] * d[1];
+        const double bend2 = bx * bx + by * by + bz * bz;
+        fold[i] = (radius * radius * bend2 >= speed2 * speed2 * speed2 && bend2 > 0.0) ? 1.0 : 0.0;
+        slow[i] = speed > tiny_bound ? 0.0 : 1.0;
+    }
+}
+
 /// One radius on every node (or none).
 bool uniform_radius(const Curve& curve) {
     const std::size_t n = curve.radius_m.size();
@@ -229,6 +281,8 @@ struct SegmentTables {
     std::vector<double> u;         // per segment
     std::vector<double> tangent;   // 4 arrays of segment_count(): FrameInput::boundary_tangent
     std::vector<double> radius;    // 7 arrays of segment_count(): constant, u_per_m, u_scale, r0, r1, r2, r3
+    std::vector<double> ring_data;         // build_rings' per-ring scratch
+    std::vector<uint32_t> ring_segment;    // build_rings' per-ring segment index
     void build(const Curve& curve, bool with_tangents) {
         const std::size_t n = curve.segment_count();
         soa.resize(12 * n);
@@ -296,6 +350,18 @@ struct SegmentTables {
     }
     bool uniform = false;     // uniform_radius(): only u_per_m is kept
     double uniform_r = 0.0;   // its radius
+    /// The radius polynomials (load_radius()'s r0 .. r3) of segments index[0 .. count - 1] into r, 4 arrays of count.
+    void radius_of(const uint32_t* index, std::size_t count, double* r) const {
+        const std::size_t n = length_m.size();
+        if (uniform) {
+            std::fill(r, r + count, uniform_r);
+            std::fill(r + count, r + 4 * count, 0.0);
+            return;
+        }
+        for (std::size_t i = 0; i < count; ++i) {
+            for (std::size_t a = 0; a < 4; ++a) r[a * count + i] = radius[(3 + a) * n + index[i]];
+        }
+    }
     /// Segment k's radius polynomial and texture scale into c, as SegmentCoeffs::load() computes them.
     void load_radius(std::size_t k, SegmentCoeffs& c) const {
         const std::size_t n = length_m.size();
@@ -354,35 +420,57 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     };
     const std::vector<double>& whole_length_m = tables.length_m;
     const std::vector<double>& whole_u = tables.u;
+    // Centre, tangent, radius and fold test of every ring in lanes (ring_samples), from the rings' segments
+    // gathered into structure-of-arrays scratch with their radius polynomials.
+    std::vector<double>& ring_data = tables.ring_data;
+    std::vector<uint32_t>& ring_segment = tables.ring_segment;
+    ring_segment.resize(n);
+    ring_data.resize(26 * n);
+    double* const ring_b = ring_data.data();      // 12 arrays: the rings' segments, gather_segments()
+    double* const ring_t = ring_b + 12 * n;       // t
+    double* const ring_r = ring_t + n;            // 4 arrays: radius polynomial r0 .. r3
+    double* const sample = ring_r + 4 * n;        // 9 arrays: ring_samples()'s output
+    for (std::size_t i = 0; i < n; ++i) {
+        ring_segment[i] = params[i].segment;
+        ring_t[i] = params[i].t;
+    }
+    tables.radius_of(ring_segment.data(), n, ring_r);
+    // The rings on ring 0's segment use `seg` as loaded above, as use_segment() leaves it for them (the table's
+    // polynomial is the same unless a radius is not finite).
+    for (std::size_t i = 0; i < n && ring_segment[i] == seg_index; ++i) {
+        ring_r[i] = seg.r0;
+        ring_r[n + i] = seg.r1;
+        ring_r[2 * n + i] = seg.r2;
+        ring_r[3 * n + i] = seg.r3;
+    }
+    detail::gather_segments(curve.segments.data(), ring_segment.data(), n, ring_b);
+    ring_samples(ring_b, n, ring_t, ring_r, out.origin_m.x, out.origin_m.y, out.origin_m.z, sample, sample + n,
+                 sample + 2 * n, sample + 3 * n, sample + 4 * n, sample + 5 * n, sample + 6 * n, sample + 7 * n,
+                 sample + 8 * n);
     double s = 0.0;
     double u = settings.u_start;
     for (std::size_t i = 0; i < n; ++i) {
         const RingParam p = params[i];
-        use_segment(p.segment);
-        out.centre_m[i] = (p.t == 0.0 ? curve.segments[p.segment].b0
-                                      : (p.t == 1.0 ? curve.segments[p.segment].b3 : seg.position(p.t))) -
-                          out.origin_m;
-        const glm::dvec3 d1 = seg.derivative(p.t);
-        const glm::dvec3 d2 = seg.second_derivative(p.t);
-        const double speed2 = glm::dot(d1, d1);
-        const double speed = std::sqrt(speed2);
-        if (speed > seg.tiny_bound || speed > seg.tiny_speed()) {
-            out.tangent_scratch[i] = d1 * (1.0 / speed);
-        } else {  // vanishing derivative: the one-sided limits of unit_tangent() (rare)
-            out.tangent_scratch[i] = unit_tangent(curve.segments[p.segment], p.t);
+        out.centre_m[i] = glm::dvec3(sample[i], sample[n + i], sample[2 * n + i]);
+        if (sample[8 * n + i] == 0.0) {
+            out.tangent_scratch[i] = glm::dvec3(sample[3 * n + i], sample[4 * n + i], sample[5 * n + i]);
+        } else {  // not surely above the noise: SegmentCoeffs::tiny_speed() decides (rare)
+            use_segment(p.segment);
+            const glm::dvec3 d1 = seg.derivative(p.t);
+            const double speed = std::sqrt(glm::dot(d1, d1));
+            // vanishing derivative: the one-sided limits of unit_tangent()
+            out.tangent_scratch[i] = speed > seg.tiny_speed() ? d1 * (1.0 / speed)
+                                                              : unit_tangent(curve.segments[p.segment], p.t);
         }
         // Fold: the inner side of the tube crosses itself where the radius reaches the curvature radius
-        // |B'|^3 / |B' x B''|; compared squared, without a root.
-        const double radius = seg.radius(p.t);
-        const glm::dvec3 bend = glm::cross(d1, d2);  // |bend| = curvature * speed^3
-        const double bend2 = glm::dot(bend, bend);
-        if (radius * radius * bend2 >= speed2 * speed2 * speed2 && bend2 > 0.0) {
+        // |B'|^3 / |B' x B''| (ring_samples compares them squared, without a root).
+        if (sample[7 * n + i] != 0.0) {
             if (out.fold_count++ == 0) {
                 out.first_fold_ring = static_cast<uint32_t>(i);
             }
         }
         Ring& ring = out.rings[i];
-        ring.radius_m = static_cast<float>(radius);
+        ring.radius_m = static_cast<float>(sample[6 * n + i]);
         ring.segment = p.segment;
 
         // Arc length and u of the interval to the next ring: the rest of this segment, every segment the interval
@@ -396,8 +484,11 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             const bool wrap = i + 1 == n;
             const RingParam b = wrap ? params[0] : params[i + 1];
             const double tb = (!wrap && b.segment == p.segment) ? b.t : 1.0;
-            Interval iv = p.t == 0.0 && tb == 1.0 ? Interval{whole_length_m[p.segment], whole_u[p.segment]}
-                                                  : integrate(seg, p.t, tb);
+            Interval iv{whole_length_m[p.segment], whole_u[p.segment]};
+            if (p.t != 0.0 || tb != 1.0) {
+                use_segment(p.segment);
+                iv = integrate(seg, p.t, tb);
+            }
             if (wrap || b.segment != p.segment) {
                 const std::size_t end = wrap ? curve.segment_count() : b.segment;
                 for (std::size_t k = p.segment + 1; k < end; ++k) {  // crossed segments, whole

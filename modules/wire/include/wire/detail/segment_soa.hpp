@@ -5,6 +5,7 @@
 #include "wire/curve.hpp"
 
 #include <cstddef>
+#include <cstdint>
 
 /// On x86-64 with GCC: the function is compiled for AVX-512, AVX2 and the baseline (SSE2), and the loader picks the
 /// widest one the CPU has (an ifunc: one indirect call per call). Only for loops written so the compiler vectorizes
@@ -35,6 +36,9 @@ namespace wire::detail {
 /// loops vectorize over (an array of 96-byte Bezier records is a gather the compiler does not vectorize). Four
 /// segments at a time by three 4x4 transposes of their 12 doubles (in frames.cpp).
 void transpose_segments(const CubicBezier* segments, std::size_t n, double* out);
+
+/// transpose_segments() of segments[index[0]], .. segments[index[n - 1]] (a segment may appear more than once).
+void gather_segments(const CubicBezier* segments, const uint32_t* index, std::size_t n, double* out);
 
 /// Unit tangents at t = 0 of `n` segments given as transpose_segments() lays them out: B'(0) = 3 (b1 - b0) times
 /// the reciprocal of its length, the operations build_rings uses for a ring at t = 0 (a crossed segment boundary
