@@ -173,16 +173,41 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     }
 }
 
-/// The lengths of gauss_whole_segments() alone (a wire of one radius: u is length times u_per_m). No select, so
-/// no WIRE_SELECT_KERNEL: that attribute keeps the loop from some of its -O3 treatment (15% slower on AVX-512).
-WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n, double* __restrict length_m) {
+/// The lengths of gauss_whole_segments() alone, and u = length u_per_m (integrate()'s constant-radius case: a wire
+/// of one radius). No select, so no WIRE_SELECT_KERNEL: that attribute keeps the loop from some of its -O3
+/// treatment (15% slower on AVX-512).
+WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n,
+                                            const double* __restrict u_per_m, double* __restrict length_m,
+                                            double* __restrict u) {
     for (std::size_t k = 0; k < n; ++k) {
         double speed[kGlPoints];
         whole_segment_speeds(b, n, k, speed);
         double len = 0.0;
         for (int q = 0; q < kGlPoints; ++q) len += (1.0 * kGlW[q]) * speed[q];  // integrate()'s h w_q, h = 1
         length_m[k] = len;
+        u[k] = len * u_per_m[k];
     }
+}
+
+/// SegmentCoeffs::load_radius()'s u_per_m for n segments of radius r_safe (> 0) whose stretch is given, positive
+/// and finite: 1 / (2 pi stretch r_safe), the same operations, in lanes.
+WIRE_VECTOR_CLONES void uniform_u_per_m(const float* __restrict stretch, std::size_t n, double r_safe,
+                                        double* __restrict u_per_m) {
+    for (std::size_t k = 0; k < n; ++k) {
+        u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * static_cast<double>(stretch[k]) * r_safe);
+    }
+}
+
+/// Whether v[1 .. n - 1] all equal v[0] (false where one of them is NaN), and whether v[0 .. n - 1] are all
+/// positive and finite; without an early exit, so in lanes.
+WIRE_VECTOR_CLONES void all_equal_and_plain(const float* __restrict v, std::size_t n, bool* equal, bool* plain) {
+    // Integer or-reductions vectorize, bool and-reductions do not. A float is positive and finite as a double
+    // exactly when it is as a float.
+    unsigned differ = 0, bad = 0;
+    for (std::size_t k = 1; k < n; ++k) differ |= v[k] == v[0] ? 0u : 1u;
+    for (std::size_t k = 0; k < n; ++k) bad |= ((v[k] > 0.0f) & (v[k] <= std::numeric_limits<float>::max())) ? 0u : 1u;
+    *equal = differ == 0;
+    *plain = bad == 0;
 }
 
 /// integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for the n segments laid out by detail::transpose_segments(): the
@@ -264,11 +289,9 @@ WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void ring_samples(
 
 /// One radius on every node (or none).
 bool uniform_radius(const Curve& curve) {
-    const std::size_t n = curve.radius_m.size();
-    for (std::size_t k = 1; k < n; ++k) {
-        if (curve.radius_m[k] != curve.radius_m[0]) return false;
-    }
-    return true;
+    bool equal = true, plain = true;
+    all_equal_and_plain(curve.radius_m.data(), curve.radius_m.size(), &equal, &plain);
+    return equal;
 }
 
 /// Per-segment tables of a wire, from one structure-of-arrays copy of its segments, in passes the compiler
@@ -305,16 +328,11 @@ struct SegmentTables {
             uniform_r = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
             const double r_safe = std::max(uniform_r, 1e-30);
             const std::size_t n_stretch = std::min(curve.stretch.size(), n);
-            bool plain = n_stretch == n;  // every stretch given, positive and finite (the common case)
-            for (std::size_t k = 0; k < n_stretch; ++k) {
-                const double stretch = curve.stretch[k];
-                plain &= stretch > 0.0 && stretch <= std::numeric_limits<double>::max();
-            }
-            if (plain) {  // no select: the loop vectorizes
-                const float* stretch = curve.stretch.data();
-                for (std::size_t k = 0; k < n; ++k) {
-                    u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * static_cast<double>(stretch[k]) * r_safe);
-                }
+            bool plain = true, equal = true;  // every stretch given, positive and finite (the common case)
+            all_equal_and_plain(curve.stretch.data(), n_stretch, &equal, &plain);
+            plain &= n_stretch == n;
+            if (plain) {
+                uniform_u_per_m(curve.stretch.data(), n, r_safe, u_per_m);
             } else {
                 for (std::size_t k = 0; k < n; ++k) {
                     double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
@@ -338,8 +356,7 @@ struct SegmentTables {
             }
         }
         if (uniform) {
-            gauss_whole_lengths(soa.data(), n, length_m.data());
-            for (std::size_t k = 0; k < n; ++k) u[k] = length_m[k] * u_per_m[k];  // integrate()'s constant case
+            gauss_whole_lengths(soa.data(), n, u_per_m, length_m.data(), u.data());
         } else {
             gauss_whole_segments(soa.data(), n, constant, u_per_m, u_scale, r0, r1, r2, r3, length_m.data(), u.data());
         }
