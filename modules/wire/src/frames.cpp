@@ -497,9 +497,9 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // Pass 2: carry r, one matrix-vector product per step (the serial part); guarded steps through Transporter.
         glm::dvec3 r = r0;
         for (std::size_t q = 1; q < m; ++q) {
-            const Sample b{{px[q], py[q], pz[q]}, {ptx[q], pty[q], ptz[q]}};
             if (special[q] != 0.0) {
                 const Sample a{{px[q - 1], py[q - 1], pz[q - 1]}, {ptx[q - 1], pty[q - 1], ptz[q - 1]}};
+                const Sample b{{px[q], py[q], pz[q]}, {ptx[q], pty[q], ptz[q]}};
                 const double tb = point_seg[q] == point_seg[q - 1] ? point_ta[q] : 1.0;
                 r = transport.step(point_seg[q - 1], point_ta[q - 1], a, glm::normalize(r), tb, b);
             } else {
@@ -508,7 +508,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                                e[m] * r.x + e[4 * m] * r.y + e[7 * m] * r.z,
                                e[2 * m] * r.x + e[5 * m] * r.y + e[8 * m] * r.z);
                 if ((q & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
-                    r = orthonormalize(r, b.t);
+                    r = orthonormalize(r, glm::dvec3(ptx[q], pty[q], ptz[q]));
                 }
             }
             if (point_ring[q] >= 0) out[static_cast<std::size_t>(point_ring[q])].r = r;
