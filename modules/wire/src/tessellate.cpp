@@ -45,8 +45,16 @@ void place_rings(const Curve& curve, std::span<const uint32_t> counts, std::vect
     assert(counts.size() == curve.segment_count() && "place_rings: one count per segment");
     out.resize(ring_count(counts, curve.closed));
     std::size_t k = 0;
+    const std::size_t size = out.size();
     for (std::size_t i = 0; i < counts.size(); ++i) {
         const uint32_t n = i == 0 ? std::max<uint32_t>(counts[i], 1) : counts[i];
+        if (n <= 1 && k < size) {
+            // The common counts below the node resolution (0: crossed, 1: one ring at t = 0): written without a
+            // branch on which (they alternate irregularly); a count of 0 leaves the slot to the next ring.
+            out[k] = RingParam{static_cast<uint32_t>(i), 0.0};
+            k += n;
+            continue;
+        }
         for (uint32_t j = 0; j < n; ++j) {
             // j / n (not j * (1/n)): exactly the rounded k/N the promise names.
             out[k++] = RingParam{static_cast<uint32_t>(i), j == 0 ? 0.0 : static_cast<double>(j) / n};
