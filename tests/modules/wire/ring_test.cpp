@@ -105,6 +105,113 @@ TEST(Rings, HundredThousandSegments) {
     EXPECT_EQ(w.inconsistent_edges, 0u);
 }
 
+/// A random wire for the per-ring checks: control points in a box (some far from the origin), with repeated control
+/// points (vanishing derivatives), signed zeros, one radius or a radius per node, random stretch; open or closed.
+Curve random_ring_curve(std::mt19937& rng) {
+    std::uniform_real_distribution<double> coord(-3.0, 3.0);
+    std::uniform_int_distribution<int> pick(0, 9);
+    const int segments = 1 + static_cast<int>(rng() % 40);
+    const bool closed = pick(rng) < 2;
+    const glm::dvec3 offset = pick(rng) < 2 ? glm::dvec3(1e6, -2e5, 3e4) : glm::dvec3(0.0);
+    auto point = [&] {
+        glm::dvec3 p(coord(rng), coord(rng), coord(rng));
+        for (int a = 0; a < 3; ++a) {
+            const int z = pick(rng);
+            if (z == 0) p[a] = 0.0;
+            if (z == 1) p[a] = -0.0;
+        }
+        return pick(rng) == 0 ? p : p + offset;
+    };
+    std::vector<glm::dvec3> nodes(static_cast<std::size_t>(closed ? segments : segments + 1));
+    for (glm::dvec3& n : nodes) n = point();
+    std::vector<CubicBezier> segs;
+    for (int k = 0; k < segments; ++k) {
+        const glm::dvec3 b0 = nodes[static_cast<std::size_t>(k)];
+        const glm::dvec3 b3 = nodes[static_cast<std::size_t>(k + 1) % nodes.size()];
+        CubicBezier c{b0, point(), point(), b3};
+        const int shape = pick(rng);
+        if (shape == 0) c.b1 = c.b0;                 // B'(0) = 0
+        if (shape == 1) c.b2 = c.b3;                 // B'(1) = 0
+        if (shape == 2) c.b1 = c.b2 = c.b3 = c.b0;  // a point
+        if (shape == 3) c.b1 = c.b0 + 1e-12 * (c.b1 - c.b0);  // near the noise threshold
+        segs.push_back(c);
+    }
+    Curve curve = make_curve(std::move(segs), 0.01f + 0.05f * static_cast<float>(pick(rng)), closed);
+    if (pick(rng) < 5) {
+        for (float& r : curve.radius_m) r = 0.005f + 0.02f * static_cast<float>(pick(rng));
+    }
+    for (float& st : curve.stretch) st = pick(rng) < 3 ? 1.0f + 0.1f * static_cast<float>(pick(rng)) : 1.0f;
+    return curve;
+}
+
+bool same_bits(const glm::dvec3& a, const glm::dvec3& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// build_rings computes every ring's centre, tangent, radius and fold test in lanes (structure of arrays). They must
+// equal, bit for bit, the per-ring operations as SegmentCoeffs writes them (power basis in t, derivative, the
+// 1-norm then length noise bound, unit_tangent()'s limits below it, radius_at(), the squared fold test): random
+// wires with vanishing derivatives, signed zeros and far offsets; counts of 0..3 per segment and custom params.
+TEST(Rings, LaneSamplesEqualThePerRingOperations) {
+    std::mt19937 rng(20261124);
+    std::size_t checked = 0, slow = 0, folds = 0;
+    for (int w = 0; w < 400; ++w) {
+        const Curve c = random_ring_curve(rng);
+        std::vector<RingParam> params;
+        if (w % 4 == 3) {  // custom params: interior t, crossing with the next ring inside its segment
+            for (uint32_t k = 0; k < c.segment_count(); k += 1 + static_cast<uint32_t>(rng() % 3)) {
+                params.push_back({k, (rng() % 4) / 4.0});
+            }
+        } else {
+            std::vector<uint32_t> counts(c.segment_count());
+            for (uint32_t& n : counts) n = static_cast<uint32_t>(rng() % 4 == 0 ? rng() % 4 : rng() % 2);
+            place_rings(c, counts, params);
+        }
+        RingSet set;
+        build_rings(c, params, RingSettings{}, set);
+        ASSERT_EQ(set.centre_m.size(), params.size());
+        uint32_t fold_count = 0, first_fold = 0;
+        for (std::size_t i = 0; i < params.size(); ++i) {
+            const CubicBezier& b = c.segments[params[i].segment];
+            const double t = params[i].t;
+            const glm::dvec3 p1 = 3.0 * (b.b1 - b.b0);
+            const glm::dvec3 p2 = 3.0 * (b.b2 - 2.0 * b.b1 + b.b0);
+            const glm::dvec3 p3 = b.b3 - 3.0 * b.b2 + 3.0 * b.b1 - b.b0;
+            const glm::dvec3 d1 = 2.0 * p2, d2 = 3.0 * p3;
+            const glm::dvec3 centre = t == 0.0 ? b.b0 : (t == 1.0 ? b.b3 : b.b0 + t * (p1 + t * (p2 + t * p3)));
+            EXPECT_TRUE(same_bits(set.centre_m[i], centre - set.origin_m)) << "wire " << w << " ring " << i;
+            const glm::dvec3 d = p1 + t * (d1 + t * d2);
+            const glm::dvec3 e = d1 + t * (2.0 * d2);
+            const double speed2 = glm::dot(d, d);
+            const double speed = std::sqrt(speed2);
+            auto norm1 = [](const glm::dvec3& v) { return std::abs(v.x) + std::abs(v.y) + std::abs(v.z); };
+            const double bound = 1e-9 * (norm1(p1) + norm1(d1) + norm1(d2));
+            const double tiny = 1e-9 * (glm::length(p1) + glm::length(d1) + glm::length(d2));
+            slow += speed > bound ? 0 : 1;
+            const glm::dvec3 tangent = speed > bound || speed > tiny ? d * (1.0 / speed) : unit_tangent(b, t);
+            if (tangent != glm::dvec3(0.0)) {  // a zero tangent takes a neighbour's (compute_frames)
+                EXPECT_TRUE(same_bits(set.frames[i].t, tangent)) << "wire " << w << " ring " << i;
+            }
+            const double radius = radius_at(c, params[i].segment, t);
+            const float radius_f = static_cast<float>(radius);
+            EXPECT_EQ(std::memcmp(&set.rings[i].radius_m, &radius_f, sizeof radius_f), 0) << "wire " << w << " ring " << i;
+            const glm::dvec3 bend = glm::cross(d, e);
+            const double bend2 = glm::dot(bend, bend);
+            if (radius * radius * bend2 >= speed2 * speed2 * speed2 && bend2 > 0.0) {
+                if (fold_count++ == 0) first_fold = static_cast<uint32_t>(i);
+            }
+            ++checked;
+        }
+        EXPECT_EQ(set.fold_count, fold_count) << "wire " << w;
+        if (fold_count > 0) {
+            EXPECT_EQ(set.first_fold_ring, first_fold) << "wire " << w;
+        }
+        folds += fold_count;
+    }
+    // The family reaches the rare paths: derivatives at the noise bound, folds.
+    EXPECT_GT(slow, 50u);
+    EXPECT_GT(folds, 50u);
+    std::printf("lane samples: %zu rings checked, %zu below the 1-norm bound, %zu folds\n", checked, slow, folds);
+}
+
 TEST(Rings, ReusedSetDoesNotReallocate) {
     const Curve c = helix_curve(1.0, 0.3, 2, 8);
     std::vector<uint32_t> counts;

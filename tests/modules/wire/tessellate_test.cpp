@@ -52,6 +52,37 @@ TEST(Tessellate, ExternalCountsAndDefaults) {
     EXPECT_EQ(defaults, std::vector<uint32_t>(4, 8u));
 }
 
+// place_rings writes the common counts (0 and 1) without a branch on which: the same parameters as the plain rule
+// (segment i gets counts[i] rings at j / counts[i], segment 0 at least one, an open wire one more at t = 1) on
+// random counts, open and closed, ending in crossed segments.
+TEST(Tessellate, PlaceRingsEqualsThePlainRule) {
+    std::mt19937 rng(7);
+    const Curve base = helix_curve(1.0, 0.3, 2, 20);
+    std::vector<RingParam> params;
+    for (int trial = 0; trial < 500; ++trial) {
+        Curve c = base;
+        c.segments.resize(1 + rng() % c.segments.size());
+        c.closed = trial % 3 == 0;
+        std::vector<uint32_t> counts(c.segment_count());
+        for (uint32_t& n : counts) n = rng() % 3 == 0 ? static_cast<uint32_t>(rng() % 5) : static_cast<uint32_t>(rng() % 2);
+        if (trial % 5 == 0) std::fill(counts.end() - static_cast<std::ptrdiff_t>(rng() % counts.size()) - 1, counts.end(), 0u);
+        std::vector<RingParam> expected;
+        for (std::size_t i = 0; i < counts.size(); ++i) {
+            const uint32_t n = i == 0 ? std::max<uint32_t>(counts[i], 1) : counts[i];
+            for (uint32_t j = 0; j < n; ++j) {
+                expected.push_back({static_cast<uint32_t>(i), j == 0 ? 0.0 : static_cast<double>(j) / n});
+            }
+        }
+        if (!c.closed) expected.push_back({static_cast<uint32_t>(counts.size() - 1), 1.0});
+        place_rings(c, counts, params);
+        ASSERT_EQ(params.size(), expected.size()) << "trial " << trial;
+        for (std::size_t k = 0; k < expected.size(); ++k) {
+            EXPECT_EQ(params[k].segment, expected[k].segment) << "trial " << trial << " ring " << k;
+            EXPECT_EQ(params[k].t, expected[k].t) << "trial " << trial << " ring " << k;
+        }
+    }
+}
+
 /// Distance from p to the segment ab.
 double point_segment_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
     const glm::dvec3 ab = b - a;
