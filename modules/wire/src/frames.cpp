@@ -511,10 +511,11 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                     r = orthonormalize(r, glm::dvec3(ptx[q], pty[q], ptz[q]));
                 }
             }
-            if (point_ring[q] >= 0) out[static_cast<std::size_t>(point_ring[q])].r = r;
-        }
-        for (std::size_t i = 1; i < n; ++i) {
-            out[i].s = glm::cross(out[i].t, out[i].r);
+            if (point_ring[q] >= 0) {  // pass 3, binormals, off the carry's latency chain
+                Frame& f = out[static_cast<std::size_t>(point_ring[q])];
+                f.r = r;
+                f.s = glm::cross(f.t, r);
+            }
         }
     } else {
         for (std::size_t i = 1; i < n; ++i) {
