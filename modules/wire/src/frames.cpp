@@ -432,21 +432,24 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         thread_local std::vector<double> point_ta;
         thread_local std::vector<int64_t> point_ring;
         const std::size_t nb = last_crossed > first_crossed ? last_crossed - first_crossed : 0;
-        soa.resize(16 * m + 4 * nb);
+        // The arrays have room for whole vectors of steps (8 lanes): step_matrices then runs no remainder loop
+        // (the steps past the last point, between copies of it, are computed and never read).
+        const std::size_t mp = 1 + (m - 1 + 7) / 8 * 8;
+        soa.resize(16 * mp + 4 * nb);
         point_seg.resize(m);
         point_ta.resize(m);
         point_ring.resize(m);
         double* const px = soa.data();
-        double* const py = px + m;
-        double* const pz = py + m;
-        double* const ptx = pz + m;
-        double* const pty = ptx + m;
-        double* const ptz = pty + m;
-        double* const mat = ptz + m;      // 9 arrays: the step matrix into point j, column-major entries
-        double* const special = mat + 9 * m;  // nonzero: the step into j takes the guarded path
+        double* const py = px + mp;
+        double* const pz = py + mp;
+        double* const ptx = pz + mp;
+        double* const pty = ptx + mp;
+        double* const ptz = pty + mp;
+        double* const mat = ptz + mp;     // 9 arrays: the step matrix into point j, column-major entries
+        double* const special = mat + 9 * mp;  // nonzero: the step into j takes the guarded path
         // Boundary tangents of the crossed range (detail::boundary_tangents): build_rings's, for every segment, or
         // computed here; a vanishing derivative (flag 0) takes unit_tangent()'s one-sided limits below.
-        double* const btan = special + m;  // 4 arrays: x, y, z, ok
+        double* const btan = special + mp;  // 4 arrays: x, y, z, ok
         const double* bt = btan;
         std::size_t bt_stride = nb;
         if (nb != 0 && in.boundary_tangent.size() == 4 * n_seg) {
@@ -492,8 +495,16 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         assert(j == m);
         // Pass 1: mirrors() and the step matrix of every step, branch-free (selects), vectorized; a step mirrors()
         // would not call ok is flagged for the guarded path.
-        step_matrices(px, py, pz, ptx, pty, ptz, m, 1e-13 * max_abs(in.origin_m), mat, mat + m, mat + 2 * m,
-                      mat + 3 * m, mat + 4 * m, mat + 5 * m, mat + 6 * m, mat + 7 * m, mat + 8 * m, special);
+        for (std::size_t q = m; q < mp; ++q) {
+            px[q] = px[m - 1];
+            py[q] = py[m - 1];
+            pz[q] = pz[m - 1];
+            ptx[q] = ptx[m - 1];
+            pty[q] = pty[m - 1];
+            ptz[q] = ptz[m - 1];
+        }
+        step_matrices(px, py, pz, ptx, pty, ptz, mp, 1e-13 * max_abs(in.origin_m), mat, mat + mp, mat + 2 * mp,
+                      mat + 3 * mp, mat + 4 * mp, mat + 5 * mp, mat + 6 * mp, mat + 7 * mp, mat + 8 * mp, special);
         // Pass 2: carry r, one matrix-vector product per step (the serial part); guarded steps through Transporter.
         glm::dvec3 r = r0;
         for (std::size_t q = 1; q < m; ++q) {
@@ -504,9 +515,9 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                 r = transport.step(point_seg[q - 1], point_ta[q - 1], a, glm::normalize(r), tb, b);
             } else {
                 const double* e = mat + q;
-                r = glm::dvec3(e[0] * r.x + e[3 * m] * r.y + e[6 * m] * r.z,
-                               e[m] * r.x + e[4 * m] * r.y + e[7 * m] * r.z,
-                               e[2 * m] * r.x + e[5 * m] * r.y + e[8 * m] * r.z);
+                r = glm::dvec3(e[0] * r.x + e[3 * mp] * r.y + e[6 * mp] * r.z,
+                               e[mp] * r.x + e[4 * mp] * r.y + e[7 * mp] * r.z,
+                               e[2 * mp] * r.x + e[5 * mp] * r.y + e[8 * mp] * r.z);
                 if ((q & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
                     r = orthonormalize(r, glm::dvec3(ptx[q], pty[q], ptz[q]));
                 }
