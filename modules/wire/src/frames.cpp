@@ -239,7 +239,7 @@ namespace {
 
 /// transpose_segments() of the segments segment(0) .. segment(n - 1): four at a time by three 4x4 transposes.
 template <class Segment>
-[[gnu::always_inline]] inline void transpose_of(Segment segment, std::size_t n, double* out) {
+[[gnu::always_inline]] inline void transpose_of(Segment segment, std::size_t n, std::size_t stride, double* out) {
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
     using V = double __attribute__((vector_size(32)));  // 4 doubles (two SSE registers on the baseline)
     std::size_t k = 0;
@@ -254,24 +254,25 @@ template <class Segment>
             const V t3 = __builtin_shufflevector(r[2], r[3], 1, 5, 3, 7);
             const V c[4] = {__builtin_shufflevector(t0, t2, 0, 1, 4, 5), __builtin_shufflevector(t1, t3, 0, 1, 4, 5),
                             __builtin_shufflevector(t0, t2, 2, 3, 6, 7), __builtin_shufflevector(t1, t3, 2, 3, 6, 7)};
-            for (std::size_t j = 0; j < 4; ++j) std::memcpy(out + (4 * g + j) * n + k, &c[j], sizeof(V));
+            for (std::size_t j = 0; j < 4; ++j) std::memcpy(out + (4 * g + j) * stride + k, &c[j], sizeof(V));
         }
     }
     for (; k < n; ++k) {
         const double* in = &segment(k).b0.x;
-        for (std::size_t j = 0; j < 12; ++j) out[j * n + k] = in[j];
+        for (std::size_t j = 0; j < 12; ++j) out[j * stride + k] = in[j];
     }
 }
 
 }  // namespace
 
-WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::size_t n, double* out) {
-    transpose_of([segments](std::size_t k) -> const CubicBezier& { return segments[k]; }, n, out);
+WIRE_VECTOR_CLONES void transpose_segments(const CubicBezier* segments, std::size_t n, double* out,
+                                           std::size_t stride) {
+    transpose_of([segments](std::size_t k) -> const CubicBezier& { return segments[k]; }, n, stride ? stride : n, out);
 }
 
 WIRE_VECTOR_CLONES void gather_segments(const CubicBezier* segments, const uint32_t* index, std::size_t n,
                                         double* out) {
-    transpose_of([segments, index](std::size_t k) -> const CubicBezier& { return segments[index[k]]; }, n, out);
+    transpose_of([segments, index](std::size_t k) -> const CubicBezier& { return segments[index[k]]; }, n, n, out);
 }
 
 }  // namespace detail
@@ -452,9 +453,9 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         double* const btan = special + mp;  // 4 arrays: x, y, z, ok
         const double* bt = btan;
         std::size_t bt_stride = nb;
-        if (nb != 0 && in.boundary_tangent.size() == 4 * n_seg) {
+        if (nb != 0 && in.boundary_tangent.size() % 4 == 0 && in.boundary_tangent.size() >= 4 * n_seg) {
             bt = in.boundary_tangent.data() + first_crossed;
-            bt_stride = n_seg;
+            bt_stride = in.boundary_tangent.size() / 4;
         } else if (nb != 0) {
             thread_local std::vector<double> transposed;
             transposed.resize(12 * nb);

@@ -294,33 +294,47 @@ bool uniform_radius(const Curve& curve) {
     return equal;
 }
 
+/// n rounded up to whole vectors of 8 lanes (AVX-512 doubles).
+std::size_t whole_vectors(std::size_t n) { return (n + 7) / 8 * 8; }
+
+/// Fills entries n .. stride - 1 of `arrays` arrays of `stride` with each array's entry n - 1 (n > 0).
+void pad(double* a, std::size_t arrays, std::size_t n, std::size_t stride) {
+    for (std::size_t j = 0; j < arrays && n != 0; ++j) std::fill(a + j * stride + n, a + (j + 1) * stride, a[j * stride + n - 1]);
+}
+
 /// Per-segment tables of a wire, from one structure-of-arrays copy of its segments, in passes the compiler
 /// vectorizes: integrate(SegmentCoeffs(curve, k), 0.0, 1.0) of every segment k bit for bit (a wire whose LOD puts
 /// fewer rings than nodes crosses most segments whole: this is their arc length and u), and, when asked, the unit
 /// tangent at every segment's start (the frames carry the normal through the boundaries an interval crosses).
+/// Every array has `stride` entries per quantity: segment_count() rounded up to whole vectors of 8 lanes, the rest
+/// copies of the last segment's, so the kernels run no remainder loop (their results there are never read).
 struct SegmentTables {
-    std::vector<double> soa;       // detail::transpose_segments()
+    std::vector<double> soa;       // detail::transpose_segments(), 12 arrays
     std::vector<double> length_m;  // per segment
     std::vector<double> u;         // per segment
-    std::vector<double> tangent;   // 4 arrays of segment_count(): FrameInput::boundary_tangent
-    std::vector<double> radius;    // 7 arrays of segment_count(): constant, u_per_m, u_scale, r0, r1, r2, r3
+    std::vector<double> tangent;   // 4 arrays: FrameInput::boundary_tangent
+    std::vector<double> radius;    // 7 arrays: constant, u_per_m, u_scale, r0, r1, r2, r3
     std::vector<double> ring_data;         // build_rings' per-ring scratch
     std::vector<uint32_t> ring_segment;    // build_rings' per-ring segment index
+    std::size_t stride = 0;
     void build(const Curve& curve, bool with_tangents) {
         const std::size_t n = curve.segment_count();
-        soa.resize(12 * n);
-        length_m.resize(n);
-        u.resize(n);
-        radius.resize(7 * n);
-        tangent.resize(with_tangents ? 4 * n : 0);
-        detail::transpose_segments(curve.segments.data(), n, soa.data());
+        const std::size_t sn = whole_vectors(n);
+        stride = sn;
+        soa.resize(12 * sn);
+        length_m.resize(sn);
+        u.resize(sn);
+        radius.resize(7 * sn);
+        tangent.resize(with_tangents ? 4 * sn : 0);
+        detail::transpose_segments(curve.segments.data(), n, soa.data(), sn);
+        pad(soa.data(), 12, n, sn);
         double* const constant = radius.data();
-        double* const u_per_m = constant + n;
-        double* const u_scale = u_per_m + n;
-        double* const r0 = u_scale + n;
-        double* const r1 = r0 + n;
-        double* const r2 = r1 + n;
-        double* const r3 = r2 + n;
+        double* const u_per_m = constant + sn;
+        double* const u_scale = u_per_m + sn;
+        double* const r0 = u_scale + sn;
+        double* const r1 = r0 + sn;
+        double* const r2 = r1 + sn;
+        double* const r3 = r2 + sn;
         uniform = uniform_radius(curve);
         if (uniform) {
             // One radius (or none): every segment is constant-radius (both node slopes 0, so r1 = r2 = r3 = 0
@@ -355,21 +369,22 @@ struct SegmentTables {
                 r3[k] = c.r3;
             }
         }
+        pad(radius.data(), 7, n, sn);
         if (uniform) {
-            gauss_whole_lengths(soa.data(), n, u_per_m, length_m.data(), u.data());
+            gauss_whole_lengths(soa.data(), sn, u_per_m, length_m.data(), u.data());
         } else {
-            gauss_whole_segments(soa.data(), n, constant, u_per_m, u_scale, r0, r1, r2, r3, length_m.data(), u.data());
+            gauss_whole_segments(soa.data(), sn, constant, u_per_m, u_scale, r0, r1, r2, r3, length_m.data(), u.data());
         }
         if (with_tangents) {
-            detail::boundary_tangents(soa.data(), n, tangent.data(), tangent.data() + n, tangent.data() + 2 * n,
-                                      tangent.data() + 3 * n);
+            detail::boundary_tangents(soa.data(), sn, tangent.data(), tangent.data() + sn, tangent.data() + 2 * sn,
+                                      tangent.data() + 3 * sn);
         }
     }
     bool uniform = false;     // uniform_radius(): only u_per_m is kept
     double uniform_r = 0.0;   // its radius
     /// The radius polynomials (load_radius()'s r0 .. r3) of segments index[0 .. count - 1] into r, 4 arrays of count.
     void radius_of(const uint32_t* index, std::size_t count, double* r) const {
-        const std::size_t n = length_m.size();
+        const std::size_t n = stride;
         if (uniform) {
             std::fill(r, r + count, uniform_r);
             std::fill(r + count, r + 4 * count, 0.0);
@@ -381,7 +396,7 @@ struct SegmentTables {
     }
     /// Segment k's radius polynomial and texture scale into c, as SegmentCoeffs::load() computes them.
     void load_radius(std::size_t k, SegmentCoeffs& c) const {
-        const std::size_t n = length_m.size();
+        const std::size_t n = stride;
         const double* r = radius.data();
         if (uniform) {
             c.load_radius(uniform_r, 0.0, 0.0, 0.0, 0.0, r[n + k], true);
@@ -441,36 +456,38 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     // gathered into structure-of-arrays scratch with their radius polynomials.
     std::vector<double>& ring_data = tables.ring_data;
     std::vector<uint32_t>& ring_segment = tables.ring_segment;
-    ring_segment.resize(n);
-    ring_data.resize(26 * n);
+    const std::size_t rn = whole_vectors(n);  // whole vectors, the rest copies of the last ring (see SegmentTables)
+    ring_segment.resize(rn);
+    ring_data.resize(26 * rn);
     double* const ring_b = ring_data.data();      // 12 arrays: the rings' segments, gather_segments()
-    double* const ring_t = ring_b + 12 * n;       // t
-    double* const ring_r = ring_t + n;            // 4 arrays: radius polynomial r0 .. r3
-    double* const sample = ring_r + 4 * n;        // 9 arrays: ring_samples()'s output
-    for (std::size_t i = 0; i < n; ++i) {
-        ring_segment[i] = params[i].segment;
-        ring_t[i] = params[i].t;
+    double* const ring_t = ring_b + 12 * rn;      // t
+    double* const ring_r = ring_t + rn;           // 4 arrays: radius polynomial r0 .. r3
+    double* const sample = ring_r + 4 * rn;       // 9 arrays: ring_samples()'s output
+    for (std::size_t i = 0; i < rn; ++i) {
+        const RingParam& p = params[std::min(i, n - 1)];
+        ring_segment[i] = p.segment;
+        ring_t[i] = p.t;
     }
-    tables.radius_of(ring_segment.data(), n, ring_r);
+    tables.radius_of(ring_segment.data(), rn, ring_r);
+    detail::gather_segments(curve.segments.data(), ring_segment.data(), rn, ring_b);
     // The rings on ring 0's segment use `seg` as loaded above, as use_segment() leaves it for them (the table's
     // polynomial is the same unless a radius is not finite).
     for (std::size_t i = 0; i < n && ring_segment[i] == seg_index; ++i) {
         ring_r[i] = seg.r0;
-        ring_r[n + i] = seg.r1;
-        ring_r[2 * n + i] = seg.r2;
-        ring_r[3 * n + i] = seg.r3;
+        ring_r[rn + i] = seg.r1;
+        ring_r[2 * rn + i] = seg.r2;
+        ring_r[3 * rn + i] = seg.r3;
     }
-    detail::gather_segments(curve.segments.data(), ring_segment.data(), n, ring_b);
-    ring_samples(ring_b, n, ring_t, ring_r, out.origin_m.x, out.origin_m.y, out.origin_m.z, sample, sample + n,
-                 sample + 2 * n, sample + 3 * n, sample + 4 * n, sample + 5 * n, sample + 6 * n, sample + 7 * n,
-                 sample + 8 * n);
+    ring_samples(ring_b, rn, ring_t, ring_r, out.origin_m.x, out.origin_m.y, out.origin_m.z, sample, sample + rn,
+                 sample + 2 * rn, sample + 3 * rn, sample + 4 * rn, sample + 5 * rn, sample + 6 * rn, sample + 7 * rn,
+                 sample + 8 * rn);
     double s = 0.0;
     double u = settings.u_start;
     for (std::size_t i = 0; i < n; ++i) {
         const RingParam p = params[i];
-        out.centre_m[i] = glm::dvec3(sample[i], sample[n + i], sample[2 * n + i]);
-        if (sample[8 * n + i] == 0.0) {
-            out.tangent_scratch[i] = glm::dvec3(sample[3 * n + i], sample[4 * n + i], sample[5 * n + i]);
+        out.centre_m[i] = glm::dvec3(sample[i], sample[rn + i], sample[2 * rn + i]);
+        if (sample[8 * rn + i] == 0.0) {
+            out.tangent_scratch[i] = glm::dvec3(sample[3 * rn + i], sample[4 * rn + i], sample[5 * rn + i]);
         } else {  // not surely above the noise: SegmentCoeffs::tiny_speed() decides (rare)
             use_segment(p.segment);
             const glm::dvec3 d1 = seg.derivative(p.t);
@@ -481,13 +498,13 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         }
         // Fold: the inner side of the tube crosses itself where the radius reaches the curvature radius
         // |B'|^3 / |B' x B''| (ring_samples compares them squared, without a root).
-        if (sample[7 * n + i] != 0.0) {
+        if (sample[7 * rn + i] != 0.0) {
             if (out.fold_count++ == 0) {
                 out.first_fold_ring = static_cast<uint32_t>(i);
             }
         }
         Ring& ring = out.rings[i];
-        ring.radius_m = static_cast<float>(sample[6 * n + i]);
+        ring.radius_m = static_cast<float>(sample[6 * rn + i]);
         ring.segment = p.segment;
 
         // Arc length and u of the interval to the next ring: the rest of this segment, every segment the interval

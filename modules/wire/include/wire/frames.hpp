@@ -57,9 +57,10 @@ struct FrameInput {
     std::span<const glm::dvec3> centre_m;
     std::span<const glm::dvec3> tangent;
     std::span<const double> arc_length_m;
-    /// Optional: the unit tangent at t = 0 of every segment of `curve` as 4 arrays of segment_count() (x, y, z, and
-    /// 1 where valid, 0 where the caller must take unit_tangent()'s limits), as build_rings computes them for the
-    /// segment boundaries a ring interval crosses. Empty: compute_frames computes the ones it needs.
+    /// Optional: the unit tangent at t = 0 of every segment of `curve` as 4 arrays of equal length, at least
+    /// segment_count() (x, y, z, and 1 where valid, 0 where the caller must take unit_tangent()'s limits), as
+    /// build_rings computes them for the segment boundaries a ring interval crosses. Empty: compute_frames computes
+    /// the ones it needs.
     std::span<const double> boundary_tangent;
 };
 

@@ -35,7 +35,8 @@ namespace wire::detail {
 /// Segments' control points as 12 arrays of `n` (b0.x, b0.y, b0.z, b1.x, ... b3.z): the layout the per-segment
 /// loops vectorize over (an array of 96-byte Bezier records is a gather the compiler does not vectorize). Four
 /// segments at a time by three 4x4 transposes of their 12 doubles (in frames.cpp).
-void transpose_segments(const CubicBezier* segments, std::size_t n, double* out);
+/// `stride` (>= n; 0: n) is the distance between the arrays.
+void transpose_segments(const CubicBezier* segments, std::size_t n, double* out, std::size_t stride = 0);
 
 /// transpose_segments() of segments[index[0]], .. segments[index[n - 1]] (a segment may appear more than once).
 void gather_segments(const CubicBezier* segments, const uint32_t* index, std::size_t n, double* out);
