@@ -140,6 +140,26 @@ WIRE_VECTOR_CLONES void step_matrices(const double* __restrict x, const double* 
     }
 }
 
+/// The frame points of `count` consecutive segment starts: position b0 - origin and boundary tangent (tx .. tz,
+/// its flag into ok), read from structure-of-arrays tables.
+WIRE_VECTOR_CLONES void segment_start_points(const double* __restrict b0x, const double* __restrict b0y,
+                                             const double* __restrict b0z, const double* __restrict tx,
+                                             const double* __restrict ty, const double* __restrict tz,
+                                             const double* __restrict tok, double ox, double oy, double oz,
+                                             std::size_t count, double* __restrict px, double* __restrict py,
+                                             double* __restrict pz, double* __restrict ptx, double* __restrict pty,
+                                             double* __restrict ptz, double* __restrict ok) {
+    for (std::size_t j = 0; j < count; ++j) {
+        px[j] = b0x[j] - ox;
+        py[j] = b0y[j] - oy;
+        pz[j] = b0z[j] - oz;
+        ptx[j] = tx[j];
+        pty[j] = ty[j];
+        ptz[j] = tz[j];
+        ok[j] = tok[j];
+    }
+}
+
 glm::dvec3 reflect_pair(const MirrorPair& m, glm::dvec3 r) {
     r -= (m.f1 * glm::dot(m.v1, r)) * m.v1;
     r -= (m.f2 * glm::dot(m.v2, r)) * m.v2;
@@ -475,9 +495,50 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             point_ring[j] = ring;
             ++j;
         };
-        put(in.centre_m[0], out[0].t, in.params[0].segment, in.params[0].t, 0);
-        for (std::size_t i = 1; i < n; ++i) {
+        // Rings only at segment starts (t = 0, at most one per segment; the last may be at t = 1: LOD at or below the
+        // node resolution, the common moving wire) with build_rings' tables: the points are the segment starts
+        // from ring 0's on, in order, so they are copied from the tables in lanes and the rings written over their
+        // starts. Else (and without the tables) point by point.
+        const std::size_t ss = in.segment_soa.size() / 12;  // the tables' stride
+        bool starts = nb != 0 && in.segment_soa.size() == 12 * ss && ss >= n_seg &&
+                      in.boundary_tangent.size() == 4 * ss && in.params[0].t == 0.0;
+        for (std::size_t i = 1; i < n && starts; ++i) {
             const RingParam& pa = in.params[i - 1];
+            const RingParam& pb = in.params[i];
+            starts = pa.t == 0.0 && (pb.t == 0.0 ? pb.segment > pa.segment
+                                                 : (i + 1 == n && pb.t == 1.0 && pb.segment >= pa.segment));
+        }
+        if (starts) {
+            const std::size_t s0 = in.params[0].segment;
+            const std::size_t count = in.params[n - 1].segment + 1 - s0;  // segment starts from ring 0's on
+            assert(m == count + (in.params[n - 1].t == 1.0 ? 1 : 0));
+            const double* const b = in.segment_soa.data() + s0;
+            const double* const t = in.boundary_tangent.data() + s0;
+            segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, t + 3 * ss, in.origin_m.x,
+                                 in.origin_m.y, in.origin_m.z, count, px, py, pz, ptx, pty, ptz, special);
+            for (std::size_t q = 0; q < count; ++q) {
+                point_seg[q] = static_cast<uint32_t>(s0 + q);
+                point_ta[q] = 0.0;
+                point_ring[q] = -1;
+            }
+            for (std::size_t i = 0; i < n; ++i) {
+                j = i + 1 == n && in.params[i].t == 1.0 ? count : in.params[i].segment - s0;
+                put(in.centre_m[i], out[i].t, in.params[i].segment, in.params[i].t, static_cast<int64_t>(i));
+                special[j - 1] = 1.0;  // a ring: no boundary tangent to fix
+            }
+            j = m;
+            // A boundary tangent whose flag is 0 takes unit_tangent()'s limits, a zero one the previous point's.
+            for (std::size_t q = 1; q < count; ++q) {
+                if (special[q] != 0.0 && (ptx[q] != 0.0 || pty[q] != 0.0 || ptz[q] != 0.0)) continue;
+                glm::dvec3 tq = special[q] != 0.0 ? glm::dvec3(ptx[q], pty[q], ptz[q]) : unit_tangent(segs[point_seg[q]], 0.0);
+                if (tq == glm::dvec3(0.0)) tq = glm::dvec3(ptx[q - 1], pty[q - 1], ptz[q - 1]);
+                ptx[q] = tq.x;
+                pty[q] = tq.y;
+                ptz[q] = tq.z;
+            }
+        } else {
+        put(in.centre_m[0], out[0].t, in.params[0].segment, in.params[0].t, 0);
+        for (std::size_t i = 1; i < n; ++i) {            const RingParam& pa = in.params[i - 1];
             const RingParam& pb = in.params[i];
             if (crosses(pa, pb, false)) {
                 glm::dvec3 cur_t = out[i - 1].t;
@@ -492,6 +553,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                 }
             }
             put(in.centre_m[i], out[i].t, pb.segment, pb.t, static_cast<int64_t>(i));
+        }
         }
         assert(j == m);
         // Pass 1: mirrors() and the step matrix of every step, branch-free (selects), vectorized; a step mirrors()

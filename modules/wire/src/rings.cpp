@@ -543,8 +543,8 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     }
     out.length_m = s;
 
-    const FrameInput in{&curve, params, out.origin_m, out.centre_m, out.tangent_scratch, out.arc_length_m,
-                        tables.tangent};
+    const FrameInput in{&curve,           params,         out.origin_m, out.centre_m, out.tangent_scratch,
+                        out.arc_length_m, tables.tangent, tables.soa};
     out.frame_stats = compute_frames(in, settings.frames, out.frames);
 
     for (std::size_t i = 0; i < n; ++i) {

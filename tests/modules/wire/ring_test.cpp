@@ -212,6 +212,42 @@ TEST(Rings, LaneSamplesEqualThePerRingOperations) {
     std::printf("lane samples: %zu rings checked, %zu below the 1-norm bound, %zu folds\n", checked, slow, folds);
 }
 
+// With its segment tables build_rings lets compute_frames take the points of rings at segment starts (counts of 0
+// and 1: LOD at or below the node resolution) from the tables in lanes; the frames must equal, bit for bit, those of
+// compute_frames building every point itself (no tables): random wires with degenerate segments (boundary tangents
+// from unit_tangent()'s limits or the previous point), open and closed, with and without a carried-over normal.
+TEST(Rings, FramesFromSegmentTablesEqualPointByPoint) {
+    std::mt19937 rng(4242);
+    std::size_t compared = 0;
+    for (int w = 0; w < 400; ++w) {
+        const Curve c = random_ring_curve(rng);
+        std::vector<uint32_t> counts(c.segment_count());
+        for (uint32_t& n : counts) n = w % 5 == 4 ? static_cast<uint32_t>(rng() % 3) : static_cast<uint32_t>(rng() % 2);
+        std::vector<RingParam> params;
+        place_rings(c, counts, params);
+        RingSettings settings;
+        if (w % 2 == 0) {
+            settings.frames.has_previous_normal = true;
+            settings.frames.previous_normal = glm::dvec3(0.3, -0.8, 0.5);
+        }
+        RingSet set;
+        build_rings(c, params, settings, set);
+        std::vector<Frame> frames(params.size());
+        const FrameInput plain{&c, params, set.origin_m, set.centre_m, set.tangent_scratch, set.arc_length_m, {}, {}};
+        const FrameStats stats = compute_frames(plain, settings.frames, frames);
+        EXPECT_EQ(stats.subdivided_steps, set.frame_stats.subdivided_steps) << "wire " << w;
+        EXPECT_EQ(stats.fallback_steps, set.frame_stats.fallback_steps) << "wire " << w;
+        EXPECT_EQ(stats.degenerate_tangents, set.frame_stats.degenerate_tangents) << "wire " << w;
+        EXPECT_EQ(stats.seeded_from_previous, set.frame_stats.seeded_from_previous) << "wire " << w;
+        EXPECT_EQ(std::memcmp(&stats.holonomy_rad, &set.frame_stats.holonomy_rad, sizeof(double)), 0) << "wire " << w;
+        for (std::size_t i = 0; i < params.size(); ++i) {
+            EXPECT_EQ(std::memcmp(&frames[i], &set.frames[i], sizeof(Frame)), 0) << "wire " << w << " ring " << i;
+        }
+        compared += params.size();
+    }
+    std::printf("frames from tables: %zu rings compared\n", compared);
+}
+
 TEST(Rings, ReusedSetDoesNotReallocate) {
     const Curve c = helix_curve(1.0, 0.3, 2, 8);
     std::vector<uint32_t> counts;

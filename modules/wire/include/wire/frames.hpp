@@ -62,6 +62,10 @@ struct FrameInput {
     /// build_rings computes them for the segment boundaries a ring interval crosses. Empty: compute_frames computes
     /// the ones it needs.
     std::span<const double> boundary_tangent;
+    /// Optional, with boundary_tangent: `curve`'s segments as 12 arrays of boundary_tangent's length (b0.x, b0.y,
+    /// b0.z, b1.x, ... b3.z; detail::transpose_segments()), as build_rings lays them out. With both, rings only at
+    /// segment starts take their points from these tables.
+    std::span<const double> segment_soa;
 };
 
 /// Unit tangent of segment `p.segment` at `p.t` from the analytic derivative. Where the derivative vanishes (a cusp,
