@@ -524,13 +524,16 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             for (std::size_t i = 0; i < n; ++i) {
                 j = i + 1 == n && in.params[i].t == 1.0 ? count : in.params[i].segment - s0;
                 put(in.centre_m[i], out[i].t, in.params[i].segment, in.params[i].t, static_cast<int64_t>(i));
-                special[j - 1] = 1.0;  // a ring: no boundary tangent to fix
             }
             j = m;
-            // A boundary tangent whose flag is 0 takes unit_tangent()'s limits, a zero one the previous point's.
+            // A boundary tangent whose flag is 0 takes unit_tangent()'s limits, a zero one the previous point's (the
+            // test reads the tables, not the point arrays just written in lanes).
+            const double* const tok = t + 3 * ss;
             for (std::size_t q = 1; q < count; ++q) {
-                if (special[q] != 0.0 && (ptx[q] != 0.0 || pty[q] != 0.0 || ptz[q] != 0.0)) continue;
-                glm::dvec3 tq = special[q] != 0.0 ? glm::dvec3(ptx[q], pty[q], ptz[q]) : unit_tangent(segs[point_seg[q]], 0.0);
+                if ((tok[q] != 0.0 && (t[q] != 0.0 || t[ss + q] != 0.0 || t[2 * ss + q] != 0.0)) || point_ring[q] >= 0) {
+                    continue;
+                }
+                glm::dvec3 tq = tok[q] != 0.0 ? glm::dvec3(t[q], t[ss + q], t[2 * ss + q]) : unit_tangent(segs[s0 + q], 0.0);
                 if (tq == glm::dvec3(0.0)) tq = glm::dvec3(ptx[q - 1], pty[q - 1], ptz[q - 1]);
                 ptx[q] = tq.x;
                 pty[q] = tq.y;
@@ -538,7 +541,8 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             }
         } else {
         put(in.centre_m[0], out[0].t, in.params[0].segment, in.params[0].t, 0);
-        for (std::size_t i = 1; i < n; ++i) {            const RingParam& pa = in.params[i - 1];
+        for (std::size_t i = 1; i < n; ++i) {
+            const RingParam& pa = in.params[i - 1];
             const RingParam& pb = in.params[i];
             if (crosses(pa, pb, false)) {
                 glm::dvec3 cur_t = out[i - 1].t;
