@@ -52,6 +52,7 @@ struct SegmentCoeffs {
     std::size_t slope_node = static_cast<std::size_t>(-1);
     double slope = 0.0;
 
+    SegmentCoeffs() = default;
     SegmentCoeffs(const Curve& curve, uint32_t seg) { load(curve, seg); }
     void load(const Curve& curve, uint32_t seg) {
         load_geometry(curve.segments[seg]);
@@ -81,6 +82,24 @@ struct SegmentCoeffs {
         tiny_bound = 1e-9 * (norm1(d0) + norm1(d1) + norm1(d2));
     }
     void load_radius(const Curve& curve, uint32_t seg) {
+        load_polynomial(curve, seg);
+        double stretch = seg < curve.stretch.size() ? curve.stretch[seg] : 1.0;
+        if (!(stretch > 0.0) || !std::isfinite(stretch)) {
+            stretch = 1.0;
+        }
+        // One radius along the whole segment (no per-node radii, the common case): u is length / (2 pi R stretch),
+        // so the quadrature needs no division per point (and this one division per segment).
+        constant_radius = r1 == 0.0 && r2 == 0.0 && r3 == 0.0;
+        if (constant_radius) {
+            u_per_m = 1.0 / (2.0 * std::numbers::pi * stretch * std::max(r0, 1e-30));
+            u_scale = 0.0;
+        } else {
+            u_per_m = 0.0;
+            u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
+        }
+    }
+    /// load_radius()'s radius polynomial r0 .. r3 alone.
+    void load_polynomial(const Curve& curve, uint32_t seg) {
         const std::size_t n = curve.radius_m.size();
         if (n == 0) {
             r0 = 1.0;
@@ -99,20 +118,6 @@ struct SegmentCoeffs {
             r1 = ma;
             r2 = -3.0 * ra - 2.0 * ma + 3.0 * rb - mb;
             r3 = 2.0 * ra + ma - 2.0 * rb + mb;
-        }
-        double stretch = seg < curve.stretch.size() ? curve.stretch[seg] : 1.0;
-        if (!(stretch > 0.0) || !std::isfinite(stretch)) {
-            stretch = 1.0;
-        }
-        // One radius along the whole segment (no per-node radii, the common case): u is length / (2 pi R stretch),
-        // so the quadrature needs no division per point (and this one division per segment).
-        constant_radius = r1 == 0.0 && r2 == 0.0 && r3 == 0.0;
-        if (constant_radius) {
-            u_per_m = 1.0 / (2.0 * std::numbers::pi * stretch * std::max(r0, 1e-30));
-            u_scale = 0.0;
-        } else {
-            u_per_m = 0.0;
-            u_scale = 1.0 / (2.0 * std::numbers::pi * stretch);
         }
     }
     [[nodiscard]] glm::dvec3 position(double t) const { return p0 + t * (p1 + t * (p2 + t * p3)); }
@@ -441,14 +446,20 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
     }
     tables.build(curve, crossing);
-    SegmentCoeffs seg(curve, params[0].segment);
+    // The segment a partial interval or a slow tangent is evaluated on, loaded when first needed (rarely): ring 0's
+    // by load() itself, any other with the table's radius polynomial (no node slopes again).
+    SegmentCoeffs seg;
     uint32_t seg_index = params[0].segment;
-    auto use_segment = [&](uint32_t i) {  // the radius polynomial from the table: no node slopes again
-        if (i != seg_index) {
+    bool seg_loaded = false;
+    auto use_segment = [&](uint32_t i) {
+        if (!seg_loaded && i == seg_index) {
+            seg.load(curve, i);
+        } else if (!seg_loaded || i != seg_index) {
             seg.load_geometry(curve.segments[i]);
             tables.load_radius(i, seg);
             seg_index = i;
         }
+        seg_loaded = true;
     };
     const std::vector<double>& whole_length_m = tables.length_m;
     const std::vector<double>& whole_u = tables.u;
@@ -470,13 +481,15 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     }
     tables.radius_of(ring_segment.data(), rn, ring_r);
     detail::gather_segments(curve.segments.data(), ring_segment.data(), rn, ring_b);
-    // The rings on ring 0's segment use `seg` as loaded above, as use_segment() leaves it for them (the table's
-    // polynomial is the same unless a radius is not finite).
-    for (std::size_t i = 0; i < n && ring_segment[i] == seg_index; ++i) {
-        ring_r[i] = seg.r0;
-        ring_r[rn + i] = seg.r1;
-        ring_r[2 * rn + i] = seg.r2;
-        ring_r[3 * rn + i] = seg.r3;
+    // The rings on ring 0's segment use load()'s radius polynomial, as use_segment() gives it to them (the table's
+    // is the same unless a radius is not finite).
+    SegmentCoeffs first;
+    first.load_polynomial(curve, params[0].segment);
+    for (std::size_t i = 0; i < n && ring_segment[i] == params[0].segment; ++i) {
+        ring_r[i] = first.r0;
+        ring_r[rn + i] = first.r1;
+        ring_r[2 * rn + i] = first.r2;
+        ring_r[3 * rn + i] = first.r3;
     }
     ring_samples(ring_b, rn, ring_t, ring_r, out.origin_m.x, out.origin_m.y, out.origin_m.z, sample, sample + rn,
                  sample + 2 * rn, sample + 3 * rn, sample + 4 * rn, sample + 5 * rn, sample + 6 * rn, sample + 7 * rn,
