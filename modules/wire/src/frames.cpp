@@ -371,7 +371,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
 
     // First frame: carried over from the previous state when possible, else seeded from the least-aligned axis.
     const glm::dvec3 t0 = out[0].t;
-    glm::dvec3 r0 = seed_normal(t0);
+    glm::dvec3 r0{};
     if (settings.has_previous_normal) {
         const glm::dvec3 p = settings.previous_normal - glm::dot(settings.previous_normal, t0) * t0;
         const double len = glm::length(p);
@@ -380,6 +380,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             stats.seeded_from_previous = true;
         }
     }
+    if (!stats.seeded_from_previous) r0 = seed_normal(t0);
     out[0].r = r0;
     out[0].s = glm::cross(t0, r0);
 
