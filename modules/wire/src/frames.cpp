@@ -433,7 +433,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // dependency, and a short one (no square root, no division), which is what bounds the speed. Reflections
         // keep |r| = 1 and r normal to t up to rounding, which is removed every 64 steps (drift stays ~1e-15); the
         // count runs over points, so a span's rings are re-projected exactly where the node-resolution rings are.
-        // Pass 3: binormals.
+        // Pass 3, binormals, runs in pass 2's loop (off its latency chain).
         const CubicBezier* const segs = in.curve != nullptr ? in.curve->segments.data() : nullptr;
         // The points, in structure-of-arrays scratch (grows once per thread, then reused): position, tangent, the
         // segment and parameter a step from the point runs along, and the ring index (-1: a crossed boundary).
@@ -531,34 +531,34 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             // test reads the tables, not the point arrays just written in lanes).
             const double* const tok = t + 3 * ss;
             for (std::size_t q = 1; q < count; ++q) {
-                if ((tok[q] != 0.0 && (t[q] != 0.0 || t[ss + q] != 0.0 || t[2 * ss + q] != 0.0)) || point_ring[q] >= 0) {
-                    continue;
-                }
-                glm::dvec3 tq = tok[q] != 0.0 ? glm::dvec3(t[q], t[ss + q], t[2 * ss + q]) : unit_tangent(segs[s0 + q], 0.0);
+                const glm::dvec3 table_t(t[q], t[ss + q], t[2 * ss + q]);
+                if ((tok[q] != 0.0 && table_t != glm::dvec3(0.0)) || point_ring[q] >= 0) continue;
+                glm::dvec3 tq = tok[q] != 0.0 ? table_t : unit_tangent(segs[s0 + q], 0.0);
                 if (tq == glm::dvec3(0.0)) tq = glm::dvec3(ptx[q - 1], pty[q - 1], ptz[q - 1]);
                 ptx[q] = tq.x;
                 pty[q] = tq.y;
                 ptz[q] = tq.z;
             }
         } else {
-        put(in.centre_m[0], out[0].t, in.params[0].segment, in.params[0].t, 0);
-        for (std::size_t i = 1; i < n; ++i) {
-            const RingParam& pa = in.params[i - 1];
-            const RingParam& pb = in.params[i];
-            if (crosses(pa, pb, false)) {
-                glm::dvec3 cur_t = out[i - 1].t;
-                for (std::size_t k = static_cast<std::size_t>(pa.segment) + 1; k < boundary_end(pb, false); ++k) {
-                    const CubicBezier& c = segs[k];
-                    const std::size_t b = k - first_crossed;
-                    glm::dvec3 t = bt[3 * bt_stride + b] != 0.0 ? glm::dvec3(bt[b], bt[bt_stride + b], bt[2 * bt_stride + b])
-                                                           : unit_tangent(c, 0.0);
-                    if (t == glm::dvec3(0.0)) t = cur_t;
-                    put(c.b0 - in.origin_m, t, static_cast<uint32_t>(k), 0.0, -1);
-                    cur_t = t;
+            put(in.centre_m[0], out[0].t, in.params[0].segment, in.params[0].t, 0);
+            for (std::size_t i = 1; i < n; ++i) {
+                const RingParam& pa = in.params[i - 1];
+                const RingParam& pb = in.params[i];
+                if (crosses(pa, pb, false)) {
+                    glm::dvec3 cur_t = out[i - 1].t;
+                    for (std::size_t k = static_cast<std::size_t>(pa.segment) + 1; k < boundary_end(pb, false); ++k) {
+                        const CubicBezier& c = segs[k];
+                        const std::size_t b = k - first_crossed;
+                        glm::dvec3 t = bt[3 * bt_stride + b] != 0.0
+                                           ? glm::dvec3(bt[b], bt[bt_stride + b], bt[2 * bt_stride + b])
+                                           : unit_tangent(c, 0.0);
+                        if (t == glm::dvec3(0.0)) t = cur_t;
+                        put(c.b0 - in.origin_m, t, static_cast<uint32_t>(k), 0.0, -1);
+                        cur_t = t;
+                    }
                 }
+                put(in.centre_m[i], out[i].t, pb.segment, pb.t, static_cast<int64_t>(i));
             }
-            put(in.centre_m[i], out[i].t, pb.segment, pb.t, static_cast<int64_t>(i));
-        }
         }
         assert(j == m);
         // Pass 1: mirrors() and the step matrix of every step, branch-free (selects), vectorized; a step mirrors()

@@ -304,7 +304,9 @@ std::size_t whole_vectors(std::size_t n) { return (n + 7) / 8 * 8; }
 
 /// Fills entries n .. stride - 1 of `arrays` arrays of `stride` with each array's entry n - 1 (n > 0).
 void pad(double* a, std::size_t arrays, std::size_t n, std::size_t stride) {
-    for (std::size_t j = 0; j < arrays && n != 0; ++j) std::fill(a + j * stride + n, a + (j + 1) * stride, a[j * stride + n - 1]);
+    for (std::size_t j = 0; j < arrays && n != 0; ++j) {
+        std::fill(a + j * stride + n, a + (j + 1) * stride, a[j * stride + n - 1]);
+    }
 }
 
 /// Per-segment tables of a wire, from one structure-of-arrays copy of its segments, in passes the compiler

@@ -192,7 +192,8 @@ TEST(Rings, LaneSamplesEqualThePerRingOperations) {
             }
             const double radius = radius_at(c, params[i].segment, t);
             const float radius_f = static_cast<float>(radius);
-            EXPECT_EQ(std::memcmp(&set.rings[i].radius_m, &radius_f, sizeof radius_f), 0) << "wire " << w << " ring " << i;
+            EXPECT_EQ(std::memcmp(&set.rings[i].radius_m, &radius_f, sizeof radius_f), 0)
+                << "wire " << w << " ring " << i;
             const glm::dvec3 bend = glm::cross(d, e);
             const double bend2 = glm::dot(bend, bend);
             if (radius * radius * bend2 >= speed2 * speed2 * speed2 && bend2 > 0.0) {

@@ -64,8 +64,11 @@ TEST(Tessellate, PlaceRingsEqualsThePlainRule) {
         c.segments.resize(1 + rng() % c.segments.size());
         c.closed = trial % 3 == 0;
         std::vector<uint32_t> counts(c.segment_count());
-        for (uint32_t& n : counts) n = rng() % 3 == 0 ? static_cast<uint32_t>(rng() % 5) : static_cast<uint32_t>(rng() % 2);
-        if (trial % 5 == 0) std::fill(counts.end() - static_cast<std::ptrdiff_t>(rng() % counts.size()) - 1, counts.end(), 0u);
+        for (uint32_t& n : counts) n = static_cast<uint32_t>(rng() % 3 == 0 ? rng() % 5 : rng() % 2);
+        if (trial % 5 == 0) {  // ending in crossed segments
+            const auto zeros = static_cast<std::ptrdiff_t>(1 + rng() % counts.size());
+            std::fill(counts.end() - zeros, counts.end(), 0u);
+        }
         std::vector<RingParam> expected;
         for (std::size_t i = 0; i < counts.size(); ++i) {
             const uint32_t n = i == 0 ? std::max<uint32_t>(counts[i], 1) : counts[i];
