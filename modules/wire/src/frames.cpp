@@ -437,9 +437,24 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         const CubicBezier* const segs = in.curve != nullptr ? in.curve->segments.data() : nullptr;
         // The points, in structure-of-arrays scratch (grows once per thread, then reused): position, tangent, the
         // segment and parameter a step from the point runs along, and the ring index (-1: a crossed boundary).
-        std::size_t m = n;
+        // Rings only at segment starts (t = 0, at most one per segment; the last may be at t = 1: LOD at or below the
+        // node resolution, the common moving wire) with build_rings' tables: the points are the segment starts
+        // from ring 0's on, in order, so they are copied from the tables in lanes and the rings written over their
+        // starts. Else (and without the tables) point by point.
+        const std::size_t ss = in.segment_soa.size() / 12;  // the tables' stride
+        bool starts = n_seg != 0 && in.segment_soa.size() == 12 * ss && ss >= n_seg &&
+                      in.boundary_tangent.size() == 4 * ss && in.params[0].t == 0.0;
+        for (std::size_t i = 1; i < n && starts; ++i) {
+            const RingParam& pa = in.params[i - 1];
+            const RingParam& pb = in.params[i];
+            starts = pa.t == 0.0 && (pb.t == 0.0 ? pb.segment > pa.segment
+                                                 : (i + 1 == n && pb.t == 1.0 && pb.segment >= pa.segment));
+        }
+        const std::size_t s0 = in.params[0].segment;
+        const std::size_t count = in.params[n - 1].segment + 1 - s0;  // with `starts`: segment starts from ring 0's on
+        std::size_t m = starts ? count + (in.params[n - 1].t == 1.0 ? 1 : 0) : n;
         std::size_t first_crossed = n_seg, last_crossed = 0;  // boundary range whose tangents are needed
-        for (std::size_t i = 1; i < n; ++i) {
+        for (std::size_t i = 1; i < n && !starts; ++i) {
             const RingParam& pa = in.params[i - 1];
             const RingParam& pb = in.params[i];
             if (crosses(pa, pb, false)) {
@@ -496,23 +511,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             point_ring[j] = ring;
             ++j;
         };
-        // Rings only at segment starts (t = 0, at most one per segment; the last may be at t = 1: LOD at or below the
-        // node resolution, the common moving wire) with build_rings' tables: the points are the segment starts
-        // from ring 0's on, in order, so they are copied from the tables in lanes and the rings written over their
-        // starts. Else (and without the tables) point by point.
-        const std::size_t ss = in.segment_soa.size() / 12;  // the tables' stride
-        bool starts = nb != 0 && in.segment_soa.size() == 12 * ss && ss >= n_seg &&
-                      in.boundary_tangent.size() == 4 * ss && in.params[0].t == 0.0;
-        for (std::size_t i = 1; i < n && starts; ++i) {
-            const RingParam& pa = in.params[i - 1];
-            const RingParam& pb = in.params[i];
-            starts = pa.t == 0.0 && (pb.t == 0.0 ? pb.segment > pa.segment
-                                                 : (i + 1 == n && pb.t == 1.0 && pb.segment >= pa.segment));
-        }
         if (starts) {
-            const std::size_t s0 = in.params[0].segment;
-            const std::size_t count = in.params[n - 1].segment + 1 - s0;  // segment starts from ring 0's on
-            assert(m == count + (in.params[n - 1].t == 1.0 ? 1 : 0));
             const double* const b = in.segment_soa.data() + s0;
             const double* const t = in.boundary_tangent.data() + s0;
             segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, t + 3 * ss, in.origin_m.x,
