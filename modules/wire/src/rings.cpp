@@ -448,20 +448,25 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         crossing = params[i].segment + (params[i].t > 0.0 ? 1u : 0u) > params[i - 1].segment + 1u;
     }
     tables.build(curve, crossing);
-    // The segment a partial interval or a slow tangent is evaluated on, loaded when first needed (rarely): ring 0's
-    // by load() itself, any other with the table's radius polynomial (no node slopes again).
+    // The segment a partial interval or a slow tangent of ring `ring` is evaluated on, loaded when first needed
+    // (rarely): for the leading rings on ring 0's segment by load() itself, for the others with the table's radius
+    // polynomial (no node slopes again): the coefficients each ring had when every ring loaded its segment.
+    std::size_t lead = 1;
+    while (lead < n && params[lead].segment == params[0].segment) ++lead;
     SegmentCoeffs seg;
     uint32_t seg_index = params[0].segment;
-    bool seg_loaded = false;
-    auto use_segment = [&](uint32_t i) {
-        if (!seg_loaded && i == seg_index) {
-            seg.load(curve, i);
-        } else if (!seg_loaded || i != seg_index) {
+    int loaded = -1;  // 0: load() of ring 0's segment, 1: the table's for seg_index
+    auto use_segment = [&](std::size_t ring) {
+        const uint32_t i = params[ring].segment;
+        if (ring < lead) {
+            if (loaded != 0) seg.load(curve, i);
+            loaded = 0;
+        } else if (loaded != 1 || i != seg_index) {
             seg.load_geometry(curve.segments[i]);
             tables.load_radius(i, seg);
-            seg_index = i;
+            loaded = 1;
         }
-        seg_loaded = true;
+        seg_index = i;
     };
     const std::vector<double>& whole_length_m = tables.length_m;
     const std::vector<double>& whole_u = tables.u;
@@ -487,7 +492,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
     // is the same unless a radius is not finite).
     SegmentCoeffs first;
     first.load_polynomial(curve, params[0].segment);
-    for (std::size_t i = 0; i < n && ring_segment[i] == params[0].segment; ++i) {
+    for (std::size_t i = 0; i < lead; ++i) {
         ring_r[i] = first.r0;
         ring_r[rn + i] = first.r1;
         ring_r[2 * rn + i] = first.r2;
@@ -504,7 +509,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
         if (sample[8 * rn + i] == 0.0) {
             out.tangent_scratch[i] = glm::dvec3(sample[3 * rn + i], sample[4 * rn + i], sample[5 * rn + i]);
         } else {  // not surely above the noise: SegmentCoeffs::tiny_speed() decides (rare)
-            use_segment(p.segment);
+            use_segment(i);
             const glm::dvec3 d1 = seg.derivative(p.t);
             const double speed = std::sqrt(glm::dot(d1, d1));
             // vanishing derivative: the one-sided limits of unit_tangent()
@@ -535,7 +540,7 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
             const double tb = (!wrap && b.segment == p.segment) ? b.t : 1.0;
             Interval iv{whole_length_m[p.segment], whole_u[p.segment]};
             if (p.t != 0.0 || tb != 1.0) {
-                use_segment(p.segment);
+                use_segment(i);
                 iv = integrate(seg, p.t, tb);
             }
             if (wrap || b.segment != p.segment) {
