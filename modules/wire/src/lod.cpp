@@ -709,14 +709,15 @@ public:
 
     // For a wire inside the frustum: its depth range [z_lo, z_hi] decides whole levels of the hierarchy from
     // the per-level deviation range, so the walk evaluates only the levels in between (usually one or two).
-    void set_depth_range(double z_lo, double z_hi) {
+    // Only the `built` lowest levels are read (update_lod_once(): the levels above fail, and cannot fit).
+    void set_depth_range(double z_lo, double z_hi, std::size_t built) {
         if (!inside_) return;
         const std::size_t levels = b_.levels;
         fit_level_ = -1;
         fail_level_ = levels;
         const double zh = std::max(z_hi, view_.near_m);
         const double fit_den = new_scale_ * z_lo;
-        for (std::size_t l = 0; l < levels; ++l) {
+        for (std::size_t l = 0; l < std::min(levels, built); ++l) {
             const bool loop_limit = l > 0 && closed_ && 3 * (std::size_t{1} << l) > b_.segments;
             // fit = fit_num / fit_den, fail = fail_num / zh, compared with 1 (divided only when noted).
             const double fit_num = b_.level_deviation_max(l) * c_ * k_;
@@ -1091,8 +1092,12 @@ SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const L
     return SegmentPass::done;
 }
 
+// built_levels: the hierarchy levels of `bounds` that were built (all but for update_lod_once(), which leaves out
+// levels an update of a wire inside the frustum cannot read: see TopLevels).
 bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
-                     const LodBounds& bounds, bool sphere_cull, bool use_bound) {
+                     const LodBounds& bounds, bool sphere_cull, bool use_bound,
+                     std::size_t built_levels = std::numeric_limits<std::size_t>::max(),
+                     const SphereScreenBound* known_sb = nullptr) {
     const std::size_t n = curve.segment_count();
     if (sphere_cull && sphere_outside_view(bounds.sphere, view)) return cull_lod(lod);
     if (n == 0) {
@@ -1120,7 +1125,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     // inside).
     SphereScreenBound sb;
     if (bounds.sphere.radius_m >= 0.0) {
-        sb = sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
+        sb = known_sb != nullptr ? *known_sb
+                                 : sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
     } else {
         sb.k = edge_factors(view).corner;
     }
@@ -1129,7 +1135,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     // The margin only serves a Coherence, which is kept for bounds that outlive this update and a wire inside.
     const bool keeps_coherence = use_bound && !bounds.transient && sb.inside;
     if (!keeps_coherence) merger.skip_margin();
-    merger.set_depth_range(sb.z_lo_m, sb.z_hi_m);
+    merger.set_depth_range(sb.z_lo_m, sb.z_hi_m, built_levels);
 
     // A sphere inside the frustum whose conservative side count is 3 (so the exact one is too) is decided
     // here.
@@ -1138,7 +1144,10 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     double wire_k = 1.0;
     if (use_bound && bounds.sphere.radius_m >= 0.0 && sb.inside) {
         const std::size_t root = merger.root_level();
-        const double root_ratio = merge ? merger.ratio(root, 0) : 0.0;
+        // A root not built has a ratio above 1 (TopLevels): not one interval.
+        const double root_ratio = !merge                  ? 0.0
+                                  : root < built_levels ? merger.ratio(root, 0)
+                                                        : std::numeric_limits<double>::infinity();
         if (merge) merger.note(root_ratio);
         if (merge && root_ratio <= merger.counts_scale(root, 0)) {
             // The whole wire is one interval for the counts (hysteresis threshold), so for the tolerance too.
@@ -1352,7 +1361,26 @@ BoundingSphere curve_bounding_sphere(const Curve& curve) {
 
 namespace {
 
-void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingSphere* known_sphere) {
+// The levels an update of a wire inside the frustum reads (update_lod_once()). With deviations that never
+// decrease from a level to the one above, a level l whose smallest deviation fails at the far depth of the wire's
+// sphere, (dev_min(l) c) k > z_hi (c = focal / eps, k the sphere's off-axis bound: set_depth_range()'s test), makes
+// every level above it fail too and none fit (their largest deviation is at least that, and the fit test's
+// denominator new_scale z_lo is at most z_hi), so set_depth_range() reads nothing above l and the walk starts below
+// it. The root (the one other node the update reads) has a ratio above 1: its deviation is >= dev_min(l), and
+// its sphere's nearest depth is at most the depth of the wire's first control point, which lies in both spheres,
+// so at most z_hi, up to roundings far below `slack`; the update takes it as not one interval, which it is not.
+// Deviations never decrease when no value overflows and none is NaN (a parent's is the larger child's plus a
+// square root, rounded up or equal): the coordinates are finite, below 1e149 in magnitude (then no square or sum
+// of squares of the kernels overflows), which the sphere's box shows for all but NaN ones and level 0's probe
+// (NaN then) for those.
+struct TopLevels {
+    double c, k, above;  // stop after level l when (dev_min(l) c) k > above (= z_hi + slack)
+};
+
+// Returns the number of levels built: all, or with `stop` (when level 0's probe shows every coordinate finite)
+// up to the first that TopLevels lets stop after.
+std::size_t compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingSphere* known_sphere,
+                                    const TopLevels* stop = nullptr) {
     const std::size_t n = curve.segment_count();
     out.segments = n;
     out.sphere = BoundingSphere{};  // curve_bounding_sphere(curve), from the level-0 boxes below
@@ -1373,7 +1401,7 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
     out.version = next_version++;
     if (n == 0) {
         out.data.clear();
-        return;
+        return 0;
     }
     // Level widths and where each level starts (root first).
     uint32_t levels = 1;
@@ -1397,12 +1425,13 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
     if (known_sphere == nullptr && sc.boxes.size() < 6 * n) sc.boxes.resize(6 * n);
     const SpanKernels& kernels = span_kernels();
     // Level 0 with its deviation range (out.data[0], [1]) and the largest M (never -0: a root of a sum of squares).
-    double range0[3];
+    double range0[4];
     double* boxes = known_sphere == nullptr ? sc.boxes.data() : nullptr;
     kernels.level0(curve.segments.data(), n, out.level_data(0), wang, boxes, sc.ends[0].data(), range0);
     out.data[0] = range0[0];
     out.data[1] = range0[1];
     out.wang_m_max = range0[2];
+    if (stop != nullptr && !std::isfinite(range0[3])) stop = nullptr;  // a coordinate NaN (or an overflow)
     if (known_sphere != nullptr) {
         out.sphere = *known_sphere;
     } else {
@@ -1417,10 +1446,12 @@ void compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingS
     // Levels 1 and up, each from the one below, with their deviation ranges; the chord ends alternate between two
     // buffers.
     for (std::size_t level = 1; level < levels; ++level) {
+        if (stop != nullptr && (out.level_deviation_min(level - 1) * stop->c) * stop->k > stop->above) return level;
         kernels.merge_level(out.level_data(level - 1), sc.ends[(level - 1) & 1].data(), out.level_width(level - 1),
                             out.level_data(level), sc.ends[level & 1].data(), out.level_width(level),
                             out.data.data() + 2 * level);
     }
+    return levels;
 }
 
 }  // namespace
@@ -1494,6 +1525,26 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
         return update_lod(curve, view, settings, lod, static_cast<const BoundingSphere*>(nullptr));
     }
     return update_lod_impl(curve, view, settings, lod, bounds, true, true);
+}
+
+bool update_lod_once(const Curve& curve, const BoundingSphere& sphere, const LodView& view,
+                     const LodSettings& settings, WireLod& lod) {
+    thread_local LodBounds bounds;
+    bounds.transient = true;  // no Coherence: the next update has new bounds
+    // The stop of TopLevels where its conditions hold: a merging wire whose sphere is inside the frustum, finite
+    // and bounded coordinates (the sphere's box here, level 0's probe for NaN), a positive finite z_hi.
+    const double eps = tolerance_or_default(settings.tolerance_px);
+    const SphereScreenBound sb = sphere.radius_m >= 0.0 ? sphere_screen_bound(sphere.centre_m, sphere.radius_m, view, eps)
+                                                        : SphereScreenBound{};
+    const double zh = std::max(sb.z_hi_m, view.near_m);
+    const double extent = (std::abs(sphere.centre_m.x) + std::abs(sphere.centre_m.y) + std::abs(sphere.centre_m.z)) +
+                          sphere.radius_m;
+    const double eye = (std::abs(view.eye_m.x) + std::abs(view.eye_m.y)) + std::abs(view.eye_m.z);
+    const TopLevels stop{view.focal_px / eps, sb.k, zh + 1e-6 * ((zh + extent) + eye)};
+    const bool may_stop = sb.inside && !settings.keep_node_resolution && extent <= 1e149 && eye <= 1e149 &&
+                          zh > 0.0 && zh <= 1e149 && std::isfinite(stop.c * stop.k);
+    const std::size_t built = compute_lod_bounds_impl(curve, bounds, &sphere, may_stop ? &stop : nullptr);
+    return update_lod_impl(curve, view, settings, lod, bounds, false, true, built, &sb);
 }
 
 ScreenError measure_screen_error(const Curve& curve, std::span<const RingParam> params, const LodView& view,

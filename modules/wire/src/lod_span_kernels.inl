@@ -35,12 +35,14 @@ __attribute__((always_inline)) inline void over_lanes(std::size_t n, Run&& run) 
 // bound). Branch-free: a value a case does not need is computed and selected away.
 template <class L>
 struct Level0 {
-    L wang, lo[3], hi[3], c[3], r, deviation;
+    L wang, lo[3], hi[3], c[3], r, deviation, probe;
     Level0(const L (&x)[4], const L (&y)[4], const L (&z)[4]) {
         const L two = L::splat(2.0), zero = L::splat(0.0), one = L::splat(1.0), half = L::splat(0.5);
         const L m0x = (x[0] - two * x[1]) + x[2], m0y = (y[0] - two * y[1]) + y[2], m0z = (z[0] - two * z[1]) + z[2];
         const L m1x = (x[1] - two * x[2]) + x[3], m1y = (y[1] - two * y[2]) + y[3], m1z = (z[1] - two * z[2]) + z[3];
-        wang = sqrt_of(max_of((m0x * m0x + m0y * m0y) + m0z * m0z, (m1x * m1x + m1y * m1y) + m1z * m1z));
+        const L m0 = (m0x * m0x + m0y * m0y) + m0z * m0z, m1 = (m1x * m1x + m1y * m1y) + m1z * m1z;
+        wang = sqrt_of(max_of(m0, m1));
+        probe = m0 + m1;  // NaN where a control point has a NaN coordinate (max_of above may skip it)
         const L* p[3] = {x, y, z};
         for (int k = 0; k < 3; ++k) {
             lo[k] = min_of(min_of(p[k][0], p[k][1]), min_of(p[k][2], p[k][3]));
@@ -132,11 +134,14 @@ struct Range {
 
 // Level 0: every segment's node (5 arrays: centre x, y, z, radius, deviation), Wang's M, box (6 arrays: lo, hi;
 // skipped where `box` is null) and chord ends (6 arrays: b0, b3), W::width segments at a time, the rest one by one;
-// range: the deviations' smallest and largest, and the largest M.
+// range: the deviations' smallest and largest, the largest M, and a sum over the segments of their two squared
+// second differences (finite where every coordinate is finite and the sum does not overflow; NaN where one is NaN).
 inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, double* wang, double* box,
                         double* ends, double* range) {
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double));  // b0 .. b3, x y z each, no padding
     Range dev, m;
+    W probe = W::splat(0.0);
+    double probe_tail = 0.0;
     auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
         L x[4], y[4], z[4];
         L::points(&seg[i].b0.x, x, y, z);  // b0 x y z, b1 x y z, b2 ..., b3 ... of each lane's segment
@@ -145,9 +150,13 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
         if constexpr (std::is_same_v<L, W>) {
             dev.add(q.deviation);
             m.add(q.wang);
+            probe = probe + q.probe;
         } else {
             dev.add_lanes(q.deviation);
             m.add_lanes(q.wang);
+            double t[L::width];
+            q.probe.store(t);
+            for (std::size_t k = 0; k < L::width; ++k) probe_tail += t[k];
         }
         for (int k = 0; k < 3; ++k) q.c[k].store(node + k * n + i);
         if (box != nullptr)
@@ -168,6 +177,10 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
     dev.finish(range[0], range[1]);
     double unused = 0.0;
     m.finish(unused, range[2]);
+    double p[W::width];
+    probe.store(p);
+    for (std::size_t k = 0; k < W::width; ++k) probe_tail += p[k];
+    range[3] = probe_tail;
 }
 
 // Level l from level l - 1 (child: 5 arrays of cw nodes, e: their chord ends, 6 arrays of cw; parent: 5 arrays of

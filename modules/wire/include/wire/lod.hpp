@@ -280,6 +280,15 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
 bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
                 const LodBounds& bounds);
 
+/// compute_lod_bounds(curve, bounds, sphere) with bounds.transient set, then update_lod(curve, view, settings, lod,
+/// bounds), for bounds that serve this one update (a wire whose curve changes every frame): the same result,
+/// but the hierarchy levels the update cannot read are not built (for a wire inside the frustum, the levels above
+/// the first whose every span fails at the sphere's far depth), and the bounds are per-thread working memory.
+/// `sphere` must be curve_bounding_sphere(curve), and sphere_outside_view(sphere, view) false: the caller has
+/// tested it (what update_lod gives a wire it culls is cull_lod()'s state), so it is not tested again.
+bool update_lod_once(const Curve& curve, const BoundingSphere& sphere, const LodView& view,
+                     const LodSettings& settings, WireLod& lod);
+
 /// True if the control points of every segment, inflated by radius_m, are not all outside one frustum plane.
 [[nodiscard]] bool hull_visible(std::span<const CubicBezier> segments, double radius_m, const LodView& view);
 

@@ -427,6 +427,9 @@ void lod_system(Registry& registry, WireContext& ctx) {
         } else if (c.released || sphere_outside_view(c.bounds, ctx.view)) {
             // What update_lod gives a wire its sphere culls, without computing the LodBounds.
             changed = cull_lod(s.lod);
+        } else if (curve_changed && c.bounds_generation == c.generation) {
+            // Moving (or new): this frame's LOD is the only reader of the bounds (not kept, partly built).
+            changed = update_lod_once(c.curve, c.bounds, ctx.view, settings, s.lod);
         } else if (curve_changed) {
             // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
             thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
