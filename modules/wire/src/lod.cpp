@@ -1239,8 +1239,11 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         wire_z = std::numeric_limits<double>::infinity();
     }
     lod.z_min_m = std::isfinite(wire_z) ? wire_z : 0.0;
-    lod.required_sides =
-        std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides) : 3u;
+    // conservative_sides: the bound's call above, with these very arguments (the visible segments are all of
+    // them), gave 3 (and so does the non-finite case).
+    lod.required_sides = conservative_sides       ? 3u
+                         : std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides)
+                                                 : 3u;
     // Clamped before the comparison: a lowered max_sides changes the sides, and the caller must hear of it.
     const uint32_t sides = std::min(
         restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band), lim.max_sides);
