@@ -519,6 +519,8 @@ using W = L8;
 struct SpanKernels {
     void (*level0)(const CubicBezier*, std::size_t, double*, double*, double*, double*, double*);
     void (*merge_level)(const double*, const double*, std::size_t, double*, double*, std::size_t, double*);
+    void (*merge_deviations)(const double*, const double*, std::size_t, double*, double*, std::size_t, double*);
+    void (*merge_spheres)(const double*, std::size_t, double*, std::size_t);
     void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
     void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
     void (*ratios)(const double*, std::size_t, const RatioConstants&, double*);
@@ -534,13 +536,13 @@ SpanKernels choose_span_kernels() {
     const int lanes = lanes_text == "2" ? 2 : lanes_text == "4" ? 4 : 8;
     __builtin_cpu_init();
     if (lanes >= 8 && __builtin_cpu_supports("avx512f"))
-        return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::hull_depth_kernel,
+        return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::span_merge_deviations, span_avx512::span_merge_spheres, span_avx512::hull_depth_kernel,
                 span_avx512::wang_roots, span_avx512::span_ratios, span_avx512::wire_box};
     if (lanes >= 4 && __builtin_cpu_supports("avx2"))
-        return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::hull_depth_kernel,
+        return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::span_merge_deviations, span_avx2::span_merge_spheres, span_avx2::hull_depth_kernel,
                 span_avx2::wang_roots, span_avx2::span_ratios, span_avx2::wire_box};
 #endif
-    return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::hull_depth_kernel,
+    return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::span_merge_deviations, span_sse2::span_merge_spheres, span_sse2::hull_depth_kernel,
             span_sse2::wang_roots, span_sse2::span_ratios, span_sse2::wire_box};
 }
 const SpanKernels& span_kernels() {
@@ -1381,7 +1383,8 @@ struct TopLevels {
 };
 
 // Returns the number of levels built: all, or with `stop` (when level 0's probe shows every coordinate finite)
-// up to the first that TopLevels lets stop after.
+// up to the first that TopLevels lets stop after; that level below the root has its deviations (and their range)
+// but no spheres, which the update does not read (the walk starts below it).
 std::size_t compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const BoundingSphere* known_sphere,
                                     const TopLevels* stop = nullptr) {
     const std::size_t n = curve.segment_count();
@@ -1448,11 +1451,21 @@ std::size_t compute_lod_bounds_impl(const Curve& curve, LodBounds& out, const Bo
     }
     // Levels 1 and up, each from the one below, with their deviation ranges; the chord ends alternate between two
     // buffers.
+    // With a stop test, a level's deviations come first: a level that stops the build needs no spheres.
+    if (stop != nullptr && (out.level_deviation_min(0) * stop->c) * stop->k > stop->above) return 1;
     for (std::size_t level = 1; level < levels; ++level) {
-        if (stop != nullptr && (out.level_deviation_min(level - 1) * stop->c) * stop->k > stop->above) return level;
-        kernels.merge_level(out.level_data(level - 1), sc.ends[(level - 1) & 1].data(), out.level_width(level - 1),
-                            out.level_data(level), sc.ends[level & 1].data(), out.level_width(level),
-                            out.data.data() + 2 * level);
+        const double* child = out.level_data(level - 1);
+        const std::size_t cw = out.level_width(level - 1), w = out.level_width(level);
+        double* parent = out.level_data(level);
+        const double* e = sc.ends[(level - 1) & 1].data();
+        double* f = sc.ends[level & 1].data();
+        if (stop == nullptr || level + 1 == levels) {  // the root: nothing above it to leave out
+            kernels.merge_level(child, e, cw, parent, f, w, out.data.data() + 2 * level);
+            continue;
+        }
+        kernels.merge_deviations(child, e, cw, parent, f, w, out.data.data() + 2 * level);
+        if ((out.level_deviation_min(level) * stop->c) * stop->k > stop->above) return level + 1;
+        kernels.merge_spheres(child, cw, parent, w);
     }
     return levels;
 }

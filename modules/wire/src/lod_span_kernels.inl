@@ -77,7 +77,12 @@ template <class L>
 struct Merge {
     L c[3], r, deviation;
     Merge(const L (&a)[3], const L (&m)[3], const L (&b)[3], const L (&lc)[3], L lr, L ld, const L (&rc)[3], L rr,
-          L rd) {
+          L rd)
+        : deviation(chord_deviation(a, m, b, ld, rd)) {
+        sphere(lc, lr, rc, rr, c, r);
+    }
+    // The two halves share nothing: span_merge_deviations() and span_merge_spheres() run them apart.
+    static L chord_deviation(const L (&a)[3], const L (&m)[3], const L (&b)[3], L ld, L rd) {
         const L zero = L::splat(0.0), one = L::splat(1.0);
         // distance_to_chord(M, A, B)
         const L abx = b[0] - a[0], aby = b[1] - a[1], abz = b[2] - a[2];
@@ -85,8 +90,10 @@ struct Merge {
         const L len2 = (abx * abx + aby * aby) + abz * abz;
         const L t = select(zero < len2, min_of(max_of(((qx * abx + qy * aby) + qz * abz) / len2, zero), one), zero);
         const L vx = m[0] - (a[0] + t * abx), vy = m[1] - (a[1] + t * aby), vz = m[2] - (a[2] + t * abz);
-        deviation = max_of(ld, rd) + sqrt_of((vx * vx + vy * vy) + vz * vz);
-        // merge_spheres(left, right)
+        return max_of(ld, rd) + sqrt_of((vx * vx + vy * vy) + vz * vz);
+    }
+    // merge_spheres(left, right)
+    static void sphere(const L (&lc)[3], L lr, const L (&rc)[3], L rr, L (&c)[3], L& r) {
         const L dx = rc[0] - lc[0], dy = rc[1] - lc[1], dz = rc[2] - lc[2];
         const L dist = sqrt_of((dx * dx + dy * dy) + dz * dz);
         const L rad = L::splat(0.5) * ((dist + lr) + rr);
@@ -222,6 +229,57 @@ inline void span_merge_level(const double* child, const double* e, std::size_t c
         dev.add_lanes(L1{child[4 * cw + l]});
     }
     dev.finish(range[0], range[1]);
+}
+
+// span_merge_level() in two passes that together write the same: the deviations (with the chord ends and the
+// range), then the spheres. compute_lod_bounds() with a stop test (update_lod_once()) runs the second only when
+// the first's range does not stop the build: the stopping level's spheres are never read.
+inline void span_merge_deviations(const double* child, const double* e, std::size_t cw, double* parent, double* f,
+                                  std::size_t w, double* range) {
+    const std::size_t pairs = cw / 2;
+    Range dev;
+    auto run = [&]<class L>(std::size_t j, L) __attribute__((always_inline)) {
+        const std::size_t at = 2 * j;
+        const L a[3] = {L::evens(e + at), L::evens(e + cw + at), L::evens(e + 2 * cw + at)};
+        const L m[3] = {L::odds(e + at), L::odds(e + cw + at), L::odds(e + 2 * cw + at)};
+        const L b[3] = {L::odds(e + 3 * cw + at), L::odds(e + 4 * cw + at), L::odds(e + 5 * cw + at)};
+        const L d = Merge<L>::chord_deviation(a, m, b, L::evens(child + 4 * cw + at), L::odds(child + 4 * cw + at));
+        for (int k = 0; k < 3; ++k) {
+            a[k].store(f + k * w + j);
+            b[k].store(f + (3 + k) * w + j);
+        }
+        d.store(parent + 4 * w + j);
+        if constexpr (std::is_same_v<L, W>) {
+            dev.add(d);
+        } else {
+            dev.add_lanes(d);
+        }
+    };
+    over_lanes(pairs, run);
+    if (pairs < w) {
+        const std::size_t l = cw - 1;
+        parent[4 * w + pairs] = child[4 * cw + l];
+        for (int k = 0; k < 6; ++k) f[k * w + pairs] = e[k * cw + l];
+        dev.add_lanes(L1{child[4 * cw + l]});
+    }
+    dev.finish(range[0], range[1]);
+}
+inline void span_merge_spheres(const double* child, std::size_t cw, double* parent, std::size_t w) {
+    const std::size_t pairs = cw / 2;
+    auto run = [&]<class L>(std::size_t j, L) __attribute__((always_inline)) {
+        const std::size_t at = 2 * j;
+        const L lc[3] = {L::evens(child + at), L::evens(child + cw + at), L::evens(child + 2 * cw + at)};
+        const L rc[3] = {L::odds(child + at), L::odds(child + cw + at), L::odds(child + 2 * cw + at)};
+        L c[3], r;
+        Merge<L>::sphere(lc, L::evens(child + 3 * cw + at), rc, L::odds(child + 3 * cw + at), c, r);
+        for (int k = 0; k < 3; ++k) c[k].store(parent + k * w + j);
+        r.store(parent + 3 * w + j);
+    };
+    over_lanes(pairs, run);
+    if (pairs < w) {
+        const std::size_t l = cw - 1;
+        for (int k = 0; k < 4; ++k) parent[k * w + pairs] = child[k * cw + l];
+    }
 }
 
 // Bit k of an 8-bit mask to bit 0 of byte k: the low 7 bits by one multiplication (the shifted copies of the mask
