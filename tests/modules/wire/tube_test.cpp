@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 namespace wire::test {
@@ -229,6 +230,56 @@ TEST(Tube, StripQuaternionsEqualTheOneRingFunction) {
             ++largest[static_cast<std::size_t>(std::max_element(f, f + 4) - f)];
         }
         for (int i = 0; i < 4; ++i) EXPECT_GT(largest[static_cast<std::size_t>(i)], 10) << "candidate " << i;
+    }
+}
+
+// write_strip works through its rings in chunks (stack buffers), four rows at a time with a one-by-one remainder:
+// every vertex and index must be the layout tube.hpp documents, for ring counts around the block and chunk sizes,
+// open and closed, with a vertex offset; the bytes are compared, so a sign or lane mix-up cannot hide.
+TEST(Tube, StripEveryRowAcrossChunks) {
+    std::mt19937_64 rng(20261124);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    for (std::size_t n : {0u, 1u, 2u, 3u, 4u, 5u, 7u, 8u, 63u, 64u, 65u, 67u, 128u, 131u, 200u}) {
+        std::vector<Ring> rings(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            Ring& ring = rings[k];
+            ring.centre_m = {uni(rng) * 10.0f, uni(rng) * 10.0f, uni(rng) * 10.0f};
+            ring.radius_m = 0.01f + 0.01f * uni(rng);
+            const glm::dvec3 a(uni(rng), uni(rng), uni(rng) + 2.0f), b(uni(rng) + 2.0f, uni(rng), uni(rng));
+            const glm::dvec3 r = glm::normalize(a);
+            ring.normal = glm::vec3(r);
+            ring.binormal = glm::vec3(glm::normalize(b - glm::dot(b, r) * r));
+            ring.u = static_cast<float>(k) * 0.25f + uni(rng) * 0.1f;
+            ring.segment = static_cast<uint32_t>(k);
+        }
+        for (bool closed : {false, true}) {
+            const uint32_t base = 1000;
+            const TubeCounts c = strip_counts(n, closed);
+            std::vector<TubeVertex> vertices(c.vertices + 1);
+            std::vector<uint32_t> indices(c.indices + 1, 7u);
+            std::memset(static_cast<void*>(vertices.data()), 0x5a, vertices.size() * sizeof(TubeVertex));
+            const TubeVertex guard = vertices.back();
+            const TubeCounts w = write_strip(rings, closed, 99.5f, vertices, indices, base);
+            ASSERT_EQ(w.vertices, c.vertices);
+            ASSERT_EQ(w.indices, c.indices);
+            const std::size_t rows = c.vertices / 2;
+            for (std::size_t row = 0; row < rows; ++row) {
+                const Ring& ring = rings[row == n ? 0 : row];
+                const float u = row == n ? 99.5f : ring.u;
+                const glm::vec3 q = ring_frame_quaternion_xyz(ring);
+                const TubeVertex expected[2] = {{ring.centre_m, q, {u, -ring.radius_m}},
+                                                {ring.centre_m, q, {u, ring.radius_m}}};
+                ASSERT_EQ(std::memcmp(&vertices[2 * row], expected, sizeof expected), 0)
+                    << "n " << n << (closed ? " closed" : " open") << " row " << row;
+            }
+            ASSERT_EQ(std::memcmp(&vertices.back(), &guard, sizeof guard), 0) << "n " << n << ": wrote past the end";
+            for (std::size_t b = 0; b + 1 < rows; ++b) {
+                const auto a = static_cast<uint32_t>(base + 2 * b);
+                const uint32_t expected[6] = {a + 1, a + 3, a + 2, a + 1, a + 2, a};
+                for (std::size_t j = 0; j < 6; ++j) ASSERT_EQ(indices[6 * b + j], expected[j]) << "band " << b;
+            }
+            ASSERT_EQ(indices.back(), 7u) << "n " << n << ": wrote past the end";
+        }
     }
 }
 
