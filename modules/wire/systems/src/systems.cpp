@@ -540,6 +540,21 @@ void mesh_system(Registry& registry, WireContext& ctx) {
         jobs.push_back(MeshJob{rings, lod, style, &mesh});
     }
     parallel_over(jobs.size(), [&](std::size_t i) {
+        if (i + 1 < jobs.size()) {
+            // The next wire's rings (written by the ring stage) and mesh buffers (last written a frame ago) are out
+            // of L1/L2 and each a separate block: start fetching them now, while this wire's mesh is written,
+            // not line by line as the writers reach them (values unchanged).
+            const MeshJob& next = jobs[i + 1];
+            const auto fetch = [](const void* data, std::size_t bytes, auto write) {
+                const char* const first = static_cast<const char*>(data);
+                for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(first + at, decltype(write)::value);
+            };
+            const std::vector<Ring>& rings = next.rings->rings.rings;
+            fetch(rings.data(), rings.size() * sizeof(Ring), std::false_type{});
+            const TubeMesh& mesh = next.mesh->mesh;
+            fetch(mesh.vertices.data(), mesh.vertices.size() * sizeof(TubeVertex), std::true_type{});
+            fetch(mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t), std::true_type{});
+        }
         MeshJob& job = jobs[i];
         WireMesh& m = *job.mesh;
         m.sides = job.lod->lod.drawn_sides;
