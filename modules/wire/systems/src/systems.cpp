@@ -89,6 +89,12 @@ struct MeshJob {
     const WireLodState* lod;
     const Style* style;
     WireMesh* mesh;
+    // The mesh buffers as they were when the job was queued: the job before prefetches them (reading them from
+    // the vectors then would race with the thread that resizes them).
+    const TubeVertex* vertices;
+    std::size_t vertex_count;
+    const uint32_t* indices;
+    std::size_t index_count;
 };
 
 bool caps_of(const Style& style) { return style.caps && !style.closed; }
@@ -537,23 +543,24 @@ void mesh_system(Registry& registry, WireContext& ctx) {
         }
         if (rings->generation == 0) continue;
         if (mesh.seen_rings == rings->generation && mesh.sides == lod->lod.drawn_sides && mesh.caps == caps_of(*style)) continue;
-        jobs.push_back(MeshJob{rings, lod, style, &mesh});
+        jobs.push_back(MeshJob{rings, lod, style, &mesh, mesh.mesh.vertices.data(), mesh.mesh.vertices.size(),
+                               mesh.mesh.indices.data(), mesh.mesh.indices.size()});
     }
     parallel_over(jobs.size(), [&](std::size_t i) {
         if (i + 1 < jobs.size()) {
             // The next wire's rings (written by the ring stage) and mesh buffers (last written a frame ago) are out
             // of L1/L2 and each a separate block: start fetching them now, while this wire's mesh is written,
-            // not line by line as the writers reach them (values unchanged).
+            // not line by line as the writers reach them (values unchanged; a prefetch of a buffer another thread
+            // has since reallocated is harmless).
             const MeshJob& next = jobs[i + 1];
             const auto fetch = [](const void* data, std::size_t bytes, auto write) {
                 const char* const first = static_cast<const char*>(data);
                 for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(first + at, decltype(write)::value);
             };
-            const std::vector<Ring>& rings = next.rings->rings.rings;
+            const std::vector<Ring>& rings = next.rings->rings.rings;  // read-only in this stage
             fetch(rings.data(), rings.size() * sizeof(Ring), std::false_type{});
-            const TubeMesh& mesh = next.mesh->mesh;
-            fetch(mesh.vertices.data(), mesh.vertices.size() * sizeof(TubeVertex), std::true_type{});
-            fetch(mesh.indices.data(), mesh.indices.size() * sizeof(uint32_t), std::true_type{});
+            fetch(next.vertices, next.vertex_count * sizeof(TubeVertex), std::true_type{});
+            fetch(next.indices, next.index_count * sizeof(uint32_t), std::true_type{});
         }
         MeshJob& job = jobs[i];
         WireMesh& m = *job.mesh;
