@@ -287,8 +287,9 @@ TubeCounts strip_counts(std::size_t ring_count, bool closed) {
 
 namespace {
 /// Rings per pass of write_strip: their frames and quaternions live in stack buffers (no per-thread vectors to
-/// look up and resize per wire), small enough to stay in L1 between the passes.
+/// look up and resize per wire), small enough to stay in L1 between the passes. A multiple of 8 (the padding).
 constexpr std::size_t kStripChunk = 64;
+static_assert(kStripChunk % 8 == 0);
 
 /// The frames of n <= kStripChunk rings as 6 float rows of kStripChunk (normal x, y, z, binormal x, y, z): four
 /// rings at a time by 4x4 transposes of their record quads (the compiler does not vectorize the strided gather).
@@ -396,7 +397,14 @@ TubeCounts write_strip(std::span<const Ring> rings, bool closed, float u_close, 
         const std::size_t count = std::min(kStripChunk, n - first);
         const Ring* chunk = rings.data() + first;
         gather_frames(chunk, count, frames);
-        frame_quaternions(frames, count, q);
+        // Rounded up to a multiple of 8 rings with identity frames (their results unused): the kernel's 8-wide
+        // epilogue takes the rest, where its scalar tail took up to 7 rings one by one (a third of its time on
+        // ~20-ring wires: the divides and square roots bound it).
+        const std::size_t padded = (count + 7) / 8 * 8;
+        for (std::size_t k = count; k < padded; ++k) {
+            for (std::size_t row = 0; row < 6; ++row) frames[row][k] = row == 0 || row == 4 ? 1.0f : 0.0f;
+        }
+        frame_quaternions(frames, padded, q);
         if (first == 0) q0 = {q[0][0], q[1][0], q[2][0]};
         std::size_t k = 0;
 #if defined(__SSE2__)
