@@ -325,10 +325,12 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         CurveJob* const job[2] = {&jobs[2 * pair], 2 * pair + 1 < jobs.size() ? &jobs[2 * pair + 1] : nullptr};
         Step step[2];
         // The next pair's components (read first thing there, out of the cache since the last frame): their
-        // lines come in while this pair builds. WireCurve's per-frame fields are its first 8 lines.
+        // lines come in while this pair builds. WireCurve's per-frame fields lie from lod_bounds.data (what the
+        // LOD stage reads of a moving wire) to the end of previous_nodes.
         for (std::size_t k = 2 * pair + 2; k < std::min(2 * pair + 4, jobs.size()); ++k) {
-            const char* const c = reinterpret_cast<const char*>(jobs[k].curve);
-            for (std::size_t at = 0; at < 512; at += 64) __builtin_prefetch(c + at, 1);
+            const char* const c = reinterpret_cast<const char*>(&jobs[k].curve->lod_bounds.data);
+            const std::size_t bytes = reinterpret_cast<const char*>(&jobs[k].curve->previous_nodes + 1) - c;
+            for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(c + at, 1);
             const char* const n = reinterpret_cast<const char*>(jobs[k].nodes);
             for (std::size_t at = 0; at < sizeof(WireNodes); at += 64) __builtin_prefetch(n + at);
             __builtin_prefetch(jobs[k].style);

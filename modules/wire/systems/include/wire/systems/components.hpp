@@ -44,10 +44,16 @@ struct Style {
 /// mesh are rebuilt); the curve stage rebuilds it likewise when the current nodes are invalid (the wire keeps its
 /// last valid curve). Readers of `curve` (tools, tests) see an empty curve only for a culled wire.
 struct WireCurve {
-    // Field order: what the curve stage reads and writes for every wire every frame (curve, settings, counters,
-    // flags, bounds, previous_nodes) comes first and together, so a moving wire's update touches ~8 contiguous
-    // cache lines instead of ~11 scattered over 1.2 KB; the LOD's bounds and the pop-free state, which the fast
-    // path leaves alone, come last.
+    // Field order: what the curve stage reads and writes for every moving wire every frame (curve, settings,
+    // counters, flags, bounds, previous_nodes) is contiguous, and what the LOD stage reads of a moving wire
+    // (lod_bounds.data, its last member, to curve, flags and bounds) lies within it: ~9 contiguous cache lines a
+    // wire for both stages instead of ~11 scattered over 1.2 KB. The pop-free state, which the fast path leaves
+    // alone, comes last.
+    /// The LOD's per-wire bound and spans of `curve` (lod.hpp), kept only by a visible wire whose curve did not
+    /// change since its last LOD update (a static wire that sees the camera move: WireLod::Coherence reuses them
+    /// while their version stands). A wire whose curve changed this frame gets them in per-thread scratch of the
+    /// LOD stage and keeps none; a wire whose sphere is outside the view needs none; a culled wire releases them.
+    LodBounds lod_bounds{};
     Curve curve;                       ///< what is drawn; empty until the nodes were valid once, or released
     SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
     uint64_t generation = 0;           ///< +1 each time `curve` changes (or is rebuilt after a release)
@@ -62,17 +68,12 @@ struct WireCurve {
     uint64_t bounds_generation = 0;    ///< `generation` whose curve `bounds` was computed from (0: none known; a
                                        ///< failed update may rewrite `curve`): then the LOD stage takes `bounds`
                                        ///< as the LodBounds' sphere instead of computing it again
+    uint64_t lod_bounds_generation = 0;  ///< `generation` lod_bounds were computed for (0: none kept)
     // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
     // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
     // `previous_nodes` (the last valid state) when the ids change. While stale the multires state is released
     // (re-priming rebuilds it from previous_nodes anyway); build_curve's output buffer is per thread, not per wire.
     WireNodes previous_nodes;          ///< the last valid nodes (re-primes `multires` when ids change)
-    uint64_t lod_bounds_generation = 0;  ///< `generation` lod_bounds were computed for (0: none kept)
-    /// The LOD's per-wire bound and spans of `curve` (lod.hpp), kept only by a visible wire whose curve did not
-    /// change since its last LOD update (a static wire that sees the camera move: WireLod::Coherence reuses them
-    /// while their version stands). A wire whose curve changed this frame gets them in per-thread scratch of the
-    /// LOD stage and keeps none; a wire whose sphere is outside the view needs none; a culled wire releases them.
-    LodBounds lod_bounds{};
     MultiresCurve multires{MultiresSettings{}};  ///< pop-free state: blends nodes in and out over frames
 };
 
