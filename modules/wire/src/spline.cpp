@@ -729,11 +729,23 @@ void tangents_kernel(std::size_t segs, const double* __restrict D, const double*
     }
 }
 
+// Writes one Bezier record at o (start point a, inner control points c0..c5, end point b) and returns whether
+// every inner control point is within +-limit (false for NaN), tested on the values in the registers (a pass over
+// the records just written would wait for the stores). Always inlined: GCC inlines nothing else into a kernel
+// compiled with its own options (WIRE_SELECT_KERNEL); __builtin_fabs for the same reason (not std::abs).
+[[gnu::always_inline]] inline bool write_record(double* __restrict o, double ax, double ay, double az, double c0,
+                                                double c1, double c2, double c3, double c4, double c5, double bx,
+                                                double by, double bz, double limit) {
+    o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
+    o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
+    return (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
+           (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit);
+}
+
 // Bezier segments k = 0 .. count-1 (12 doubles each, out at 12k) from node coordinates p0 (3 per node, segment
 // k's start at 3k), p1 (its end at 3k) and the segment tangents: inner control points B1 = P0 + t0/3 and
 // B2 = P1 - t1/3, written straight into the records (one pass: the control points are not stored apart first).
-// Returns whether every inner control point is within +-limit (false for NaN), tested on the values in the
-// registers (a pass over the records just written would wait for the stores).
+// Returns whether every inner control point is within +-limit (write_record's test).
 WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
 bool segments_kernel(std::size_t count, const double* __restrict p0, const double* __restrict p1,
                      const double* __restrict t0x, const double* __restrict t0y, const double* __restrict t0z,
@@ -746,12 +758,7 @@ bool segments_kernel(std::size_t count, const double* __restrict p0, const doubl
         const double bx = p1[3 * k], by = p1[3 * k + 1], bz = p1[3 * k + 2];
         const double c0 = ax + t0x[k] * (1.0 / 3.0), c1 = ay + t0y[k] * (1.0 / 3.0), c2 = az + t0z[k] * (1.0 / 3.0);
         const double c3 = bx - t1x[k] * (1.0 / 3.0), c4 = by - t1y[k] * (1.0 / 3.0), c5 = bz - t1z[k] * (1.0 / 3.0);
-        o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
-        o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
-        // __builtin_fabs: a kernel with its own optimize attribute does not inline std::abs.
-        const bool in = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
-                        (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit);
-        ok = in ? ok : 0.0;
+        ok = write_record(o, ax, ay, az, c0, c1, c2, c3, c4, c5, bx, by, bz, limit) ? ok : 0.0;
     }
     return ok == 1.0;
 }
@@ -773,11 +780,7 @@ bool node_segments_kernel(std::size_t count, const double* __restrict p0, const 
         const double c0 = ax + (Dx[k] * h) * (1.0 / 3.0), c1 = ay + (Dy[k] * h) * (1.0 / 3.0);
         const double c2 = az + (Dz[k] * h) * (1.0 / 3.0), c3 = bx - (Dx[k + 1] * h) * (1.0 / 3.0);
         const double c4 = by - (Dy[k + 1] * h) * (1.0 / 3.0), c5 = bz - (Dz[k + 1] * h) * (1.0 / 3.0);
-        o[0] = ax, o[1] = ay, o[2] = az, o[3] = c0, o[4] = c1, o[5] = c2;
-        o[6] = c3, o[7] = c4, o[8] = c5, o[9] = bx, o[10] = by, o[11] = bz;
-        const bool in = (__builtin_fabs(c0) <= limit) & (__builtin_fabs(c1) <= limit) & (__builtin_fabs(c2) <= limit) &
-                        (__builtin_fabs(c3) <= limit) & (__builtin_fabs(c4) <= limit) & (__builtin_fabs(c5) <= limit);
-        ok = in ? ok : 0.0;
+        ok = write_record(o, ax, ay, az, c0, c1, c2, c3, c4, c5, bx, by, bz, limit) ? ok : 0.0;
     }
     return ok == 1.0;
 }

@@ -698,6 +698,18 @@ TEST(LodBoundingSphere, EqualsTheSequenceBitForBit) {
     EXPECT_GT(nans, 200u);
 }
 
+// Wire i of the cheap-pass families: shape i % 3 (make_wire), every fifth non-hanging one closed, a random
+// radius of 1 to 50 mm. False if the curve could not be built.
+bool family_curve(int i, Rng& rng, Curve& curve) {
+    const Shape shape = static_cast<Shape>(i % 3);
+    const WireNodes nodes = make_wire(shape, rng);
+    const bool closed = shape != Shape::hanging && i % 5 == 4;
+    return build_curve(nodes,
+                       SplineSettings{.closed = closed, .radius_m = static_cast<float>(uniform(rng, 0.001, 0.05))},
+                       curve)
+        .ok;
+}
+
 // The cheap pass (per-wire bound, then per-segment work only where needed) leaves exactly the state of the
 // per-segment evaluation, over random wires (open and closed), cameras of every kind and short camera walks
 // (so the hysteresis state is compared too), at node resolution and below it. The bound must decide a fair
@@ -706,15 +718,8 @@ TEST(LodCheapPass, EqualsThePerSegmentEvaluation) {
     Rng rng(31);
     std::size_t updates = 0, bounded = 0, visible = 0, spans = 0, bounded_partly = 0;
     for (int i = 0; i < 240; ++i) {
-        const Shape shape = static_cast<Shape>(i % 3);
-        const WireNodes nodes = make_wire(shape, rng);
         Curve curve;
-        const bool closed = shape != Shape::hanging && i % 5 == 4;
-        ASSERT_TRUE(build_curve(nodes,
-                                SplineSettings{.closed = closed,
-                                               .radius_m = static_cast<float>(uniform(rng, 0.001, 0.05))},
-                                curve)
-                        .ok);
+        ASSERT_TRUE(family_curve(i, rng, curve));
         LodBounds bounds;
         compute_lod_bounds(curve, bounds);
         const BoundingSphere sphere = curve_bounding_sphere(curve);
@@ -795,15 +800,8 @@ TEST(LodCheapPass, UpdateOnceEqualsTheFullBounds) {
     Rng rng(43);
     std::size_t updates = 0, visible = 0, left_out = 0;
     for (int i = 0; i < 160; ++i) {
-        const Shape shape = static_cast<Shape>(i % 3);
-        const WireNodes nodes = make_wire(shape, rng);
         Curve curve;
-        const bool closed = shape != Shape::hanging && i % 5 == 4;
-        ASSERT_TRUE(build_curve(nodes,
-                                SplineSettings{.closed = closed,
-                                               .radius_m = static_cast<float>(uniform(rng, 0.001, 0.05))},
-                                curve)
-                        .ok);
+        ASSERT_TRUE(family_curve(i, rng, curve));
         if (i % 16 == 14) {  // a NaN node: NaN deviations up to the root (the root level's largest is then 0)
             const std::size_t k = curve.segments.size() / 2;
             curve.segments[k].b0.y = curve.segments[k - 1].b3.y = std::numeric_limits<double>::quiet_NaN();
