@@ -140,15 +140,14 @@ WIRE_VECTOR_CLONES void step_matrices(const double* __restrict x, const double* 
     }
 }
 
-/// The frame points of `count` consecutive segment starts: position b0 - origin and boundary tangent (tx .. tz,
-/// its flag into ok), read from structure-of-arrays tables.
+/// The frame points of `count` consecutive segment starts: position b0 - origin and boundary tangent (tx .. tz),
+/// read from structure-of-arrays tables (the caller fixes the tangents whose flag in the table is 0).
 WIRE_VECTOR_CLONES void segment_start_points(const double* __restrict b0x, const double* __restrict b0y,
                                              const double* __restrict b0z, const double* __restrict tx,
-                                             const double* __restrict ty, const double* __restrict tz,
-                                             const double* __restrict tok, double ox, double oy, double oz,
-                                             std::size_t count, double* __restrict px, double* __restrict py,
-                                             double* __restrict pz, double* __restrict ptx, double* __restrict pty,
-                                             double* __restrict ptz, double* __restrict ok) {
+                                             const double* __restrict ty, const double* __restrict tz, double ox,
+                                             double oy, double oz, std::size_t count, double* __restrict px,
+                                             double* __restrict py, double* __restrict pz, double* __restrict ptx,
+                                             double* __restrict pty, double* __restrict ptz) {
     for (std::size_t j = 0; j < count; ++j) {
         px[j] = b0x[j] - ox;
         py[j] = b0y[j] - oy;
@@ -156,7 +155,6 @@ WIRE_VECTOR_CLONES void segment_start_points(const double* __restrict b0x, const
         ptx[j] = tx[j];
         pty[j] = ty[j];
         ptz[j] = tz[j];
-        ok[j] = tok[j];
     }
 }
 
@@ -514,8 +512,8 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         if (starts) {
             const double* const b = in.segment_soa.data() + s0;
             const double* const t = in.boundary_tangent.data() + s0;
-            segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, t + 3 * ss, in.origin_m.x,
-                                 in.origin_m.y, in.origin_m.z, count, px, py, pz, ptx, pty, ptz, special);
+            segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, in.origin_m.x, in.origin_m.y,
+                                 in.origin_m.z, count, px, py, pz, ptx, pty, ptz);
             for (std::size_t q = 0; q < count; ++q) {
                 point_seg[q] = static_cast<uint32_t>(s0 + q);
                 point_ta[q] = 0.0;

@@ -187,6 +187,9 @@ inline void span_level0(const CubicBezier* seg, std::size_t n, double* node, dou
     double p[W::width];
     probe.store(p);
     for (std::size_t k = 0; k < W::width; ++k) probe_tail += p[k];
+    // Read only as finite or not (a NaN coordinate makes it NaN): the overlapping last group counts some segments
+    // twice and the summation order depends on the lane width, so near DBL_MAX its finiteness may differ between
+    // widths; that only turns update_lod_once's level stop off, whose result is the same either way.
     range[3] = probe_tail;
 }
 

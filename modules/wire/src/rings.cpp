@@ -292,7 +292,7 @@ WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void ring_samples(
     }
 }
 
-/// One radius on every node (or none).
+/// One radius on every node (or none). (all_equal_and_plain's second answer is not needed here.)
 bool uniform_radius(const Curve& curve) {
     bool equal = true, plain = true;
     all_equal_and_plain(curve.radius_m.data(), curve.radius_m.size(), &equal, &plain);

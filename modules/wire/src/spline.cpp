@@ -1178,10 +1178,17 @@ Status end_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& 
     return Status::success();
 }
 
+// A thread's build memory: build_curve uses the first, build_curve_pair both (nothing calls build_curve between a
+// pair's begin_curve and end_curve), so a thread keeps at most two builds' worth for its largest wires.
+CurveBuild& thread_build(int k) {
+    thread_local CurveBuild b[2];
+    return b[k];
+}
+
 }  // namespace
 
 Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
-    thread_local CurveBuild b;
+    CurveBuild& b = thread_build(0);
     Status st = begin_curve(nodes, settings, out, b);
     if (st && b.ts.pending) solve(b.ts);
     if (st) st = end_curve(nodes, settings, out, b);
@@ -1191,8 +1198,13 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
 
 std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0, Curve& out0,
                                            const WireNodes& nodes1, const SplineSettings& settings1, Curve& out1) {
-    assert(&out0 != &out1);
-    thread_local CurveBuild b0, b1;  // not build_curve's: each build keeps its own memory until its end
+    if (&out0 == &out1) {  // one curve for both (the header asks for two): what two build_curve calls leave
+        Status st0 = build_curve(nodes0, settings0, out0);
+        Status st1 = build_curve(nodes1, settings1, out1);
+        return {std::move(st0), std::move(st1)};
+    }
+    CurveBuild& b0 = thread_build(0);  // each build keeps its own memory until its end
+    CurveBuild& b1 = thread_build(1);
     Status st0 = begin_curve(nodes0, settings0, out0, b0);
     Status st1 = begin_curve(nodes1, settings1, out1, b1);
     const bool pair = st0 && st1 && b0.ts.pending && b1.ts.pending && b0.ts.m == b1.ts.m && b0.ts.m >= 4;

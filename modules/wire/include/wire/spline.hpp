@@ -57,8 +57,8 @@ namespace wire {
 /// Cost O(n) time and memory for every kind (100,000 nodes: a few ms).
 [[nodiscard]] Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out);
 
-/// build_curve for two wires (into two different curves): the same outputs and statuses, bit for bit, as two
-/// build_curve calls. Faster where both are open c2 or automatic wires with the same number of curve nodes: the
+/// build_curve for two wires: the same outputs and statuses, bit for bit, as two build_curve calls (also when
+/// out0 and out1 are the same curve, which then holds the second). Faster where both are open c2 or automatic wires with the same number of curve nodes: the
 /// tridiagonal solve, a serial chain of divisions per wire, runs for both side by side.
 [[nodiscard]] std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0,
                                                          Curve& out0, const WireNodes& nodes1,

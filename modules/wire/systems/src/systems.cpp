@@ -150,11 +150,8 @@ void release_curve(WireCurve& c) {
     c.released = true;
 }
 
-/// Rebuilds a released curve from the last valid nodes with the settings it was built with. It was built by
-/// build_curve from the same nodes and settings (the fast path), which is deterministic: the same curve, bit for
-/// bit. False (still released) if that fails, which cannot happen for nodes that built once.
-// to = from. The optional per-node arrays are usually empty on both sides: they are assigned only when either
-// has entries (a vector assignment is a call even for two empty vectors, 11 a wire a frame otherwise).
+/// to = from. The optional per-node arrays are usually empty on both sides: they are assigned only when either
+/// has entries (a vector assignment is a call even for two empty vectors, 11 a wire a frame otherwise).
 void copy_nodes(WireNodes& to, const WireNodes& from) {
     static_assert(sizeof(WireNodes) == 12 * sizeof(std::vector<double>), "copy_nodes: a WireNodes array added?");
     to.positions = from.positions;
@@ -167,6 +164,9 @@ void copy_nodes(WireNodes& to, const WireNodes& from) {
     copy(to.kb_tension, from.kb_tension), copy(to.kb_bias, from.kb_bias), copy(to.kb_continuity, from.kb_continuity);
 }
 
+/// Rebuilds a released curve from the last valid nodes with the settings it was built with. It was built by
+/// build_curve from the same nodes and settings (the fast path), which is deterministic: the same curve, bit for
+/// bit. False (still released) if that fails, which cannot happen for nodes that built once.
 bool restore_curve(WireCurve& c, const SplineSettings& spline) {
     if (!build_curve(c.previous_nodes, spline, c.curve).ok) return false;
     c.released = false;
