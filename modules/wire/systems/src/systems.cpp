@@ -107,8 +107,6 @@ std::vector<T>& reused() {
     return v;
 }
 
-/// What a wire keeps of build_rings' output (see WireRings): the float records (swapped, so no copy and no
-/// allocation once both buffers are large enough), ring 0's frame, scalars.
 /// The LOD's bounds of the wire's curve, with the curve stage's sphere when it is of this curve.
 void bounds_of(const WireCurve& c, LodBounds& out) {
     if (c.bounds_generation == c.generation) {
@@ -118,6 +116,16 @@ void bounds_of(const WireCurve& c, LodBounds& out) {
     }
 }
 
+/// Starts fetching the cache lines of [data, data + bytes) (for writing when `write`): values unchanged, and a
+/// prefetch of memory another thread has since released or reallocated is harmless.
+template <bool write>
+void prefetch_lines(const void* data, std::size_t bytes) {
+    const char* const first = static_cast<const char*>(data);
+    for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(first + at, write ? 1 : 0);
+}
+
+/// What a wire keeps of build_rings' output (see WireRings): the float records (swapped, so no copy and no
+/// allocation once both buffers are large enough), ring 0's frame, scalars.
 void keep_rings(RingSet& built, WireRings& r) {
     RingSet& k = r.rings;
     std::swap(k.rings, built.rings);
@@ -329,11 +337,10 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         // LOD stage reads of a moving wire) to the end of previous_nodes.
         for (std::size_t k = 2 * pair + 2; k < std::min(2 * pair + 4, jobs.size()); ++k) {
             const char* const c = reinterpret_cast<const char*>(&jobs[k].curve->lod_bounds.data);
-            const std::size_t bytes = reinterpret_cast<const char*>(&jobs[k].curve->previous_nodes + 1) - c;
-            for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(c + at, 1);
-            const char* const n = reinterpret_cast<const char*>(jobs[k].nodes);
-            for (std::size_t at = 0; at < sizeof(WireNodes); at += 64) __builtin_prefetch(n + at);
-            __builtin_prefetch(jobs[k].style);
+            prefetch_lines<true>(c, static_cast<std::size_t>(
+                                        reinterpret_cast<const char*>(&jobs[k].curve->previous_nodes + 1) - c));
+            prefetch_lines<false>(jobs[k].nodes, sizeof(WireNodes));
+            prefetch_lines<false>(jobs[k].style, 1);
         }
         for (int k = 0; k < 2; ++k) {
             if (job[k] == nullptr) continue;
@@ -341,9 +348,8 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             // The curve's records are written at the end of its build into this buffer, another wire's curve
             // before (swapped), out of the cache since the last frame: start fetching its lines now, while the
             // tangents are built, not one by one as the records are written (values unchanged).
-            const std::size_t bytes = std::min(scratch[k].segments.capacity(), job[k]->nodes->size()) * sizeof(CubicBezier);
-            const char* const first = reinterpret_cast<const char*>(scratch[k].segments.data());
-            for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(first + at, 1);
+            prefetch_lines<true>(scratch[k].segments.data(),
+                                 std::min(scratch[k].segments.capacity(), job[k]->nodes->size()) * sizeof(CubicBezier));
         }
         if (job[1] != nullptr && step[0].exact && step[1].exact) {
             std::tie(job[0]->status, job[1]->status) = build_curve_pair(
@@ -561,17 +567,12 @@ void mesh_system(Registry& registry, WireContext& ctx) {
         if (i + 1 < jobs.size()) {
             // The next wire's rings (written by the ring stage) and mesh buffers (last written a frame ago) are out
             // of L1/L2 and each a separate block: start fetching them now, while this wire's mesh is written,
-            // not line by line as the writers reach them (values unchanged; a prefetch of a buffer another thread
-            // has since reallocated is harmless).
+            // not line by line as the writers reach them.
             const MeshJob& next = jobs[i + 1];
-            const auto fetch = [](const void* data, std::size_t bytes, auto write) {
-                const char* const first = static_cast<const char*>(data);
-                for (std::size_t at = 0; at < bytes; at += 64) __builtin_prefetch(first + at, decltype(write)::value);
-            };
             const std::vector<Ring>& rings = next.rings->rings.rings;  // read-only in this stage
-            fetch(rings.data(), rings.size() * sizeof(Ring), std::false_type{});
-            fetch(next.vertices, next.vertex_count * sizeof(TubeVertex), std::true_type{});
-            fetch(next.indices, next.index_count * sizeof(uint32_t), std::true_type{});
+            prefetch_lines<false>(rings.data(), rings.size() * sizeof(Ring));
+            prefetch_lines<true>(next.vertices, next.vertex_count * sizeof(TubeVertex));
+            prefetch_lines<true>(next.indices, next.index_count * sizeof(uint32_t));
         }
         MeshJob& job = jobs[i];
         WireMesh& m = *job.mesh;
