@@ -158,6 +158,17 @@ WIRE_VECTOR_CLONES void segment_start_points(const double* __restrict b0x, const
     }
 }
 
+/// Whether some of `count` table tangents needs the fix-up of a boundary tangent (flag 0, or the zero vector),
+/// without an early exit, so in lanes.
+WIRE_VECTOR_CLONES bool unfit_tangents(const double* __restrict tx, const double* __restrict ty,
+                                       const double* __restrict tz, const double* __restrict ok, std::size_t count) {
+    unsigned unfit = 0;  // integer or-reductions vectorize, bool ones do not
+    for (std::size_t j = 0; j < count; ++j) {
+        unfit |= (!(ok[j] != 0.0) | ((tx[j] == 0.0) & (ty[j] == 0.0) & (tz[j] == 0.0))) ? 1u : 0u;
+    }
+    return unfit != 0;
+}
+
 glm::dvec3 reflect_pair(const MirrorPair& m, glm::dvec3 r) {
     r -= (m.f1 * glm::dot(m.v1, r)) * m.v1;
     r -= (m.f2 * glm::dot(m.v2, r)) * m.v2;
@@ -431,7 +442,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // dependency, and a short one (no square root, no division), which is what bounds the speed. Reflections
         // keep |r| = 1 and r normal to t up to rounding, which is removed every 64 steps (drift stays ~1e-15); the
         // count runs over points, so a span's rings are re-projected exactly where the node-resolution rings are.
-        // Pass 3, binormals, runs in pass 2's loop (off its latency chain).
+        // Pass 3 writes the rings' normals and binormals.
         const CubicBezier* const segs = in.curve != nullptr ? in.curve->segments.data() : nullptr;
         // The points, in structure-of-arrays scratch (grows once per thread, then reused): position, tangent, the
         // segment and parameter a step from the point runs along, and the ring index (-1: a crossed boundary).
@@ -465,15 +476,15 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         thread_local std::vector<double> soa;
         thread_local std::vector<uint32_t> point_seg;
         thread_local std::vector<double> point_ta;
-        thread_local std::vector<int64_t> point_ring;
+        thread_local std::vector<uint32_t> ring_point;  // the point of every ring
         const std::size_t nb = last_crossed > first_crossed ? last_crossed - first_crossed : 0;
         // The arrays have room for whole vectors of steps (8 lanes): step_matrices then runs no remainder loop
         // (the steps past the last point, between copies of it, are computed and never read).
         const std::size_t mp = 1 + (m - 1 + 7) / 8 * 8;
-        soa.resize(16 * mp + 4 * nb);
+        soa.resize(19 * mp + 4 * nb);
         point_seg.resize(m);
         point_ta.resize(m);
-        point_ring.resize(m);
+        ring_point.resize(n);
         double* const px = soa.data();
         double* const py = px + mp;
         double* const pz = py + mp;
@@ -482,9 +493,12 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         double* const ptz = pty + mp;
         double* const mat = ptz + mp;     // 9 arrays: the step matrix into point j, column-major entries
         double* const special = mat + 9 * mp;  // nonzero: the step into j takes the guarded path
+        double* const nx = special + mp;        // 3 arrays: the normal carried to point j
+        double* const ny = nx + mp;
+        double* const nz = ny + mp;
         // Boundary tangents of the crossed range (detail::boundary_tangents): build_rings's, for every segment, or
         // computed here; a vanishing derivative (flag 0) takes unit_tangent()'s one-sided limits below.
-        double* const btan = special + mp;  // 4 arrays: x, y, z, ok
+        double* const btan = nz + mp;  // 4 arrays: x, y, z, ok
         const double* bt = btan;
         std::size_t bt_stride = nb;
         if (nb != 0 && in.boundary_tangent.size() % 4 == 0 && in.boundary_tangent.size() >= 4 * n_seg) {
@@ -506,7 +520,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             ptz[j] = t.z;
             point_seg[j] = seg;
             point_ta[j] = ta;
-            point_ring[j] = ring;
+            if (ring >= 0) ring_point[static_cast<std::size_t>(ring)] = static_cast<uint32_t>(j);
             ++j;
         };
         if (starts) {
@@ -517,19 +531,33 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             for (std::size_t q = 0; q < count; ++q) {
                 point_seg[q] = static_cast<uint32_t>(s0 + q);
                 point_ta[q] = 0.0;
-                point_ring[q] = -1;
             }
+            // The rings over their starts (a ring's segment and t are its start's; the last ring may be at t = 1,
+            // one point more).
             for (std::size_t i = 0; i < n; ++i) {
-                j = i + 1 == n && in.params[i].t == 1.0 ? count : in.params[i].segment - s0;
-                put(in.centre_m[i], out[i].t, in.params[i].segment, in.params[i].t, static_cast<int64_t>(i));
+                const std::size_t q = i + 1 == n && in.params[i].t == 1.0 ? count : in.params[i].segment - s0;
+                px[q] = in.centre_m[i].x;
+                py[q] = in.centre_m[i].y;
+                pz[q] = in.centre_m[i].z;
+                ptx[q] = out[i].t.x;
+                pty[q] = out[i].t.y;
+                ptz[q] = out[i].t.z;
+                ring_point[i] = static_cast<uint32_t>(q);
+            }
+            if (m > count) {
+                point_seg[count] = in.params[n - 1].segment;
+                point_ta[count] = 1.0;
             }
             j = m;
             // A boundary tangent whose flag is 0 takes unit_tangent()'s limits, a zero one the previous point's (the
-            // test reads the tables, not the point arrays just written in lanes).
+            // test reads the tables, not the point arrays just written in lanes). Rare: tested in lanes first.
             const double* const tok = t + 3 * ss;
-            for (std::size_t q = 1; q < count; ++q) {
+            const bool unfit = count > 1 && unfit_tangents(t + 1, t + ss + 1, t + 2 * ss + 1, tok + 1, count - 1);
+            std::size_t next_ring = 0;  // the first ring whose point is not before q (ring_point increases)
+            for (std::size_t q = 1; q < count && unfit; ++q) {
+                while (ring_point[next_ring] < q) ++next_ring;  // the last ring's point is at least count - 1
                 const glm::dvec3 table_t(t[q], t[ss + q], t[2 * ss + q]);
-                if ((tok[q] != 0.0 && table_t != glm::dvec3(0.0)) || point_ring[q] >= 0) continue;
+                if ((tok[q] != 0.0 && table_t != glm::dvec3(0.0)) || ring_point[next_ring] == q) continue;
                 glm::dvec3 tq = tok[q] != 0.0 ? table_t : unit_tangent(segs[s0 + q], 0.0);
                 if (tq == glm::dvec3(0.0)) tq = glm::dvec3(ptx[q - 1], pty[q - 1], ptz[q - 1]);
                 ptx[q] = tq.x;
@@ -587,11 +615,17 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                     r = orthonormalize(r, glm::dvec3(ptx[q], pty[q], ptz[q]));
                 }
             }
-            if (point_ring[q] >= 0) {  // pass 3, binormals, off the carry's latency chain
-                Frame& f = out[static_cast<std::size_t>(point_ring[q])];
-                f.r = r;
-                f.s = glm::cross(f.t, r);
-            }
+            nx[q] = r.x;
+            ny[q] = r.y;
+            nz[q] = r.z;
+        }
+        // Pass 3: the rings' normals and binormals (after the carry: a branch on whether a point is a ring, in the
+        // carry loop, is mispredicted wherever LOD leaves segments without rings).
+        for (std::size_t i = 1; i < n; ++i) {
+            const std::size_t q = ring_point[i];
+            Frame& f = out[i];
+            f.r = glm::dvec3(nx[q], ny[q], nz[q]);
+            f.s = glm::cross(f.t, f.r);
         }
     } else {
         for (std::size_t i = 1; i < n; ++i) {
