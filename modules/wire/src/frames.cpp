@@ -88,56 +88,75 @@ Mirrors mirrors(const Sample& a, const Sample& b, double noise, MirrorPair& m) {
 }
 
 /// The double-reflection step from point q - 1 to point q (positions x, y, z relative to the rings' origin, unit
-/// tangents tx, ty, tz) for q = 1 .. m - 1, as one matrix (column-major entries e00 .. e22: e<column><row>), with the
-/// operations mirrors() and the step's matrix take, branch-free so the loop vectorizes. special[q] = 1 where
-/// mirrors() would not answer ok (repeated point with reversing tangent, vanishing or ill-conditioned second
-/// mirror, a turn over 45 degrees) or the matrix is not a number: the guarded path takes those steps.
+/// tangents tx, ty, tz) for q = 1 .. m - 1 (m - 1 a multiple of 8), as one matrix (column-major entries e00 .. e22:
+/// e<column><row>), with the operations mirrors() and the step's matrix take, branch-free so the loop vectorizes.
+/// special = 1 where mirrors() would not answer ok (repeated point with reversing tangent, vanishing or
+/// ill-conditioned second mirror, a turn over 45 degrees) or the matrix is not a number: the guarded path takes
+/// those steps. Out: blocks of 8 steps (see step_entries), 10 rows of 8 lanes each: e00, e01, e02, e10, ... e22,
+/// special. In blocks the carry finds a step's 10 numbers at fixed distances from one pointer (from 10 arrays of
+/// a wire-dependent stride it computed 10 addresses a step).
 WIRE_VECTOR_CLONES void step_matrices(const double* __restrict x, const double* __restrict y, const double* __restrict z,
                    const double* __restrict tx, const double* __restrict ty, const double* __restrict tz, std::size_t m,
-                   double origin_noise, double* __restrict e00, double* __restrict e01, double* __restrict e02,
-                   double* __restrict e10, double* __restrict e11, double* __restrict e12, double* __restrict e20,
-                   double* __restrict e21, double* __restrict e22, double* __restrict special) {
-    for (std::size_t q = 1; q < m; ++q) {
-        const double ax = x[q - 1], ay = y[q - 1], az = z[q - 1];
-        const double bx = x[q], by = y[q], bz = z[q];
-        const double atx = tx[q - 1], aty = ty[q - 1], atz = tz[q - 1];
-        const double btx = tx[q], bty = ty[q], btz = tz[q];
-        // Transporter::noise()
-        const double noise = origin_noise + 1e-13 * (max3(std::abs(ax), std::abs(ay), std::abs(az)) +
-                                                     max3(std::abs(bx), std::abs(by), std::abs(bz)));
-        double v1x = bx - ax, v1y = by - ay, v1z = bz - az;
-        double c1 = v1x * v1x + v1y * v1y + v1z * v1z;
-        const bool repeated = c1 <= noise * noise * 64.0;
-        const double sx = atx + btx, sy = aty + bty, sz = atz + btz;
-        const double cs = sx * sx + sy * sy + sz * sz;
-        v1x = repeated ? sx : v1x;
-        v1y = repeated ? sy : v1y;
-        v1z = repeated ? sz : v1z;
-        c1 = repeated ? cs : c1;
-        const double f1 = 2.0 / c1;
-        const double d1 = f1 * (v1x * atx + v1y * aty + v1z * atz);
-        const double v2x = btx - (atx - d1 * v1x), v2y = bty - (aty - d1 * v1y), v2z = btz - (atz - d1 * v1z);
-        const double c2 = v2x * v2x + v2y * v2y + v2z * v2z;
-        const double f2 = 2.0 / c2;
-        const double k = f1 * (v2x * v1x + v2y * v1y + v2z * v1z);
-        // Column c: e_c - f1 v1 v1_c - f2 v2 (v2_c - k v1_c), k = f1 (v2.v1).
-        const double g1x = f1 * v1x, g2x = f2 * (v2x - k * v1x);
-        const double g1y = f1 * v1y, g2y = f2 * (v2y - k * v1y);
-        const double g1z = f1 * v1z, g2z = f2 * (v2z - k * v1z);
-        const double m00 = 1.0 - (v1x * g1x + v2x * g2x);
-        e00[q] = m00;
-        e01[q] = 0.0 - (v1y * g1x + v2y * g2x);
-        e02[q] = 0.0 - (v1z * g1x + v2z * g2x);
-        e10[q] = 0.0 - (v1x * g1y + v2x * g2y);
-        e11[q] = 1.0 - (v1y * g1y + v2y * g2y);
-        e12[q] = 0.0 - (v1z * g1y + v2z * g2y);
-        e20[q] = 0.0 - (v1x * g1z + v2x * g2z);
-        e21[q] = 0.0 - (v1y * g1z + v2y * g2z);
-        e22[q] = 1.0 - (v1z * g1z + v2z * g2z);
-        const bool not_ok = (repeated & (cs < 1e-20)) | (c2 < 1e-20) | (c2 < 0.1) |
-                            ((atx * btx + aty * bty + atz * btz) < kSplitCos) | (m00 != m00);
-        special[q] = not_ok ? 1.0 : 0.0;
+                   double origin_noise, double* __restrict blocks) {
+    for (std::size_t block = 0; block < (m - 1) / 8; ++block) {
+        double* __restrict const e00 = blocks + 80 * block;
+        double* __restrict const e01 = e00 + 8;
+        double* __restrict const e02 = e00 + 16;
+        double* __restrict const e10 = e00 + 24;
+        double* __restrict const e11 = e00 + 32;
+        double* __restrict const e12 = e00 + 40;
+        double* __restrict const e20 = e00 + 48;
+        double* __restrict const e21 = e00 + 56;
+        double* __restrict const e22 = e00 + 64;
+        double* __restrict const special = e00 + 72;
+        for (std::size_t lane = 0; lane < 8; ++lane) {
+            const std::size_t q = 1 + 8 * block + lane;
+            const double ax = x[q - 1], ay = y[q - 1], az = z[q - 1];
+            const double bx = x[q], by = y[q], bz = z[q];
+            const double atx = tx[q - 1], aty = ty[q - 1], atz = tz[q - 1];
+            const double btx = tx[q], bty = ty[q], btz = tz[q];
+            // Transporter::noise()
+            const double noise = origin_noise + 1e-13 * (max3(std::abs(ax), std::abs(ay), std::abs(az)) +
+                                                         max3(std::abs(bx), std::abs(by), std::abs(bz)));
+            double v1x = bx - ax, v1y = by - ay, v1z = bz - az;
+            double c1 = v1x * v1x + v1y * v1y + v1z * v1z;
+            const bool repeated = c1 <= noise * noise * 64.0;
+            const double sx = atx + btx, sy = aty + bty, sz = atz + btz;
+            const double cs = sx * sx + sy * sy + sz * sz;
+            v1x = repeated ? sx : v1x;
+            v1y = repeated ? sy : v1y;
+            v1z = repeated ? sz : v1z;
+            c1 = repeated ? cs : c1;
+            const double f1 = 2.0 / c1;
+            const double d1 = f1 * (v1x * atx + v1y * aty + v1z * atz);
+            const double v2x = btx - (atx - d1 * v1x), v2y = bty - (aty - d1 * v1y), v2z = btz - (atz - d1 * v1z);
+            const double c2 = v2x * v2x + v2y * v2y + v2z * v2z;
+            const double f2 = 2.0 / c2;
+            const double k = f1 * (v2x * v1x + v2y * v1y + v2z * v1z);
+            // Column c: e_c - f1 v1 v1_c - f2 v2 (v2_c - k v1_c), k = f1 (v2.v1).
+            const double g1x = f1 * v1x, g2x = f2 * (v2x - k * v1x);
+            const double g1y = f1 * v1y, g2y = f2 * (v2y - k * v1y);
+            const double g1z = f1 * v1z, g2z = f2 * (v2z - k * v1z);
+            const double m00 = 1.0 - (v1x * g1x + v2x * g2x);
+            e00[lane] = m00;
+            e01[lane] = 0.0 - (v1y * g1x + v2y * g2x);
+            e02[lane] = 0.0 - (v1z * g1x + v2z * g2x);
+            e10[lane] = 0.0 - (v1x * g1y + v2x * g2y);
+            e11[lane] = 1.0 - (v1y * g1y + v2y * g2y);
+            e12[lane] = 0.0 - (v1z * g1y + v2z * g2y);
+            e20[lane] = 0.0 - (v1x * g1z + v2x * g2z);
+            e21[lane] = 0.0 - (v1y * g1z + v2y * g2z);
+            e22[lane] = 1.0 - (v1z * g1z + v2z * g2z);
+            const bool not_ok = (repeated & (cs < 1e-20)) | (c2 < 1e-20) | (c2 < 0.1) |
+                                ((atx * btx + aty * bty + atz * btz) < kSplitCos) | (m00 != m00);
+            special[lane] = not_ok ? 1.0 : 0.0;
+        }
     }
+}
+
+/// Step q's 10 numbers in step_matrices()' blocks: entry k (e00, e01, ... e22, special) at [8 k].
+inline const double* step_entries(const double* blocks, std::size_t q) {
+    return blocks + 80 * ((q - 1) / 8) + (q - 1) % 8;
 }
 
 /// The frame points of `count` consecutive segment starts: position b0 - origin and boundary tangent (tx .. tz),
@@ -164,7 +183,9 @@ WIRE_VECTOR_CLONES bool unfit_tangents(const double* __restrict tx, const double
                                        const double* __restrict tz, const double* __restrict ok, std::size_t count) {
     unsigned unfit = 0;  // integer or-reductions vectorize, bool ones do not
     for (std::size_t j = 0; j < count; ++j) {
-        unfit |= (!(ok[j] != 0.0) | ((tx[j] == 0.0) & (ty[j] == 0.0) & (tz[j] == 0.0))) ? 1u : 0u;
+        const bool flag_off = !(ok[j] != 0.0);
+        const bool zero = (tx[j] == 0.0) & (ty[j] == 0.0) & (tz[j] == 0.0);
+        unfit |= (flag_off | zero) ? 1u : 0u;
     }
     return unfit != 0;
 }
@@ -350,6 +371,65 @@ glm::dvec3 unit_tangent(const CubicBezier& c, double t, bool* degenerate) {
     return glm::dvec3(0.0);
 }
 
+namespace {
+
+/// Pass 2 of one wire's double-reflection frames: the normal carried from point 0 (r0) through points 1 .. m - 1,
+/// stored at every point (nx, ny, nz). Steps flagged special take the guarded path (Transporter).
+struct CarryChain {
+    std::size_t m = 0;
+    glm::dvec3 r0{};
+    const double* blocks = nullptr;  // step_matrices()' output
+    const double *px = nullptr, *py = nullptr, *pz = nullptr, *ptx = nullptr, *pty = nullptr, *ptz = nullptr;
+    const uint32_t* point_seg = nullptr;
+    const double* point_ta = nullptr;
+    double *nx = nullptr, *ny = nullptr, *nz = nullptr;
+    Transporter* transport = nullptr;
+
+    /// The guarded step into point q (rare: out of line).
+    [[gnu::noinline]] glm::dvec3 guarded(std::size_t q, glm::dvec3 r) const {
+        const Sample a{{px[q - 1], py[q - 1], pz[q - 1]}, {ptx[q - 1], pty[q - 1], ptz[q - 1]}};
+        const Sample b{{px[q], py[q], pz[q]}, {ptx[q], pty[q], ptz[q]}};
+        const double tb = point_seg[q] == point_seg[q - 1] ? point_ta[q] : 1.0;
+        return transport->step(point_seg[q - 1], point_ta[q - 1], a, glm::normalize(r), tb, b);
+    }
+    /// The step into point q from normal (x, y, z) at point q - 1: one matrix-vector product (the serial part).
+    /// Three scalars, not a glm::dvec3 by reference: that one GCC keeps in memory, in the latency chain.
+    [[gnu::always_inline]] void step(std::size_t q, double& x, double& y, double& z) const {
+        const double* e = step_entries(blocks, q);
+        if (e[72] != 0.0) [[unlikely]] {
+            const glm::dvec3 r = guarded(q, glm::dvec3(x, y, z));
+            x = r.x;
+            y = r.y;
+            z = r.z;
+        } else {
+            const double rx = e[0] * x + e[24] * y + e[48] * z;
+            const double ry = e[8] * x + e[32] * y + e[56] * z;
+            const double rz = e[16] * x + e[40] * y + e[64] * z;
+            x = rx;
+            y = ry;
+            z = rz;
+            if ((q & 63) == 0) [[unlikely]] {  // reflections preserve length and plane; only rounding drifts, slowly
+                const glm::dvec3 r = orthonormalize(glm::dvec3(x, y, z), glm::dvec3(ptx[q], pty[q], ptz[q]));
+                x = r.x;
+                y = r.y;
+                z = r.z;
+            }
+        }
+        nx[q] = x;
+        ny[q] = y;
+        nz[q] = z;
+    }
+};
+
+/// Pass 2. A function of its own: inlined into compute_frames, its loop ran out of registers and reloaded its
+/// pointers from the stack every step.
+void carry_normal(const CarryChain& c) {
+    double x = c.r0.x, y = c.r0.y, z = c.r0.z;
+    for (std::size_t q = 1; q < c.m; ++q) c.step(q, x, y, z);
+}
+
+}  // namespace
+
 FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, std::span<Frame> out) {
     FrameStats stats;
     const std::size_t n = in.params.size();
@@ -491,9 +571,8 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         double* const ptx = pz + mp;
         double* const pty = ptx + mp;
         double* const ptz = pty + mp;
-        double* const mat = ptz + mp;     // 9 arrays: the step matrix into point j, column-major entries
-        double* const special = mat + 9 * mp;  // nonzero: the step into j takes the guarded path
-        double* const nx = special + mp;        // 3 arrays: the normal carried to point j
+        double* const blocks = ptz + mp;  // step_matrices()' blocks: the step into j, and whether it is guarded
+        double* const nx = blocks + 10 * mp;  // 3 arrays: the normal carried to point j
         double* const ny = nx + mp;
         double* const nz = ny + mp;
         // Boundary tangents of the crossed range (detail::boundary_tangents): build_rings's, for every segment, or
@@ -596,29 +675,11 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             pty[q] = pty[m - 1];
             ptz[q] = ptz[m - 1];
         }
-        step_matrices(px, py, pz, ptx, pty, ptz, mp, 1e-13 * max_abs(in.origin_m), mat, mat + mp, mat + 2 * mp,
-                      mat + 3 * mp, mat + 4 * mp, mat + 5 * mp, mat + 6 * mp, mat + 7 * mp, mat + 8 * mp, special);
+        step_matrices(px, py, pz, ptx, pty, ptz, mp, 1e-13 * max_abs(in.origin_m), blocks);
         // Pass 2: carry r, one matrix-vector product per step (the serial part); guarded steps through Transporter.
-        glm::dvec3 r = r0;
-        for (std::size_t q = 1; q < m; ++q) {
-            if (special[q] != 0.0) {
-                const Sample a{{px[q - 1], py[q - 1], pz[q - 1]}, {ptx[q - 1], pty[q - 1], ptz[q - 1]}};
-                const Sample b{{px[q], py[q], pz[q]}, {ptx[q], pty[q], ptz[q]}};
-                const double tb = point_seg[q] == point_seg[q - 1] ? point_ta[q] : 1.0;
-                r = transport.step(point_seg[q - 1], point_ta[q - 1], a, glm::normalize(r), tb, b);
-            } else {
-                const double* e = mat + q;
-                r = glm::dvec3(e[0] * r.x + e[3 * mp] * r.y + e[6 * mp] * r.z,
-                               e[mp] * r.x + e[4 * mp] * r.y + e[7 * mp] * r.z,
-                               e[2 * mp] * r.x + e[5 * mp] * r.y + e[8 * mp] * r.z);
-                if ((q & 63) == 0) {  // reflections preserve length and plane; only rounding drifts, slowly
-                    r = orthonormalize(r, glm::dvec3(ptx[q], pty[q], ptz[q]));
-                }
-            }
-            nx[q] = r.x;
-            ny[q] = r.y;
-            nz[q] = r.z;
-        }
+        const CarryChain chain{m,   r0,  blocks, px, py, pz, ptx, pty, ptz, point_seg.data(), point_ta.data(),
+                               nx, ny, nz, &transport};
+        carry_normal(chain);
         // Pass 3: the rings' normals and binormals (after the carry: a branch on whether a point is a ring, in the
         // carry loop, is mispredicted wherever LOD leaves segments without rings).
         for (std::size_t i = 1; i < n; ++i) {
