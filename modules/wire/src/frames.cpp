@@ -160,13 +160,16 @@ inline const double* step_entries(const double* blocks, std::size_t q) {
 }
 
 /// The frame points of `count` consecutive segment starts: position b0 - origin and boundary tangent (tx .. tz),
-/// read from structure-of-arrays tables (the caller fixes the tangents whose flag in the table is 0).
-WIRE_VECTOR_CLONES void segment_start_points(const double* __restrict b0x, const double* __restrict b0y,
+/// read from structure-of-arrays tables. Returns whether some tangent needs the caller's fix-up (its flag `ok` is
+/// 0, or it is the zero vector): rare, so tested here, in lanes (integer or-reductions vectorize, bool ones do not).
+WIRE_VECTOR_CLONES bool segment_start_points(const double* __restrict b0x, const double* __restrict b0y,
                                              const double* __restrict b0z, const double* __restrict tx,
-                                             const double* __restrict ty, const double* __restrict tz, double ox,
-                                             double oy, double oz, std::size_t count, double* __restrict px,
-                                             double* __restrict py, double* __restrict pz, double* __restrict ptx,
-                                             double* __restrict pty, double* __restrict ptz) {
+                                             const double* __restrict ty, const double* __restrict tz,
+                                             const double* __restrict ok, double ox, double oy, double oz,
+                                             std::size_t count, double* __restrict px, double* __restrict py,
+                                             double* __restrict pz, double* __restrict ptx, double* __restrict pty,
+                                             double* __restrict ptz) {
+    unsigned unfit = 0;
     for (std::size_t j = 0; j < count; ++j) {
         px[j] = b0x[j] - ox;
         py[j] = b0y[j] - oy;
@@ -174,15 +177,6 @@ WIRE_VECTOR_CLONES void segment_start_points(const double* __restrict b0x, const
         ptx[j] = tx[j];
         pty[j] = ty[j];
         ptz[j] = tz[j];
-    }
-}
-
-/// Whether some of `count` table tangents needs the fix-up of a boundary tangent (flag 0, or the zero vector),
-/// without an early exit, so in lanes.
-WIRE_VECTOR_CLONES bool unfit_tangents(const double* __restrict tx, const double* __restrict ty,
-                                       const double* __restrict tz, const double* __restrict ok, std::size_t count) {
-    unsigned unfit = 0;  // integer or-reductions vectorize, bool ones do not
-    for (std::size_t j = 0; j < count; ++j) {
         const bool flag_off = !(ok[j] != 0.0);
         const bool zero = (tx[j] == 0.0) & (ty[j] == 0.0) & (tz[j] == 0.0);
         unfit |= (flag_off | zero) ? 1u : 0u;
@@ -605,8 +599,9 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         if (starts) {
             const double* const b = in.segment_soa.data() + s0;
             const double* const t = in.boundary_tangent.data() + s0;
-            segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, in.origin_m.x, in.origin_m.y,
-                                 in.origin_m.z, count, px, py, pz, ptx, pty, ptz);
+            const double* const tok = t + 3 * ss;
+            const bool unfit = segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, tok, in.origin_m.x,
+                                                    in.origin_m.y, in.origin_m.z, count, px, py, pz, ptx, pty, ptz);
             for (std::size_t q = 0; q < count; ++q) {
                 point_seg[q] = static_cast<uint32_t>(s0 + q);
                 point_ta[q] = 0.0;
@@ -629,9 +624,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             }
             j = m;
             // A boundary tangent whose flag is 0 takes unit_tangent()'s limits, a zero one the previous point's (the
-            // test reads the tables, not the point arrays just written in lanes). Rare: tested in lanes first.
-            const double* const tok = t + 3 * ss;
-            const bool unfit = count > 1 && unfit_tangents(t + 1, t + ss + 1, t + 2 * ss + 1, tok + 1, count - 1);
+            // test reads the tables, not the point arrays just written in lanes). Rare: segment_start_points tells.
             std::size_t next_ring = 0;  // the first ring whose point is not before q (ring_point increases)
             for (std::size_t q = 1; q < count && unfit; ++q) {
                 while (ring_point[next_ring] < q) ++next_ring;  // the last ring's point is at least count - 1
