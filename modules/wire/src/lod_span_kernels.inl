@@ -32,7 +32,8 @@ __attribute__((always_inline)) inline void over_lanes(std::size_t n, Run&& run) 
 // larger squared length (the root is monotone and correctly rounded: the same value, one root fewer). The hull's
 // distance to the chord: both inner control points against one reciprocal of the chord's squared length (a foot
 // parameter off by a rounding is still a point of the chord, so the distance can only come out larger: still a
-// bound). Branch-free: a value a case does not need is computed and selected away.
+// bound), skipped for groups whose every lane's hull is certified to exceed 3/4 of Wang's M (hull_certified()).
+// Otherwise branch-free: a value a case does not need is computed and selected away.
 template <class L>
 struct Level0 {
     L wang, lo[3], hi[3], c[3], r, deviation, probe;
@@ -52,20 +53,56 @@ struct Level0 {
         const L p1x = x[1] - x[0], p1y = y[1] - y[0], p1z = z[1] - z[0];
         const L p2x = x[2] - x[0], p2y = y[2] - y[0], p2z = z[2] - z[0];
         const L len2 = (abx * abx + aby * aby) + abz * abz;
-        const L inv = select(zero < len2, one / len2, zero);
-        // std::clamp(t, 0, 1) is std::min(std::max(t, 0), 1)
-        const L t1 = min_of(max_of(((p1x * abx + p1y * aby) + p1z * abz) * inv, zero), one);
-        const L t2 = min_of(max_of(((p2x * abx + p2y * aby) + p2z * abz) * inv, zero), one);
-        const L v1x = p1x - t1 * abx, v1y = p1y - t1 * aby, v1z = p1z - t1 * abz;
-        const L v2x = p2x - t2 * abx, v2y = p2y - t2 * aby, v2z = p2z - t2 * abz;
-        const L hull = sqrt_of(max_of((v1x * v1x + v1y * v1y) + v1z * v1z, (v2x * v2x + v2y * v2y) + v2z * v2z));
-        const L d = min_of(hull, L::splat(0.75) * wang);
+        const L dot1 = (p1x * abx + p1y * aby) + p1z * abz;
+        const L w = L::splat(0.75) * wang;
+        // d = min(hull, w) is w wherever hull >= w, which hull_certified() shows without the hull for the lanes
+        // where b1 alone is provably far enough from the chord: on a hanging cable 9 groups of 10, which skip the
+        // hull's division, root and ~40 operations (the kernel is bound by its arithmetic).
+        L d;
+        if (hull_certified(p1x, p1y, p1z, dot1, len2, w).bits() == (1u << L::width) - 1) {
+            d = w;
+        } else {
+            const L inv = select(zero < len2, one / len2, zero);
+            const L dot2 = (p2x * abx + p2y * aby) + p2z * abz;
+            // std::clamp(t, 0, 1) is std::min(std::max(t, 0), 1)
+            const L t1 = min_of(max_of(dot1 * inv, zero), one), t2 = min_of(max_of(dot2 * inv, zero), one);
+            const L v1x = p1x - t1 * abx, v1y = p1y - t1 * aby, v1z = p1z - t1 * abz;
+            const L v2x = p2x - t2 * abx, v2y = p2y - t2 * aby, v2z = p2z - t2 * abz;
+            const L hull = sqrt_of(max_of((v1x * v1x + v1y * v1y) + v1z * v1z, (v2x * v2x + v2y * v2y) + v2z * v2z));
+            d = min_of(hull, w);
+        }
         // Not finite (NaN too): infinity.
         deviation = select(abs_of(d) <= L::splat(std::numeric_limits<double>::max()), d,
                            L::splat(std::numeric_limits<double>::infinity()));
         for (int k = 0; k < 3; ++k) c[k] = half * (lo[k] + hi[k]);
         const L sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
         r = half * sqrt_of((sx * sx + sy * sy) + sz * sz) * L::splat(1.0 + 1e-12);
+    }
+    // Lanes where the hull's squared distance as computed above, h = max(|v1|^2, |v2|^2) (rounded), is at least
+    // w^2 (w >= 0 a double): then sqrt(h) >= w exactly, so its rounding is >= w, and min_of(hull, w) is w (or an
+    // equal hull: the same bits, neither is -0). p = b1 - b0 and a = b3 - b0 (doubles), dot and len2 their p.a and
+    // |a|^2 rounded as the hull computes them, pp = |p|^2 and ww = w w rounded; u = 2^-53.
+    // 1. v1 = p - t a (t in [0, 1]), each component rounded twice (t a_k, then p_k minus it): |v1| >= |p - t a|
+    //    (1 - u) - u |a| >= D (1 - u) - u |a|, D the distance of b1 to the chord's line, and |v1|^2 rounded >=
+    //    (D - u |a|)^2 (1 - 5u). That is >= w^2 when D >= w (1 + 2.6u) + u |a|, which (x + y)^2 <= (1 + 2^-20) x^2 +
+    //    (1 + 2^20) y^2 turns into: D^2 >= w^2 (1 + 2^-19) + 2^-85 |a|^2.
+    // 2. D^2 |a|^2 = |p|^2 |a|^2 - (p.a)^2 (Lagrange). pp and len2 are within 3.01u of |p|^2 and |a|^2 (sums of
+    //    squares), w^2 <= ww (1 + 1.01u), |dot - p.a| <= 3.01u |p| |a| (Cauchy-Schwarz), squared with the identity
+    //    of step 1: step 1's condition holds when pp len2 (1 - 2^-49) >= dot^2 (1 + 2^-20) + len2 (ww (1 + 2^-17) +
+    //    2^-84 len2).
+    // 3. With len2 <= 2^60 ww the last term is at most 2^-24 len2 ww; divided by 1 + 2^-20: it holds when
+    //    pp len2 (1 - 2^-19) >= dot^2 + len2 ww (1 + 2^-16).
+    // 4. The test is step 3's with both margins doubled; its five roundings (terms >= 0) move its sides by under 4u.
+    // Ranges: len2 in [2^-300, 2^60 ww], ww in [2^-300, 2^300], pp <= 2^300: no product overflows, and one that
+    // passes has pp len2 >= 2^-600, so pp >= 2^-960: the absolute errors of underflow (< 2^-1074) vanish against the
+    // margins. A NaN fails a comparison. (LodLevel0.HullCertificateEqualsTheHull tests it near the boundary.)
+    static auto hull_certified(L px, L py, L pz, L dot, L len2, L w) {
+        const L pp = (px * px + py * py) + pz * pz, ww = w * w;
+        const L lhs = (pp * len2) * L::splat(1.0 - 0x1p-17);
+        const L rhs = dot * dot + (len2 * ww) * L::splat(1.0 + 0x1p-15);
+        const auto ranges = ((L::splat(0x1p-300) <= len2) & (len2 <= ww * L::splat(0x1p60))) &
+                            (((L::splat(0x1p-300) <= ww) & (ww <= L::splat(0x1p300))) & (pp <= L::splat(0x1p300)));
+        return (rhs <= lhs) & ranges;
     }
 };
 

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -708,6 +709,85 @@ bool family_curve(int i, Rng& rng, Curve& curve) {
                        SplineSettings{.closed = closed, .radius_m = static_cast<float>(uniform(rng, 0.001, 0.05))},
                        curve)
         .ok;
+}
+
+// Level 0's deviation of one segment as span_level0() computed it before its hull certificate: min(hull, 3M/4),
+// the hull's distance by one reciprocal of the chord's squared length, infinity where not finite.
+double level0_deviation(const CubicBezier& c) {
+    const glm::dvec3 m0 = (c.b0 - 2.0 * c.b1) + c.b2, m1 = (c.b1 - 2.0 * c.b2) + c.b3;
+    const double wang = std::sqrt(std::max((m0.x * m0.x + m0.y * m0.y) + m0.z * m0.z, (m1.x * m1.x + m1.y * m1.y) + m1.z * m1.z));
+    const glm::dvec3 ab = c.b3 - c.b0, p1 = c.b1 - c.b0, p2 = c.b2 - c.b0;
+    const double len2 = (ab.x * ab.x + ab.y * ab.y) + ab.z * ab.z;
+    const double inv = 0.0 < len2 ? 1.0 / len2 : 0.0;
+    const double t1 = std::min(std::max(((p1.x * ab.x + p1.y * ab.y) + p1.z * ab.z) * inv, 0.0), 1.0);
+    const double t2 = std::min(std::max(((p2.x * ab.x + p2.y * ab.y) + p2.z * ab.z) * inv, 0.0), 1.0);
+    const glm::dvec3 v1(p1.x - t1 * ab.x, p1.y - t1 * ab.y, p1.z - t1 * ab.z);
+    const glm::dvec3 v2(p2.x - t2 * ab.x, p2.y - t2 * ab.y, p2.z - t2 * ab.z);
+    const double hull = std::sqrt(std::max((v1.x * v1.x + v1.y * v1.y) + v1.z * v1.z, (v2.x * v2.x + v2.y * v2.y) + v2.z * v2.z));
+    const double d = std::min(hull, 0.75 * wang);
+    return std::abs(d) <= std::numeric_limits<double>::max() ? d : std::numeric_limits<double>::infinity();
+}
+
+// span_level0() skips the hull where a certificate shows it exceeds 3M/4 (hull_certified(), proof at it): its
+// deviations stay those of the full formula, bit for bit. Curves of 64 segments whose segments all pass it but one
+// probe, so that the probe alone decides its lane group's branch at every lane width: sagging segments (b1, b2 at
+// heights 1 and rho across a unit chord: hull 1, 3M/4 = 1 - 3 delta / 4 for rho = 2/3 + delta) with the probe's
+// |delta| from 1e-16 to 1e-4 of either sign (hull a hair above or below 3M/4), sags from 1e-12 to 1 of the chord (the
+// rounding of nearly straight segments), scales from 1e-6 to 1e6 m, rotated, 1e4 m from the origin at most; plus
+// generic random segments (tiny, huge, degenerate, NaN).
+TEST(LodLevel0, HullCertificateEqualsTheHull) {
+    Rng rng(53);
+    auto bits = [](double x) { return std::bit_cast<uint64_t>(x); };
+    auto sag_segment = [&](double delta, double sag, double scale, const glm::dmat3& rot, const glm::dvec3& at) {
+        const double s1 = 1.0 / 3.0 + uniform(rng, -0.02, 0.02), s2 = 2.0 / 3.0 + uniform(rng, -0.02, 0.02);
+        const glm::dvec3 q[4] = {{0, 0, 0}, {s1, sag, 0}, {s2, sag * (2.0 / 3.0 + delta), 0}, {1, 0, 0}};
+        CubicBezier c;
+        glm::dvec3* b[4] = {&c.b0, &c.b1, &c.b2, &c.b3};
+        for (int k = 0; k < 4; ++k) *b[k] = at + rot * (scale * q[k]);
+        return c;
+    };
+    std::size_t checked = 0, probes_above = 0;
+    for (int i = 0; i < 600; ++i) {
+        Curve curve;
+        curve.segments.resize(64);
+        const double scale = std::pow(10.0, uniform(rng, -6.0, 6.0));
+        // every third nearly straight at the origin: |p.a| close to |p| |a|, where the certificate's own rounding
+        // matters most
+        const double sag = std::pow(10.0, i % 3 == 0 ? uniform(rng, -9.0, -6.0) : uniform(rng, -12.0, 0.0));
+        const glm::dvec3 e0 = random_unit(rng), e1 = glm::normalize(glm::cross(e0, random_unit(rng)));
+        const glm::dmat3 rot(e0, e1, glm::cross(e0, e1));  // a random rotation
+        const glm::dvec3 at = i % 3 == 0 ? glm::dvec3(0.0) : random_unit(rng) * std::pow(10.0, uniform(rng, -2.0, 4.0));
+        const std::size_t probe = static_cast<std::size_t>(uniform(rng, 0.0, 64.0)) % 64;
+        for (std::size_t k = 0; k < 64; ++k) {
+            const double delta = k == probe ? (i % 2 == 0 ? 1.0 : -1.0) * std::pow(10.0, uniform(rng, i % 4 < 2 ? -17.0 : -14.0, i % 4 < 2 ? -14.0 : -4.0))
+                                            : uniform(rng, 0.05, 0.3);
+            curve.segments[k] = sag_segment(delta, sag, scale, rot, at + glm::dvec3(scale * static_cast<double>(k), 0, 0));
+        }
+        if (i % 2 == 0) ++probes_above;
+        LodBounds b;
+        compute_lod_bounds(curve, b);
+        for (std::size_t k = 0; k < 64; ++k, ++checked)
+            ASSERT_EQ(bits(b.node(0, k).deviation_m), bits(level0_deviation(curve.segments[k])))
+                << "curve " << i << " segment " << k << (k == probe ? " (the probe)" : "");
+    }
+    for (int i = 0; i < 400; ++i) {
+        Curve curve;
+        curve.segments.resize(1 + static_cast<std::size_t>(i % 40));
+        const double scale = std::pow(10.0, uniform(rng, -160.0, 160.0));
+        for (CubicBezier& c : curve.segments) {
+            for (glm::dvec3* p : {&c.b0, &c.b1, &c.b2, &c.b3}) *p = random_unit(rng) * (scale * uniform(rng, 0.0, 2.0));
+            if (i % 7 == 1) c.b3 = c.b0;                                           // no chord
+            if (i % 7 == 2) c.b1 = c.b0 + (c.b1 - c.b0) * 1e-200;                  // b1 on b0
+            if (i % 7 == 3) c.b2.y = std::numeric_limits<double>::quiet_NaN();  // NaN
+        }
+        LodBounds b;
+        compute_lod_bounds(curve, b);
+        for (std::size_t k = 0; k < curve.segments.size(); ++k, ++checked)
+            ASSERT_EQ(bits(b.node(0, k).deviation_m), bits(level0_deviation(curve.segments[k])))
+                << "generic curve " << i << " segment " << k;
+    }
+    std::printf("%zu level-0 deviations equal the full formula (%zu probes with the hull above 3M/4)\n", checked,
+                probes_above);
 }
 
 // The cheap pass (per-wire bound, then per-segment work only where needed) leaves exactly the state of the
