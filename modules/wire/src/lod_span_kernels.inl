@@ -58,9 +58,8 @@ struct Level0 {
         // d = min(hull, w) is w wherever hull >= w, which hull_certified() shows without the hull for the lanes
         // where b1 alone is provably far enough from the chord: on a hanging cable 9 groups of 10, which skip the
         // hull's division, root and ~40 operations (the kernel is bound by its arithmetic).
-        L d;
         if (hull_certified(p1x, p1y, p1z, dot1, len2, w).bits() == (1u << L::width) - 1) {
-            d = w;
+            deviation = w;  // finite: w w <= 2^300 (hull_certified)
         } else {
             const L inv = select(zero < len2, one / len2, zero);
             const L dot2 = (p2x * abx + p2y * aby) + p2z * abz;
@@ -69,11 +68,11 @@ struct Level0 {
             const L v1x = p1x - t1 * abx, v1y = p1y - t1 * aby, v1z = p1z - t1 * abz;
             const L v2x = p2x - t2 * abx, v2y = p2y - t2 * aby, v2z = p2z - t2 * abz;
             const L hull = sqrt_of(max_of((v1x * v1x + v1y * v1y) + v1z * v1z, (v2x * v2x + v2y * v2y) + v2z * v2z));
-            d = min_of(hull, w);
+            const L d = min_of(hull, w);
+            // Not finite (NaN too): infinity.
+            deviation = select(abs_of(d) <= L::splat(std::numeric_limits<double>::max()), d,
+                               L::splat(std::numeric_limits<double>::infinity()));
         }
-        // Not finite (NaN too): infinity.
-        deviation = select(abs_of(d) <= L::splat(std::numeric_limits<double>::max()), d,
-                           L::splat(std::numeric_limits<double>::infinity()));
         for (int k = 0; k < 3; ++k) c[k] = half * (lo[k] + hi[k]);
         const L sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
         r = half * sqrt_of((sx * sx + sy * sy) + sz * sz) * L::splat(1.0 + 1e-12);
