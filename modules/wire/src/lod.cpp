@@ -884,12 +884,13 @@ struct Limits {
 };
 
 // Every segment's hull depth, off-axis factor and plane mask, into scratch(): z_min, k, outside.
-void hull_depths(const Curve& curve, const LodView& view, double radius_m) {
+// with_planes = false: the depths only (scratch().outside is left as it is).
+void hull_depths(const Curve& curve, const LodView& view, double radius_m, bool with_planes = true) {
     const std::size_t n = curve.segment_count();
     Scratch& sc = scratch();
     sc.z_min.resize(n);
     sc.k.resize(n);
-    sc.outside.resize(n);
+    if (with_planes) sc.outside.resize(n);
     const ViewTransform tf(view);
     const PlaneTest planes(view, radius_m);
     HullConstants h{};
@@ -903,7 +904,8 @@ void hull_depths(const Curve& curve, const LodView& view, double radius_m) {
     h.neg_rx = -planes.rx;
     h.neg_ry = -planes.ry;
     h.neg_r = -planes.r;
-    span_kernels().hull_depths(curve.segments.data(), n, h, sc.z_min.data(), sc.k.data(), sc.outside.data());
+    span_kernels().hull_depths(curve.segments.data(), n, h, sc.z_min.data(), sc.k.data(),
+                               with_planes ? sc.outside.data() : nullptr);
 }
 
 // Per-segment pass: required Wang counts (and visibility, depth) of every segment from the hull depths and the
@@ -1172,7 +1174,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
                 wire_k = sb.k;
                 conservative_sides = true;
             } else {
-                hull_depths(curve, view, radius);  // the exact side count needs the segments' depths
+                hull_depths(curve, view, radius, false);  // the exact side count needs the segments' depths
                 const Scratch& d = scratch();
                 for (std::size_t i = 0; i < n; ++i) {
                     wire_z = std::min(wire_z, d.z_min[i]);

@@ -329,10 +329,11 @@ inline uint64_t spread_bits(unsigned m) {
 
 // Every segment's hull depth (nearest control point depth, clamped to near), off-axis factor k and plane mask
 // (bit i: all four control points farther than the radius outside plane i): hull_depth() and PlaneTest::outside()
-// W::width segments at a time, the same arithmetic per lane (world -> view as ViewTransform computes it).
+// W::width segments at a time, the same arithmetic per lane (world -> view as ViewTransform computes it). Without
+// the plane masks where `outside` is null (a caller that reads only the depths).
 inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullConstants& h, double* z_min,
                               double* k_out, unsigned char* outside) {
-    auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
+    auto group = [&]<bool Planes, class L>(std::size_t i, L) __attribute__((always_inline)) {
         L x[4], y[4], z[4];
         L::points(&seg[i].b0.x, x, y, z);
         const L near = L::splat(h.near), far = L::splat(h.far), tx = L::splat(h.tx), ty = L::splat(h.ty);
@@ -350,22 +351,30 @@ inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullC
             zm = min_of(zm, qz);
             a = max_of(a, abs_of(qx) / den);
             b = max_of(b, abs_of(qy) / den);
-            const decltype(zm < zm) o[6] = {qx + qz * tx < neg_rx, qz * tx - qx < neg_rx, qy + qz * ty < neg_ry,
-                                            qz * ty - qy < neg_ry, qz - near < neg_r,    far - qz < neg_r};
-            for (int p = 0; p < 6; ++p) out[p] = c == 0 ? o[p] : out[p] & o[p];
+            if constexpr (Planes) {
+                const decltype(zm < zm) o[6] = {qx + qz * tx < neg_rx, qz * tx - qx < neg_rx, qy + qz * ty < neg_ry,
+                                                qz * ty - qy < neg_ry, qz - near < neg_r,    far - qz < neg_r};
+                for (int p = 0; p < 6; ++p) out[p] = c == 0 ? o[p] : out[p] & o[p];
+            }
         }
         const auto in_front = near <= zm;
         a = select(in_front, min_of(a, tx), tx);
         b = select(in_front, min_of(b, ty), ty);
         max_of(zm, near).store(z_min + i);
         sqrt_of((L::splat(1.0) + a * a) + b * b).store(k_out + i);
-        // Transpose the six planes' lane masks into one byte per lane: byte k of `bytes` holds lane k's planes.
-        uint64_t bytes = 0;
-        for (int p = 0; p < 6; ++p) bytes |= spread_bits(out[p].bits()) << p;
-        for (std::size_t lane = 0; lane < L::width; ++lane)
-            outside[i + lane] = static_cast<unsigned char>(bytes >> (8 * lane));
+        if constexpr (Planes) {
+            // Transpose the six planes' lane masks into one byte per lane: byte k of `bytes` holds lane k's planes.
+            uint64_t bytes = 0;
+            for (int p = 0; p < 6; ++p) bytes |= spread_bits(out[p].bits()) << p;
+            for (std::size_t lane = 0; lane < L::width; ++lane)
+                outside[i + lane] = static_cast<unsigned char>(bytes >> (8 * lane));
+        }
     };
-    over_lanes(n, run);
+    if (outside != nullptr) {
+        over_lanes(n, [&]<class L>(std::size_t i, L) __attribute__((always_inline)) { group.template operator()<true>(i, L{}); });
+    } else {
+        over_lanes(n, [&]<class L>(std::size_t i, L) __attribute__((always_inline)) { group.template operator()<false>(i, L{}); });
+    }
 }
 
 // Per segment: the world tolerance at its hull depth, eps = scale z_min / k, and Wang's root sqrt(3 M / (4 eps))
