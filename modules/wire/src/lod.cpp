@@ -1163,7 +1163,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
             decided = true;
             whole = true;
         } else if (one_ring_per_segment(bounds, sb)) {
-            lod.required.assign(n, 1);
+            // One ring each, unless the spans below overwrite every entry (the zeroed walk: then not filled twice).
+            if (!(merge && merger.writes_every_segment())) lod.required.assign(n, 1);
             decided = true;
         }
         if (decided) {
