@@ -91,7 +91,8 @@ struct Level0 {
     //    2^-84 len2).
     // 3. With len2 <= 2^60 ww the last term is at most 2^-24 len2 ww; divided by 1 + 2^-20: it holds when
     //    pp len2 (1 - 2^-19) >= dot^2 + len2 ww (1 + 2^-16).
-    // 4. The test is step 3's with both margins doubled; its five roundings (terms >= 0) move its sides by under 4u.
+    // 4. The test below has margins 2^-17 (for 2^-19) and 2^-15 (for 2^-16); its six roundings (all terms >= 0)
+    //    move its left side by at most 2.01u and its right side by at most 3.01u relative, far inside the gaps.
     // Ranges: len2 in [2^-300, 2^60 ww], ww in [2^-300, 2^300], pp <= 2^300: no product overflows, and one that
     // passes has pp len2 >= 2^-600, so pp >= 2^-960: the absolute errors of underflow (< 2^-1074) vanish against the
     // margins. A NaN fails a comparison. (LodLevel0.HullCertificateEqualsTheHull tests it near the boundary.)
