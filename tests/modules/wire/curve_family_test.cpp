@@ -5,6 +5,7 @@
 
 #include "wire/bezier.hpp"
 #include "wire/curve.hpp"
+#include "wire/detail/segment_soa.hpp"
 #include "wire/families.hpp"
 #include "wire/spline.hpp"
 
@@ -242,4 +243,57 @@ TEST(WireCurveFamilies, PairBuildsEqualSingleBuildsBitForBit) {
     }
     EXPECT_GT(interleaved, 100);  // the interleaved solve did run
     std::printf("\n%d pairs, %d of them two valid open same-size c2/automatic wires\n", pairs, interleaved);
+}
+
+TEST(WireCurveFamilies, RecordKernelEqualsThePortableLoopBitForBit) {
+    // build_curve writes the Bezier records of c2 / automatic curves with a hand-written AVX-512 kernel where the
+    // CPU has one (8 segments a step, the last step overlapping the one before); it must give the portable loop's
+    // records and range test exactly: every family's nodes with random node tangents (some huge, some NaN: the
+    // test fails there), every segment count 1 .. n - 1, the end nodes apart (a closed wire's last segment).
+    // On a CPU without AVX-512 both calls run the loop and the test compares it with itself.
+    std::vector<Case> all = catenaries(kSeed, 60);
+    for (auto* more : {&zigzags, &helices, &wrapped}) {
+        std::vector<Case> f = (*more)(kSeed, 30);
+        all.insert(all.end(), f.begin(), f.end());
+    }
+    uint64_t state = 4242;
+    auto next = [&state] { state = state * 6364136223846793005ull + 1442695040888963407ull; return static_cast<double>(state >> 11) * 0x1.0p-53; };
+    constexpr double kOffsetLimit = 8e12;
+    int compared = 0, failed_tests = 0;
+    for (const Case& c : all) {
+        const std::vector<glm::dvec3>& P = c.nodes.positions;
+        const std::size_t n = P.size();
+        std::vector<double> D[3], len(n);
+        for (std::vector<double>& d : D) {
+            d.resize(n + 1);
+            for (double& v : d) v = 4.0 * (next() - 0.5);
+        }
+        for (std::size_t k = 0; k + 1 < n; ++k) len[k] = glm::length(P[k + 1] - P[k]);
+        len[n - 1] = glm::length(P[0] - P[n - 1]);
+        if (next() < 0.3) D[static_cast<int>(3 * next())][static_cast<std::size_t>(next() * n)] = 1e14 * (next() - 0.5);
+        if (next() < 0.2) D[static_cast<int>(3 * next())][static_cast<std::size_t>(next() * n)] = std::nan("");
+        for (std::size_t count = 1; count < n; ++count) {
+            // Every segment from k0 on (the last ones: both kernels' remainders), and one closing segment.
+            const std::size_t k0 = n - 1 - count;
+            std::vector<double> wide(12 * count, 7.0), loop(12 * count, -7.0);  // every value must be written
+            const auto run = [&](std::vector<double>& out, bool widest, const glm::dvec3* p1) {
+                return detail::node_segment_records(count, &P[k0].x, &p1->x, D[0].data() + k0, D[1].data() + k0,
+                                                    D[2].data() + k0, len.data() + k0, out.data(), kOffsetLimit, widest);
+            };
+            EXPECT_EQ(run(wide, true, &P[k0 + 1]), run(loop, false, &P[k0 + 1])) << c.label << " count " << count;
+            EXPECT_EQ(std::memcmp(wide.data(), loop.data(), wide.size() * sizeof(double)), 0) << c.label << " count " << count;
+            failed_tests += !run(loop, false, &P[k0 + 1]);
+            ++compared;
+        }
+        std::vector<double> wide(12, 7.0), loop(12, -7.0);
+        const bool w = detail::node_segment_records(1, &P[n - 1].x, &P[0].x, D[0].data() + n - 1, D[1].data() + n - 1,
+                                                    D[2].data() + n - 1, len.data() + n - 1, wide.data(), kOffsetLimit);
+        const bool l = detail::node_segment_records(1, &P[n - 1].x, &P[0].x, D[0].data() + n - 1, D[1].data() + n - 1,
+                                                    D[2].data() + n - 1, len.data() + n - 1, loop.data(), kOffsetLimit, false);
+        EXPECT_EQ(w, l) << c.label;
+        EXPECT_EQ(std::memcmp(wide.data(), loop.data(), sizeof(double) * 12), 0) << c.label;
+    }
+    EXPECT_GT(failed_tests, 100);  // the range test's failing side was compared too
+    EXPECT_GT(compared - failed_tests, 1000);
+    std::printf("\n%d record runs compared, %d of them out of range\n", compared, failed_tests);
 }

@@ -47,4 +47,13 @@ void gather_segments(const CubicBezier* segments, const uint32_t* index, std::si
 /// (the caller takes unit_tangent()'s one-sided limits there). In frames.cpp.
 void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty, double* tz, double* ok);
 
+/// Bezier records (12 doubles each, segment k's at out + 12k) of `count` segments from their start and end nodes
+/// (3 doubles each, at p0 + 3k and p1 + 3k), node tangents per unit chord (Dx, Dy, Dz: the start node's at k, the
+/// end node's at k + 1) and chord lengths len[k]: b1 = b0 + u0, b2 = b3 - u1 with u0 = (D[k] len[k]) / 3 and
+/// u1 = (D[k + 1] len[k]) / 3. Returns whether every offset u is within +-offset_limit (false for NaN).
+/// build_curve's record pass (spline.cpp): a hand-written AVX-512 version where the CPU has one and count >= 8;
+/// `widest` false: the portable loop, the same bits (tests compare the two).
+bool node_segment_records(std::size_t count, const double* p0, const double* p1, const double* Dx, const double* Dy,
+                          const double* Dz, const double* len, double* out, double offset_limit, bool widest = true);
+
 }  // namespace wire::detail
