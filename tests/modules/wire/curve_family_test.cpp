@@ -245,6 +245,69 @@ TEST(WireCurveFamilies, PairBuildsEqualSingleBuildsBitForBit) {
     std::printf("\n%d pairs, %d of them two valid open same-size c2/automatic wires\n", pairs, interleaved);
 }
 
+TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
+    // build_curves builds up to four wires, their tridiagonal solves side by side (four open c2 / automatic wires
+    // of one node count: the four-lane solve; else pairs of one size; else alone), and must give exactly
+    // build_curve's outputs and statuses: every family, each case grouped with moved copies of itself (same size)
+    // and with the next cases (mostly other sizes), open and closed, c2, automatic and catmull_rom, a wire-wide
+    // tension, an invalid wire in any slot, groups of 1 to 4.
+    std::vector<Case> all = catenaries(kSeed, 60);
+    for (auto* more : {&zigzags, &helices, &wrapped}) {
+        std::vector<Case> f = (*more)(kSeed, 30);
+        all.insert(all.end(), f.begin(), f.end());
+    }
+    uint64_t state = 999;
+    auto next = [&state] { state = state * 6364136223846793005ull + 1442695040888963407ull; return static_cast<double>(state >> 11) * 0x1.0p-53; };
+    SplineSettings tensioned{.kind = SplineKind::automatic};
+    tensioned.tension = 0.3;
+    SplineSettings closed_auto{.kind = SplineKind::automatic};
+    closed_auto.closed = true;
+    const SplineSettings settings[] = {kMethods[kAuto].settings, kMethods[2].settings, kMethods[kChordal].settings,
+                                       tensioned, closed_auto};
+    Curve grouped[4], single;  // reused across cases, as the systems reuse them
+    int groups = 0, four_lane = 0;
+    for (std::size_t ci = 0; ci < all.size(); ++ci) {
+        WireNodes moved[3];
+        for (WireNodes& m : moved) {
+            m = all[ci].nodes;
+            for (glm::dvec3& p : m.positions) p += 1e-3 * glm::dvec3(next() - 0.5, next() - 0.5, next() - 0.5);
+        }
+        WireNodes bad = moved[1];
+        bad.positions[bad.positions.size() / 2].y = std::nan("");
+        // Groups: the case and three moved copies; with the next cases; with an invalid wire in slot ci % 4.
+        const WireNodes* member[3][4] = {
+            {&all[ci].nodes, &moved[0], &moved[1], &moved[2]},
+            {&all[ci].nodes, &all[(ci + 1) % all.size()].nodes, &moved[0], &all[(ci + 2) % all.size()].nodes},
+            {&all[ci].nodes, &moved[0], &moved[1], &moved[2]}};
+        member[2][ci % 4] = &bad;
+        for (const auto& nodes : member) {
+            for (std::size_t si = 0; si < std::size(settings); ++si) {
+                const bool mixed = (ci + si) % 3 == 0;  // one group in three mixes the settings
+                const SplineSettings* set[4];
+                for (int k = 0; k < 4; ++k) set[k] = &settings[mixed ? (si + k) % std::size(settings) : si];
+                const std::size_t count = (ci + si) % 5 == 4 ? 1 + ci % 3 : 4;  // mostly 4
+                CurveBuildJob jobs[4];
+                for (std::size_t k = 0; k < count; ++k) jobs[k] = {nodes[k], set[k], &grouped[k], {}};
+                build_curves(std::span(jobs, count));
+                ++groups;
+                bool quad = count == 4;
+                for (std::size_t k = 0; k < count; ++k) {
+                    const Status alone = build_curve(*nodes[k], *set[k], single);
+                    quad = quad && alone.ok && !set[k]->closed && set[k]->kind != SplineKind::catmull_rom &&
+                           set[k]->kind == set[0]->kind && nodes[k]->size() == nodes[0]->size();
+                    EXPECT_EQ(jobs[k].status.ok, alone.ok) << all[ci].label << " slot " << k;
+                    EXPECT_EQ(jobs[k].status.message, alone.message) << all[ci].label << " slot " << k;
+                    EXPECT_EQ(jobs[k].status.node, alone.node) << all[ci].label << " slot " << k;
+                    EXPECT_TRUE(same_curve(grouped[k], single)) << all[ci].family << " #" << ci << " " << all[ci].label << " slot " << k;
+                }
+                four_lane += quad;
+            }
+        }
+    }
+    EXPECT_GT(four_lane, 100);  // the four-lane solve did run
+    std::printf("\n%d groups, %d of them four valid open same-size c2/automatic wires\n", groups, four_lane);
+}
+
 TEST(WireCurveFamilies, RecordKernelEqualsThePortableLoopBitForBit) {
     // build_curve writes the Bezier records of c2 / automatic curves with a hand-written AVX-512 kernel where the
     // CPU has one (8 segments a step, the last step overlapping the one before); it must give the portable loop's

@@ -47,6 +47,7 @@
 #include "wire/nodes.hpp"
 #include "wire/status.hpp"
 
+#include <span>
 #include <utility>
 
 namespace wire {
@@ -63,6 +64,19 @@ namespace wire {
 [[nodiscard]] std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0,
                                                          Curve& out0, const WireNodes& nodes1,
                                                          const SplineSettings& settings1, Curve& out1);
+
+/// One wire for build_curves(): its nodes and settings, the curve to write, and (after the call) its status.
+struct CurveBuildJob {
+    const WireNodes* nodes = nullptr;
+    const SplineSettings* settings = nullptr;
+    Curve* out = nullptr;
+    Status status;
+};
+
+/// build_curve for up to four wires into distinct curves: the same outputs and statuses, bit for bit, as a
+/// build_curve call for each. Faster where open c2 or automatic wires have the same number of curve nodes: the
+/// tridiagonal solves, a serial chain of divisions per wire, run side by side (four, else two, at once).
+void build_curves(std::span<CurveBuildJob> jobs);
 
 /// The thesis' curvature-driven tension for one node: R = theta*Iz*L / (A*dL^2); 0 if R > 100 (or dL = 0),
 /// else 1 - tanh(R/50). Non-finite or non-positive denominators give 0.

@@ -236,8 +236,8 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     // The view the LOD stage will see (unless the camera changes in between: the LOD stage then restores what
     // needs restoring). A released wire that moved and is still outside it stays released (below).
     const LodView cull_view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
-    // One wire's update in two steps around its build, so that two wires building their exact curves share
-    // build_curve_pair (their tridiagonal solves, a serial chain of divisions each, run side by side).
+    // One wire's update in two steps around its build, so that up to four wires building their exact curves share
+    // build_curves (their tridiagonal solves, a serial chain of divisions each, run side by side).
     struct Step {
         SplineSettings spline;           // the wire's settings now
         SplineSettings released_spline;  // what a released curve was built with
@@ -328,40 +328,37 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         }
         c.blending = job.status.ok && !c.multires_stale && c.multires.blending();
     };
-    parallel_over((jobs.size() + 1) / 2, [&](std::size_t pair) {
-        thread_local Curve scratch[2];
-        CurveJob* const job[2] = {&jobs[2 * pair], 2 * pair + 1 < jobs.size() ? &jobs[2 * pair + 1] : nullptr};
-        Step step[2];
-        // The next pair's components (read first thing there, out of the cache since the last frame): their
-        // lines come in while this pair builds. WireCurve's per-frame fields lie from lod_bounds.data (what the
+    parallel_over((jobs.size() + 3) / 4, [&](std::size_t group) {
+        thread_local Curve scratch[4];
+        const std::size_t first = 4 * group, count = std::min<std::size_t>(4, jobs.size() - first);
+        CurveJob* const job = &jobs[first];
+        Step step[4];
+        // The next group's components (read first thing there, out of the cache since the last frame): their
+        // lines come in while this group builds. WireCurve's per-frame fields lie from lod_bounds.data (what the
         // LOD stage reads of a moving wire) to the end of previous_nodes.
-        for (std::size_t k = 2 * pair + 2; k < std::min(2 * pair + 4, jobs.size()); ++k) {
+        for (std::size_t k = first + 4; k < std::min(first + 8, jobs.size()); ++k) {
             const char* const c = reinterpret_cast<const char*>(&jobs[k].curve->lod_bounds.data);
             prefetch_lines<true>(c, static_cast<std::size_t>(
                                         reinterpret_cast<const char*>(&jobs[k].curve->previous_nodes + 1) - c));
             prefetch_lines<false>(jobs[k].nodes, sizeof(WireNodes));
             prefetch_lines<false>(jobs[k].style, 1);
         }
-        for (int k = 0; k < 2; ++k) {
-            if (job[k] == nullptr) continue;
-            prepare(*job[k], step[k]);
+        CurveBuildJob builds[4];  // the exact curves, built together (their tridiagonal solves side by side)
+        std::size_t built[4], exact = 0;
+        for (std::size_t k = 0; k < count; ++k) {
+            prepare(job[k], step[k]);
+            if (!step[k].exact) continue;
             // The curve's records are written at the end of its build into this buffer, another wire's curve
             // before (swapped), out of the cache since the last frame: start fetching its lines now, while the
             // tangents are built, not one by one as the records are written (values unchanged).
             prefetch_lines<true>(scratch[k].segments.data(),
-                                 std::min(scratch[k].segments.capacity(), job[k]->nodes->size()) * sizeof(CubicBezier));
+                                 std::min(scratch[k].segments.capacity(), job[k].nodes->size()) * sizeof(CubicBezier));
+            builds[exact] = CurveBuildJob{job[k].nodes, &step[k].spline, &scratch[k], {}};
+            built[exact++] = k;
         }
-        if (job[1] != nullptr && step[0].exact && step[1].exact) {
-            std::tie(job[0]->status, job[1]->status) = build_curve_pair(
-                *job[0]->nodes, step[0].spline, scratch[0], *job[1]->nodes, step[1].spline, scratch[1]);
-        } else {
-            for (int k = 0; k < 2; ++k) {
-                if (job[k] != nullptr && step[k].exact) job[k]->status = build_curve(*job[k]->nodes, step[k].spline, scratch[k]);
-            }
-        }
-        for (int k = 0; k < 2; ++k) {
-            if (job[k] != nullptr) finish(*job[k], step[k], scratch[k]);
-        }
+        build_curves(std::span(builds, exact));
+        for (std::size_t e = 0; e < exact; ++e) job[built[e]].status = std::move(builds[e].status);
+        for (std::size_t k = 0; k < count; ++k) finish(job[k], step[k], scratch[k]);
     });
 
     // Serial, in entity order: errors (reported once per distinct message), work lists.
