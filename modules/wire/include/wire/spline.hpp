@@ -67,10 +67,10 @@ namespace wire {
 
 /// One wire for build_curves(): its nodes and settings, the curve to write, and (after the call) its status.
 struct CurveBuildJob {
-    const WireNodes* nodes = nullptr;
-    const SplineSettings* settings = nullptr;
-    Curve* out = nullptr;
-    Status status;
+    const WireNodes* nodes = nullptr;          ///< the wire's nodes
+    const SplineSettings* settings = nullptr;  ///< its settings
+    Curve* out = nullptr;                      ///< the curve to write (cleared on failure, as build_curve's)
+    Status status;                             ///< build_curve's status, set by the call
 };
 
 /// build_curve for up to four wires into distinct curves: the same outputs and statuses, bit for bit, as a
