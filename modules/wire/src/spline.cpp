@@ -1394,8 +1394,8 @@ Status end_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& 
 }
 
 // A thread's build memory: build_curve uses the first, build_curves (and build_curve_pair) one per wire (nothing
-// calls build_curve between a group's begin_curve and end_curve), so a thread keeps at most four builds' worth for
-// its largest wires.
+// calls build_curve between a group's begin_curve and end_curve), so a thread keeps at most two builds' worth for
+// its largest wires and two more for wires of up to 1,024 nodes (build_curves' kGroupNodes).
 CurveBuild& thread_build(std::size_t k) {
     thread_local CurveBuild b[4];
     return b[k];
@@ -1415,6 +1415,15 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
 void build_curves(std::span<CurveBuildJob> jobs) {
     assert(jobs.size() <= 4 && "build_curves: at most four wires");
     const std::size_t count = std::min<std::size_t>(jobs.size(), 4);
+    // Four builds in flight keep four builds' working memory per thread: only wires of up to kGroupNodes nodes
+    // take the third and fourth (a group with a larger wire is built as two pairs, in the first two builds).
+    constexpr std::size_t kGroupNodes = 1024;
+    const auto large = [](const CurveBuildJob& j) { return j.nodes->size() > kGroupNodes; };
+    if (count > 2 && std::any_of(jobs.begin(), jobs.begin() + count, large)) {
+        build_curves(jobs.first(2));
+        build_curves(jobs.subspan(2, count - 2));
+        return;
+    }
     CurveBuild* b[4] = {};
     for (std::size_t k = 0; k < count; ++k) {  // each build keeps its own memory until its end
         b[k] = &thread_build(k);

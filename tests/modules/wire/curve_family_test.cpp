@@ -304,6 +304,22 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
             }
         }
     }
+    // A group with a wire of more than 1,024 nodes is built as two pairs (the same results).
+    WireNodes big;
+    for (int i = 0; i < 1500; ++i) {
+        const double x = 0.01 * i;
+        big.positions.emplace_back(x, 0.5 * std::cosh(x - 7.5), 0.1 * std::sin(3.0 * x));
+    }
+    for (std::size_t slot = 0; slot < 4; ++slot) {
+        CurveBuildJob jobs[4];
+        for (std::size_t k = 0; k < 4; ++k) jobs[k] = {k == slot ? &big : &all[k].nodes, &settings[0], &grouped[k], {}};
+        build_curves(jobs);
+        for (std::size_t k = 0; k < 4; ++k) {
+            const Status alone = build_curve(*jobs[k].nodes, settings[0], single);
+            EXPECT_TRUE(alone.ok && jobs[k].status.ok) << "large wire in slot " << slot << ", slot " << k;
+            EXPECT_TRUE(same_curve(grouped[k], single)) << "large wire in slot " << slot << ", slot " << k;
+        }
+    }
     EXPECT_GT(four_lane, 100);  // the four-lane solve did run
     std::printf("\n%d groups, %d of them four valid open same-size c2/automatic wires\n", groups, four_lane);
 }
