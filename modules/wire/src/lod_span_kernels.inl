@@ -148,8 +148,12 @@ struct Merge {
 // the lanes together. Exact in any order: the values are never -0 (square roots of sums of squares, and sums of
 // those), so the one pair of equal values with two encodings cannot occur.
 struct Range {
-    W lo = W::splat(std::numeric_limits<double>::infinity()), hi = W::splat(0.0);
+    W lo, hi;
     double slo = std::numeric_limits<double>::infinity(), shi = 0.0;
+    // A constructor written here, not default member initializers: GCC compiles an implicit constructor outside
+    // the `#pragma GCC target` region this file is included in, so without optimization (nothing inlined) it took
+    // the wide lanes' values through the baseline ABI and left them garbage (Debug builds' LOD ranges).
+    Range() : lo(W::splat(std::numeric_limits<double>::infinity())), hi(W::splat(0.0)) {}
     void add(W v) {
         lo = min_of(lo, v);
         hi = max_of(hi, v);
