@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -190,6 +191,39 @@ bool same_curve(const Curve& a, const Curve& b) {
     return a.closed == b.closed && eq(a.segments, b.segments) && eq(a.source_node, b.source_node) &&
            eq(a.radius_m, b.radius_m) && eq(a.stretch, b.stretch);
 }
+
+// The cases the paired and grouped builds are compared on (every family), the settings they are built with (c2,
+// automatic, chordal, a wire-wide tension, closed), and copies of a case's nodes moved by up to 0.5 mm.
+std::vector<Case> grouping_cases() {
+    std::vector<Case> all = catenaries(kSeed, 60);
+    for (auto* more : {&zigzags, &helices, &wrapped}) {
+        std::vector<Case> f = (*more)(kSeed, 30);
+        all.insert(all.end(), f.begin(), f.end());
+    }
+    return all;
+}
+
+std::array<SplineSettings, 5> grouping_settings() {
+    SplineSettings tensioned{.kind = SplineKind::automatic};
+    tensioned.tension = 0.3;
+    SplineSettings closed_auto{.kind = SplineKind::automatic};
+    closed_auto.closed = true;
+    return {kMethods[kAuto].settings, kMethods[2].settings, kMethods[kChordal].settings, tensioned, closed_auto};
+}
+
+struct Lcg {
+    uint64_t state;
+    double operator()() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return static_cast<double>(state >> 11) * 0x1.0p-53;
+    }
+};
+
+WireNodes moved_copy(const WireNodes& nodes, Lcg& next) {
+    WireNodes moved = nodes;
+    for (glm::dvec3& p : moved.positions) p += 1e-3 * glm::dvec3(next() - 0.5, next() - 0.5, next() - 0.5);
+    return moved;
+}
 }  // namespace
 
 TEST(WireCurveFamilies, PairBuildsEqualSingleBuildsBitForBit) {
@@ -197,30 +231,19 @@ TEST(WireCurveFamilies, PairBuildsEqualSingleBuildsBitForBit) {
     // count) and must give exactly build_curve's outputs and statuses: every family, each case paired with a
     // moved copy of itself (same size: the interleaved solve) and with the next case (mostly another size),
     // open and closed, c2, automatic and catmull_rom, a wire-wide tension, and an invalid wire in either slot.
-    std::vector<Case> all = catenaries(kSeed, 60);
-    for (auto* more : {&zigzags, &helices, &wrapped}) {
-        std::vector<Case> f = (*more)(kSeed, 30);
-        all.insert(all.end(), f.begin(), f.end());
-    }
-    uint64_t state = 777;
-    auto next = [&state] { state = state * 6364136223846793005ull + 1442695040888963407ull; return static_cast<double>(state >> 11) * 0x1.0p-53; };
-    SplineSettings tensioned{.kind = SplineKind::automatic};
-    tensioned.tension = 0.3;
-    SplineSettings closed_auto{.kind = SplineKind::automatic};
-    closed_auto.closed = true;
-    const SplineSettings settings[] = {kMethods[kAuto].settings, kMethods[2].settings, kMethods[kChordal].settings,
-                                       tensioned, closed_auto};
+    const std::vector<Case> all = grouping_cases();
+    Lcg next{777};
+    const std::array<SplineSettings, 5> settings = grouping_settings();
     Curve p0, p1, s0, s1;  // reused across cases, as the systems reuse them
     int pairs = 0, interleaved = 0;
     for (std::size_t ci = 0; ci < all.size(); ++ci) {
-        WireNodes moved = all[ci].nodes;
-        for (glm::dvec3& p : moved.positions) p += 1e-3 * glm::dvec3(next() - 0.5, next() - 0.5, next() - 0.5);
+        const WireNodes moved = moved_copy(all[ci].nodes, next);
         WireNodes bad = moved;
         bad.positions[moved.positions.size() / 2].y = std::nan("");
         const WireNodes* partners[] = {&moved, &all[(ci + 1) % all.size()].nodes, &bad};
         for (const WireNodes* other : partners) {
             for (const SplineSettings& sa : settings) {
-                const SplineSettings& sb = settings[(&sa - settings + ci) % std::size(settings)];
+                const SplineSettings& sb = settings[(&sa - settings.data() + ci) % settings.size()];
                 for (int swap = 0; swap < 2; ++swap) {
                     const WireNodes& na = swap ? *other : all[ci].nodes;
                     const WireNodes& nb = swap ? all[ci].nodes : *other;
@@ -251,27 +274,14 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
     // build_curve's outputs and statuses: every family, each case grouped with moved copies of itself (same size)
     // and with the next cases (mostly other sizes), open and closed, c2, automatic and catmull_rom, a wire-wide
     // tension, an invalid wire in any slot, groups of 1 to 4.
-    std::vector<Case> all = catenaries(kSeed, 60);
-    for (auto* more : {&zigzags, &helices, &wrapped}) {
-        std::vector<Case> f = (*more)(kSeed, 30);
-        all.insert(all.end(), f.begin(), f.end());
-    }
-    uint64_t state = 999;
-    auto next = [&state] { state = state * 6364136223846793005ull + 1442695040888963407ull; return static_cast<double>(state >> 11) * 0x1.0p-53; };
-    SplineSettings tensioned{.kind = SplineKind::automatic};
-    tensioned.tension = 0.3;
-    SplineSettings closed_auto{.kind = SplineKind::automatic};
-    closed_auto.closed = true;
-    const SplineSettings settings[] = {kMethods[kAuto].settings, kMethods[2].settings, kMethods[kChordal].settings,
-                                       tensioned, closed_auto};
+    const std::vector<Case> all = grouping_cases();
+    Lcg next{999};
+    const std::array<SplineSettings, 5> settings = grouping_settings();
     Curve grouped[4], single;  // reused across cases, as the systems reuse them
     int groups = 0, four_lane = 0;
     for (std::size_t ci = 0; ci < all.size(); ++ci) {
         WireNodes moved[3];
-        for (WireNodes& m : moved) {
-            m = all[ci].nodes;
-            for (glm::dvec3& p : m.positions) p += 1e-3 * glm::dvec3(next() - 0.5, next() - 0.5, next() - 0.5);
-        }
+        for (WireNodes& m : moved) m = moved_copy(all[ci].nodes, next);
         WireNodes bad = moved[1];
         bad.positions[bad.positions.size() / 2].y = std::nan("");
         // Groups: the case and three moved copies; with the next cases; with an invalid wire in slot ci % 4.
