@@ -374,17 +374,29 @@ struct CarryChain {
     glm::dvec3 r0{};
     const double* blocks = nullptr;  // step_matrices()' output
     const double *px = nullptr, *py = nullptr, *pz = nullptr, *ptx = nullptr, *pty = nullptr, *ptz = nullptr;
+    // The segment and parameter a step from point q runs along: point_seg[q], point_ta[q]; without them (nullptr:
+    // the points are segment starts) segment first_segment + q at t = 0, the one point past them at t = 1 of the last.
     const uint32_t* point_seg = nullptr;
     const double* point_ta = nullptr;
     double *nx = nullptr, *ny = nullptr, *nz = nullptr;
     Transporter* transport = nullptr;
+    std::size_t first_segment = 0;
+    std::size_t start_count = 0;
 
+    [[nodiscard]] uint32_t segment_of(std::size_t q) const {
+        if (point_seg != nullptr) return point_seg[q];
+        return static_cast<uint32_t>(first_segment + std::min(q, start_count - 1));
+    }
+    [[nodiscard]] double t_of(std::size_t q) const {
+        if (point_ta != nullptr) return point_ta[q];
+        return q < start_count ? 0.0 : 1.0;
+    }
     /// The guarded step into point q (rare: out of line).
     [[gnu::noinline]] glm::dvec3 guarded(std::size_t q, glm::dvec3 r) const {
         const Sample a{{px[q - 1], py[q - 1], pz[q - 1]}, {ptx[q - 1], pty[q - 1], ptz[q - 1]}};
         const Sample b{{px[q], py[q], pz[q]}, {ptx[q], pty[q], ptz[q]}};
-        const double tb = point_seg[q] == point_seg[q - 1] ? point_ta[q] : 1.0;
-        return transport->step(point_seg[q - 1], point_ta[q - 1], a, glm::normalize(r), tb, b);
+        const double tb = segment_of(q) == segment_of(q - 1) ? t_of(q) : 1.0;
+        return transport->step(segment_of(q - 1), t_of(q - 1), a, glm::normalize(r), tb, b);
     }
     /// The step into point q from normal (x, y, z) at point q - 1: one matrix-vector product (the serial part).
     /// Three scalars, not a glm::dvec3 by reference: that one GCC keeps in memory, in the latency chain.
@@ -556,8 +568,10 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // (the steps past the last point, between copies of it, are computed and never read).
         const std::size_t mp = 1 + (m - 1 + 7) / 8 * 8;
         soa.resize(19 * mp + 4 * nb);
-        point_seg.resize(m);
-        point_ta.resize(m);
+        if (!starts) {  // segment starts: CarryChain knows their segments and parameters
+            point_seg.resize(m);
+            point_ta.resize(m);
+        }
         ring_point.resize(n);
         double* const px = soa.data();
         double* const py = px + mp;
@@ -602,10 +616,6 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
             const double* const tok = t + 3 * ss;
             const bool unfit = segment_start_points(b, b + ss, b + 2 * ss, t, t + ss, t + 2 * ss, tok, in.origin_m.x,
                                                     in.origin_m.y, in.origin_m.z, count, px, py, pz, ptx, pty, ptz);
-            for (std::size_t q = 0; q < count; ++q) {
-                point_seg[q] = static_cast<uint32_t>(s0 + q);
-                point_ta[q] = 0.0;
-            }
             // The rings over their starts (a ring's segment and t are its start's; the last ring may be at t = 1,
             // one point more).
             for (std::size_t i = 0; i < n; ++i) {
@@ -618,11 +628,7 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
                 ptz[q] = out[i].t.z;
                 ring_point[i] = static_cast<uint32_t>(q);
             }
-            if (m > count) {
-                point_seg[count] = in.params[n - 1].segment;
-                point_ta[count] = 1.0;
-            }
-            j = m;
+            j = m;  // their segments and parameters: CarryChain::segment_of(), t_of()
             // A boundary tangent whose flag is 0 takes unit_tangent()'s limits, a zero one the previous point's (the
             // test reads the tables, not the point arrays just written in lanes). Rare: segment_start_points tells.
             std::size_t next_ring = 0;  // the first ring whose point is not before q (ring_point increases)
@@ -670,8 +676,11 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         }
         step_matrices(px, py, pz, ptx, pty, ptz, mp, 1e-13 * max_abs(in.origin_m), blocks);
         // Pass 2: carry r, one matrix-vector product per step (the serial part); guarded steps through Transporter.
-        const CarryChain chain{m,   r0,  blocks, px, py, pz, ptx, pty, ptz, point_seg.data(), point_ta.data(),
-                               nx, ny, nz, &transport};
+        CarryChain chain{m, r0, blocks, px, py, pz, ptx, pty, ptz, nullptr, nullptr, nx, ny, nz, &transport, s0, count};
+        if (!starts) {
+            chain.point_seg = point_seg.data();
+            chain.point_ta = point_ta.data();
+        }
         carry_normal(chain);
         // Pass 3: the rings' normals and binormals (after the carry: a branch on whether a point is a ring, in the
         // carry loop, is mispredicted wherever LOD leaves segments without rings).
