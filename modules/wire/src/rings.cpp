@@ -389,6 +389,9 @@ struct SegmentTables {
     }
     bool uniform = false;     // uniform_radius(): only u_per_m is kept
     double uniform_r = 0.0;   // its radius
+    /// Whether length_m and u equal integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for every segment k bit for bit: not
+    /// for a uniform infinite radius (load()'s node slopes are then NaN: not a constant-radius segment).
+    [[nodiscard]] bool exact() const { return !uniform || std::isfinite(uniform_r); }
     /// The radius polynomials (load_radius()'s r0 .. r3) of segments index[0 .. count - 1] into r, 4 arrays of count.
     void radius_of(const uint32_t* index, std::size_t count, double* r) const {
         const std::size_t n = stride;
@@ -551,7 +554,11 @@ void build_rings(const Curve& curve, std::span<const RingParam> params, const Ri
                 }
             }
             if (!wrap && b.segment != p.segment && b.t > 0.0) {  // custom params: the next segment's part too
-                const Interval ib = integrate(SegmentCoeffs(curve, b.segment), 0.0, b.t);
+                // At t = 1 (an open wire's last ring, on a segment without a ring of its own): the whole segment,
+                // from the table.
+                const Interval ib = b.t == 1.0 && tables.exact()
+                                        ? Interval{whole_length_m[b.segment], whole_u[b.segment]}
+                                        : integrate(SegmentCoeffs(curve, b.segment), 0.0, b.t);
                 iv.length_m += ib.length_m;
                 iv.u += ib.u;
             }

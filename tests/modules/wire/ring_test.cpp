@@ -1,7 +1,9 @@
 // Rings: arc length, stretch-aware u (continuous, monotonic), radius interpolation, fold detection, big wires.
 #include "ring_test_curves.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <numbers>
 
 namespace wire::test {
 namespace {
@@ -247,6 +249,69 @@ TEST(Rings, FramesFromSegmentTablesEqualPointByPoint) {
         compared += params.size();
     }
     std::printf("frames from tables: %zu rings compared\n", compared);
+}
+
+/// integrate(SegmentCoeffs(c, k), 0.0, 1.0)'s arc length of one whole segment, the same operations: 3-point
+/// Gauss-Legendre of |B'| in the power basis.
+double whole_segment_length(const CubicBezier& b) {
+    constexpr double x[3] = {0.1127016653792583, 0.5, 0.8872983346207417};
+    constexpr double w[3] = {0.2777777777777778, 0.4444444444444444, 0.2777777777777778};
+    const glm::dvec3 p1 = 3.0 * (b.b1 - b.b0);
+    const glm::dvec3 p2 = 3.0 * (b.b2 - 2.0 * b.b1 + b.b0);
+    const glm::dvec3 p3 = b.b3 - 3.0 * b.b2 + 3.0 * b.b1 - b.b0;
+    const glm::dvec3 d1 = 2.0 * p2, d2 = 3.0 * p3;
+    double length = 0.0;
+    for (int q = 0; q < 3; ++q) {
+        const double t = 0.0 + 1.0 * x[q];
+        length += (1.0 * w[q]) * glm::length(p1 + t * (d1 + t * d2));
+    }
+    return length;
+}
+
+// An open wire's last ring sits at t = 1 of the last segment; when that segment has no ring of its own (LOD count 0)
+// the last interval ends with the whole segment, which build_rings takes from its per-segment table. Arc length
+// and u must equal the whole-segment quadrature summed in order, bit for bit (u = length / (2 pi R stretch) on a
+// wire of one radius): random open wires with degenerate segments, one radius or a radius per node, random stretch.
+TEST(Rings, LastRingOnASegmentWithoutRingsAddsTheWholeSegment) {
+    std::mt19937 rng(777);
+    std::size_t checked = 0, with_u = 0;
+    for (int w = 0; w < 400; ++w) {
+        const Curve c = random_ring_curve(rng);
+        if (c.closed || c.segment_count() < 2) continue;
+        std::vector<uint32_t> counts(c.segment_count());
+        for (uint32_t& n : counts) n = static_cast<uint32_t>(rng() % 2);
+        counts.back() = 0;
+        std::vector<RingParam> params;
+        place_rings(c, counts, params);
+        RingSet set;
+        build_rings(c, params, RingSettings{}, set);
+        const std::size_t n = params.size();
+        ASSERT_EQ(params[n - 1].t, 1.0);
+        const uint32_t a = params[n - 2].segment, last = params[n - 1].segment;
+        ASSERT_LT(a, last);
+        const bool one_radius = std::all_of(c.radius_m.begin(), c.radius_m.end(),
+                                            [&](float r) { return r == c.radius_m[0]; });
+        double length = 0.0, u = 0.0;
+        for (uint32_t k = a; k <= last; ++k) {
+            const double lk = whole_segment_length(c.segments[k]);
+            const double stretch = static_cast<double>(c.stretch[k]);
+            const double uk = lk * (1.0 / (2.0 * std::numbers::pi * stretch *
+                                           std::max(static_cast<double>(c.radius_m[0]), 1e-30)));
+            length = k == a ? lk : length + lk;
+            u = k == a ? uk : u + uk;
+        }
+        const double s_end = set.arc_length_m[n - 2] + length;
+        EXPECT_EQ(std::memcmp(&set.arc_length_m[n - 1], &s_end, sizeof(double)), 0) << "wire " << w;
+        if (one_radius) {
+            const double u_end = set.u[n - 2] + u;
+            EXPECT_EQ(std::memcmp(&set.u[n - 1], &u_end, sizeof(double)), 0) << "wire " << w;
+            ++with_u;
+        }
+        ++checked;
+    }
+    EXPECT_GT(checked, 200u);
+    EXPECT_GT(with_u, 100u);
+    std::printf("last intervals: %zu wires checked, %zu with u\n", checked, with_u);
 }
 
 TEST(Rings, ReusedSetDoesNotReallocate) {
