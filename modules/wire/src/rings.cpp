@@ -194,25 +194,28 @@ WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::siz
     }
 }
 
-/// SegmentCoeffs::load_radius()'s u_per_m for n segments of radius r_safe (> 0) whose stretch is given, positive
-/// and finite: 1 / (2 pi stretch r_safe), the same operations, in lanes.
-WIRE_VECTOR_CLONES void uniform_u_per_m(const float* __restrict stretch, std::size_t n, double r_safe,
-                                        double* __restrict u_per_m) {
-    for (std::size_t k = 0; k < n; ++k) {
-        u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * static_cast<double>(stretch[k]) * r_safe);
-    }
-}
-
-/// Whether v[1 .. n - 1] all equal v[0] (false where one of them is NaN), and whether v[0 .. n - 1] are all
-/// positive and finite; without an early exit, so in lanes.
-WIRE_VECTOR_CLONES void all_equal_and_plain(const float* __restrict v, std::size_t n, bool* equal, bool* plain) {
+/// SegmentCoeffs::load_radius()'s u_per_m for n segments of radius r_safe (> 0) from their stretch: 1 / (2 pi stretch
+/// r_safe), the same operations, in lanes. Returns whether every stretch is positive and finite (the common case);
+/// if not, the caller recomputes with load_radius()'s replacement for the others (one pass for test and values: the
+/// test was a pass and a call of its own).
+WIRE_VECTOR_CLONES bool plain_u_per_m(const float* __restrict stretch, std::size_t n, double r_safe,
+                                      double* __restrict u_per_m) {
     // Integer or-reductions vectorize, bool and-reductions do not. A float is positive and finite as a double
     // exactly when it is as a float.
-    unsigned differ = 0, bad = 0;
+    unsigned bad = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const float st = stretch[k];
+        bad |= ((st > 0.0f) & (st <= std::numeric_limits<float>::max())) ? 0u : 1u;
+        u_per_m[k] = 1.0 / (2.0 * std::numbers::pi * static_cast<double>(st) * r_safe);
+    }
+    return bad == 0;
+}
+
+/// Whether v[1 .. n - 1] all equal v[0] (false where one of them is NaN); without an early exit, so in lanes.
+WIRE_VECTOR_CLONES bool all_equal(const float* __restrict v, std::size_t n) {
+    unsigned differ = 0;  // an integer or-reduction vectorizes, a bool and-reduction does not
     for (std::size_t k = 1; k < n; ++k) differ |= v[k] == v[0] ? 0u : 1u;
-    for (std::size_t k = 0; k < n; ++k) bad |= ((v[k] > 0.0f) & (v[k] <= std::numeric_limits<float>::max())) ? 0u : 1u;
-    *equal = differ == 0;
-    *plain = bad == 0;
+    return differ == 0;
 }
 
 /// integrate(SegmentCoeffs(curve, k), 0.0, 1.0) for the n segments laid out by detail::transpose_segments(): the
@@ -292,12 +295,8 @@ WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL void ring_samples(
     }
 }
 
-/// One radius on every node (or none). (all_equal_and_plain's second answer is not needed here.)
-bool uniform_radius(const Curve& curve) {
-    bool equal = true, plain = true;
-    all_equal_and_plain(curve.radius_m.data(), curve.radius_m.size(), &equal, &plain);
-    return equal;
-}
+/// One radius on every node (or none).
+bool uniform_radius(const Curve& curve) { return all_equal(curve.radius_m.data(), curve.radius_m.size()); }
 
 /// n rounded up to whole vectors of 8 lanes (AVX-512 doubles).
 std::size_t whole_vectors(std::size_t n) { return (n + 7) / 8 * 8; }
@@ -349,12 +348,9 @@ struct SegmentTables {
             uniform_r = curve.radius_m.empty() ? 1.0 : static_cast<double>(curve.radius_m[0]);
             const double r_safe = std::max(uniform_r, 1e-30);
             const std::size_t n_stretch = std::min(curve.stretch.size(), n);
-            bool plain = true, equal = true;  // every stretch given, positive and finite (the common case)
-            all_equal_and_plain(curve.stretch.data(), n_stretch, &equal, &plain);
-            plain &= n_stretch == n;
-            if (plain) {
-                uniform_u_per_m(curve.stretch.data(), n, r_safe, u_per_m);
-            } else {
+            // Every stretch given, positive and finite: the common case, in lanes.
+            const bool plain = plain_u_per_m(curve.stretch.data(), n_stretch, r_safe, u_per_m) && n_stretch == n;
+            if (!plain) {
                 for (std::size_t k = 0; k < n; ++k) {
                     double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;
                     stretch = (stretch > 0.0 && stretch <= std::numeric_limits<double>::max()) ? stretch : 1.0;

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <iterator>
+#include <limits>
 #include <numbers>
 
 namespace wire::test {
@@ -312,6 +314,42 @@ TEST(Rings, LastRingOnASegmentWithoutRingsAddsTheWholeSegment) {
     EXPECT_GT(checked, 200u);
     EXPECT_GT(with_u, 100u);
     std::printf("last intervals: %zu wires checked, %zu with u\n", checked, with_u);
+}
+
+// A stretch that is missing, zero, negative or not finite counts as 1 (SegmentCoeffs::load_radius): u must equal, bit
+// for bit, that of the same wire with 1 there. Random wires of one radius (where the per-segment texture scales are
+// computed in lanes and the whole set is redone when one stretch is not plain) and of a radius per node.
+TEST(Rings, InvalidStretchCountsAsOne) {
+    std::mt19937 rng(99);
+    const float bad[] = {0.0f, -0.0f, -1.5f, std::numeric_limits<float>::infinity(),
+                         std::numeric_limits<float>::quiet_NaN()};
+    std::size_t compared = 0;
+    for (int w = 0; w < 200; ++w) {
+        Curve c = random_ring_curve(rng);
+        Curve fixed = c;
+        if (w % 4 == 3) {  // missing entries
+            const std::size_t keep = rng() % c.stretch.size();
+            c.stretch.resize(keep);
+            for (std::size_t k = keep; k < fixed.stretch.size(); ++k) fixed.stretch[k] = 1.0f;
+        } else {
+            for (std::size_t k = 0; k < c.stretch.size(); ++k) {
+                if (rng() % 3 != 0) continue;
+                c.stretch[k] = bad[rng() % std::size(bad)];
+                fixed.stretch[k] = 1.0f;
+            }
+        }
+        std::vector<uint32_t> counts(c.segment_count());
+        for (uint32_t& n : counts) n = static_cast<uint32_t>(rng() % 3);
+        std::vector<RingParam> params;
+        place_rings(c, counts, params);
+        RingSet a, b;
+        build_rings(c, params, RingSettings{}, a);
+        build_rings(fixed, params, RingSettings{}, b);
+        ASSERT_EQ(a.u.size(), b.u.size());
+        EXPECT_EQ(std::memcmp(a.u.data(), b.u.data(), a.u.size() * sizeof(double)), 0) << "wire " << w;
+        compared += a.u.size();
+    }
+    std::printf("invalid stretch: %zu u values compared\n", compared);
 }
 
 TEST(Rings, ReusedSetDoesNotReallocate) {
