@@ -251,32 +251,7 @@ namespace detail {
 
 WIRE_VECTOR_CLONES void boundary_tangents(const double* __restrict b, std::size_t n, double* __restrict tx,
                                           double* __restrict ty, double* __restrict tz, double* __restrict ok) {
-    const double* b0x = b;
-    const double* b0y = b + n;
-    const double* b0z = b + 2 * n;
-    const double* b1x = b + 3 * n;
-    const double* b1y = b + 4 * n;
-    const double* b1z = b + 5 * n;
-    const double* b2x = b + 6 * n;
-    const double* b2y = b + 7 * n;
-    const double* b2z = b + 8 * n;
-    const double* b3x = b + 9 * n;
-    const double* b3y = b + 10 * n;
-    const double* b3z = b + 11 * n;
-    for (std::size_t k = 0; k < n; ++k) {
-        const double dx = 3.0 * (b1x[k] - b0x[k]), dy = 3.0 * (b1y[k] - b0y[k]), dz = 3.0 * (b1z[k] - b0z[k]);
-        const double speed = std::sqrt(dx * dx + dy * dy + dz * dz);
-        const double extent =
-            max3(max3(std::abs(b1x[k] - b0x[k]), std::abs(b1y[k] - b0y[k]), std::abs(b1z[k] - b0z[k])),
-                 max3(std::abs(b2x[k] - b0x[k]), std::abs(b2y[k] - b0y[k]), std::abs(b2z[k] - b0z[k])),
-                 max3(std::abs(b3x[k] - b0x[k]), std::abs(b3y[k] - b0y[k]), std::abs(b3z[k] - b0z[k])));
-        const double inv = 1.0 / speed;
-        tx[k] = dx * inv;
-        ty[k] = dy * inv;
-        tz[k] = dz * inv;
-        const double tiny = 1e-10 * extent + 1e-15 * max3(std::abs(b0x[k]), std::abs(b0y[k]), std::abs(b0z[k])) + 1e-300;
-        ok[k] = speed > tiny ? 1.0 : 0.0;
-    }
+    for (std::size_t k = 0; k < n; ++k) boundary_tangent(b, n, k, tx, ty, tz, ok);
 }
 
 namespace {

@@ -194,6 +194,22 @@ WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::siz
     }
 }
 
+/// gauss_whole_lengths() and detail::boundary_tangents() in one pass over the segments (a wire of one radius whose
+/// intervals cross segment boundaries: the common moving wire): the same operations.
+WIRE_VECTOR_CLONES void gauss_whole_lengths_and_tangents(const double* __restrict b, std::size_t n,
+                                                         const double* __restrict u_per_m, double* __restrict length_m,
+                                                         double* __restrict u, double* __restrict tangent) {
+    for (std::size_t k = 0; k < n; ++k) {
+        double speed[kGlPoints];
+        whole_segment_speeds(b, n, k, speed);
+        double len = 0.0;
+        for (int q = 0; q < kGlPoints; ++q) len += (1.0 * kGlW[q]) * speed[q];
+        length_m[k] = len;
+        u[k] = len * u_per_m[k];
+        detail::boundary_tangent(b, n, k, tangent, tangent + n, tangent + 2 * n, tangent + 3 * n);
+    }
+}
+
 /// SegmentCoeffs::load_radius()'s u_per_m for n segments of radius r_safe (> 0) from their stretch: 1 / (2 pi stretch
 /// r_safe), the same operations, in lanes. Returns whether every stretch is positive and finite (the common case);
 /// if not, the caller recomputes with load_radius()'s replacement for the others (one pass for test and values: the
@@ -373,6 +389,10 @@ struct SegmentTables {
             }
         }
         pad(radius.data(), 7, n, sn);
+        if (uniform && with_tangents) {
+            gauss_whole_lengths_and_tangents(soa.data(), sn, u_per_m, length_m.data(), u.data(), tangent.data());
+            return;
+        }
         if (uniform) {
             gauss_whole_lengths(soa.data(), sn, u_per_m, length_m.data(), u.data());
         } else {

@@ -4,6 +4,8 @@
 
 #include "wire/curve.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -55,5 +57,30 @@ void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty,
 /// `widest` false: the portable loop, the same bits (tests compare the two).
 bool node_segment_records(std::size_t count, const double* p0, const double* p1, const double* Dx, const double* Dy,
                           const double* Dz, const double* len, double* out, double offset_limit, bool widest = true);
+
+/// boundary_tangents()' work for segment k (of n laid out by transpose_segments()). Always inlined: GCC inlines
+/// nothing else into a kernel compiled for another instruction set (WIRE_VECTOR_CLONES), and build_rings' Gauss
+/// lengths kernel does this in the same pass over the segments.
+[[gnu::always_inline]] inline void boundary_tangent(const double* __restrict b, std::size_t n, std::size_t k,
+                                                    double* __restrict tx, double* __restrict ty,
+                                                    double* __restrict tz, double* __restrict ok) {
+    // The largest of three magnitudes (no NaN; equal values are equal), without a branch.
+    const auto max3 = [](double p, double q, double r) { return std::max(std::max(p, q), r); };
+    const double b0x = b[k], b0y = b[n + k], b0z = b[2 * n + k];
+    const double b1x = b[3 * n + k], b1y = b[4 * n + k], b1z = b[5 * n + k];
+    const double b2x = b[6 * n + k], b2y = b[7 * n + k], b2z = b[8 * n + k];
+    const double b3x = b[9 * n + k], b3y = b[10 * n + k], b3z = b[11 * n + k];
+    const double dx = 3.0 * (b1x - b0x), dy = 3.0 * (b1y - b0y), dz = 3.0 * (b1z - b0z);
+    const double speed = std::sqrt(dx * dx + dy * dy + dz * dz);
+    const double extent = max3(max3(std::fabs(b1x - b0x), std::fabs(b1y - b0y), std::fabs(b1z - b0z)),
+                               max3(std::fabs(b2x - b0x), std::fabs(b2y - b0y), std::fabs(b2z - b0z)),
+                               max3(std::fabs(b3x - b0x), std::fabs(b3y - b0y), std::fabs(b3z - b0z)));
+    const double inv = 1.0 / speed;
+    tx[k] = dx * inv;
+    ty[k] = dy * inv;
+    tz[k] = dz * inv;
+    const double tiny = 1e-10 * extent + 1e-15 * max3(std::fabs(b0x), std::fabs(b0y), std::fabs(b0z)) + 1e-300;
+    ok[k] = speed > tiny ? 1.0 : 0.0;
+}
 
 }  // namespace wire::detail
