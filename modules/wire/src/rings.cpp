@@ -388,7 +388,12 @@ struct SegmentTables {
                 r3[k] = c.r3;
             }
         }
-        pad(radius.data(), 7, n, sn);
+        // Padded for the kernels below: of one radius, only u_per_m is written and read.
+        if (uniform) {
+            pad(u_per_m, 1, n, sn);
+        } else {
+            pad(radius.data(), 7, n, sn);
+        }
         if (uniform && with_tangents) {
             gauss_whole_lengths_and_tangents(soa.data(), sn, u_per_m, length_m.data(), u.data(), tangent.data());
             return;
