@@ -334,6 +334,7 @@ inline L1 abs_of(L1 a) { return {std::abs(a.v)}; }
 inline L1 min_of(L1 x, L1 y) { return {min_of(x.v, y.v)}; }
 inline L1 max_of(L1 x, L1 y) { return {max_of(x.v, y.v)}; }
 inline L1 select(M1 m, L1 a, L1 b) { return {m.v ? a.v : b.v}; }
+inline L1 ceil_of(L1 a) { return {std::ceil(a.v)}; }
 
 #if defined(__SSE2__)
 struct L2 {
@@ -372,6 +373,14 @@ inline L2 abs_of(L2 a) { return {_mm_andnot_pd(_mm_set1_pd(-0.0), a.v)}; }
 inline L2 min_of(L2 x, L2 y) { return {_mm_min_pd(y.v, x.v)}; }  // y < x ? y : x
 inline L2 max_of(L2 x, L2 y) { return {_mm_max_pd(y.v, x.v)}; }  // y > x ? y : x, i.e. x < y ? y : x
 inline L2 select(M2 m, L2 a, L2 b) { return {_mm_or_pd(_mm_and_pd(m.v, a.v), _mm_andnot_pd(m.v, b.v))}; }
+// std::ceil for x >= 0 (and NaN), without SSE4.1's rounding: below 2^52, (x + 2^52) - 2^52 is x rounded to an
+// integer (both operations exact: the sum's spacing is 1), raised by 1 where that fell below x; from 2^52 on
+// (and for +inf) x is an integer already, and a NaN stays NaN (the last select).
+inline L2 ceil_of(L2 x) {
+    const L2 big = L2::splat(0x1p52);
+    const L2 t = (x + big) - big;
+    return select(x < big, select(t < x, t + L2::splat(1.0), t), x);
+}
 namespace span_sse2 {
 using W = L2;
 #include "lod_span_kernels.inl"
@@ -435,6 +444,7 @@ inline L4 abs_of(L4 a) { return {_mm256_andnot_pd(_mm256_set1_pd(-0.0), a.v)}; }
 inline L4 min_of(L4 x, L4 y) { return {_mm256_min_pd(y.v, x.v)}; }
 inline L4 max_of(L4 x, L4 y) { return {_mm256_max_pd(y.v, x.v)}; }
 inline L4 select(M4 m, L4 a, L4 b) { return {_mm256_blendv_pd(b.v, a.v, m.v)}; }
+inline L4 ceil_of(L4 a) { return {_mm256_ceil_pd(a.v)}; }
 namespace span_avx2 {
 using W = L4;
 #include "lod_span_kernels.inl"
@@ -505,6 +515,7 @@ inline L8 neg_of(L8 a) {
 inline L8 min_of(L8 x, L8 y) { return {_mm512_min_pd(y.v, x.v)}; }
 inline L8 max_of(L8 x, L8 y) { return {_mm512_max_pd(y.v, x.v)}; }
 inline L8 select(M8 m, L8 a, L8 b) { return {_mm512_mask_blend_pd(m.v, b.v, a.v)}; }
+inline L8 ceil_of(L8 a) { return {_mm512_roundscale_pd(a.v, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)}; }
 namespace span_avx512 {
 using W = L8;
 #define WIRE_LOD_TAIL4 1
@@ -522,7 +533,7 @@ struct SpanKernels {
     void (*merge_deviations)(const double*, const double*, std::size_t, double*, double*, std::size_t, double*);
     void (*merge_spheres)(const double*, std::size_t, double*, std::size_t);
     void (*hull_depths)(const CubicBezier*, std::size_t, const HullConstants&, double*, double*, unsigned char*);
-    void (*wang_roots)(const double*, const double*, const double*, std::size_t, double, double*, double*);
+    void (*wang_counts)(const double*, const double*, const double*, std::size_t, double, double, double*, double*);
     void (*ratios)(const double*, std::size_t, const RatioConstants&, double*);
     void (*box)(const CubicBezier*, std::size_t, double*, double*);
 };
@@ -537,13 +548,13 @@ SpanKernels choose_span_kernels() {
     __builtin_cpu_init();
     if (lanes >= 8 && __builtin_cpu_supports("avx512f"))
         return {span_avx512::span_level0, span_avx512::span_merge_level, span_avx512::span_merge_deviations, span_avx512::span_merge_spheres, span_avx512::hull_depth_kernel,
-                span_avx512::wang_roots, span_avx512::span_ratios, span_avx512::wire_box};
+                span_avx512::wang_counts, span_avx512::span_ratios, span_avx512::wire_box};
     if (lanes >= 4 && __builtin_cpu_supports("avx2"))
         return {span_avx2::span_level0, span_avx2::span_merge_level, span_avx2::span_merge_deviations, span_avx2::span_merge_spheres, span_avx2::hull_depth_kernel,
-                span_avx2::wang_roots, span_avx2::span_ratios, span_avx2::wire_box};
+                span_avx2::wang_counts, span_avx2::span_ratios, span_avx2::wire_box};
 #endif
     return {span_sse2::span_level0, span_sse2::span_merge_level, span_sse2::span_merge_deviations, span_sse2::span_merge_spheres, span_sse2::hull_depth_kernel,
-            span_sse2::wang_roots, span_sse2::span_ratios, span_sse2::wire_box};
+            span_sse2::wang_counts, span_sse2::span_ratios, span_sse2::wire_box};
 }
 const SpanKernels& span_kernels() {
     static const SpanKernels kernels = choose_span_kernels();
@@ -553,7 +564,7 @@ const SpanKernels& span_kernels() {
 // Per-update working memory of one thread (grows once, then reused).
 struct Scratch {
     std::vector<double> z_min, k;  // per segment: hull depth and off-axis factor (hull_depths())
-    std::vector<double> eps, root;     // per segment: world tolerance, Wang's root
+    std::vector<double> raw, clamped;  // per segment: Wang's count and clamp flag (wang_counts())
     std::vector<double> ratios;        // per hierarchy node: SpanMerger's ratios
     std::vector<unsigned char> outside;
     std::vector<uint32_t> old_counts;
@@ -926,36 +937,30 @@ bool per_segment_required(const Curve& curve, const LodView& view, const LodSett
     wire_z = std::numeric_limits<double>::infinity();
     wire_k = 1.0;
     const double scale = lim.eps / view.focal_px;
-    // Wang's M of every segment (cached in the bounds), then every segment's world tolerance and root in a lane
-    // kernel (computed for all; used where the segment needs them).
+    // Wang's M of every segment (cached in the bounds), then every segment's count and clamp flag in a lane kernel
+    // (computed for all; used where the segment needs them).
     const double* mm = &bounds.data[bounds.data.size() - bounds.segments];  // wang_m(0 .. n): segments == n here
-    sc.eps.resize(n);
-    sc.root.resize(n);
-    span_kernels().wang_roots(zmin, ks, mm, n, scale, sc.eps.data(), sc.root.data());
+    sc.raw.resize(n);
+    sc.clamped.resize(n);
+    span_kernels().wang_counts(zmin, ks, mm, n, scale, static_cast<double>(lim.max_rings), sc.raw.data(),
+                               sc.clamped.data());
+    uint32_t visible = 0, clamped = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const bool seg_visible = sc.outside[i] == 0;
         uint32_t raw = 1;
         if (seg_visible || !settings.coarse_offscreen_segments) {
-            const double eps_world = sc.eps[i];  // scale * zmin[i] / ks[i]
-            // wang_ring_count() on the cached M.
-            if (!(eps_world > 0.0) || !std::isfinite(mm[i])) {
-                raw = lim.max_rings;
-            } else {
-                const double c = std::ceil(sc.root[i]);  // sqrt(3 M / (4 eps_world))
-                raw = !(c < static_cast<double>(lim.max_rings))
-                          ? lim.max_rings
-                          : std::max<uint32_t>(1, static_cast<uint32_t>(c));
-                if (raw >= lim.max_rings && !(c <= static_cast<double>(lim.max_rings)))
-                    ++lod.clamped_segments;
-            }
+            raw = static_cast<uint32_t>(sc.raw[i]);  // an integer in [1, max_rings]
+            clamped += sc.clamped[i] != 0.0 ? 1u : 0u;
             if (seg_visible) {
-                ++lod.visible_segments;
+                ++visible;
                 wire_z = std::min(wire_z, zmin[i]);
                 wire_k = std::max(wire_k, ks[i]);
             }
         }
         lod.required[i] = raw;
     }
+    lod.visible_segments += visible;
+    lod.clamped_segments += clamped;
     return true;
 }
 

@@ -382,14 +382,19 @@ inline void hull_depth_kernel(const CubicBezier* seg, std::size_t n, const HullC
     }
 }
 
-// Per segment: the world tolerance at its hull depth, eps = scale z_min / k, and Wang's root sqrt(3 M / (4 eps))
-// (wang_ring_count()'s arithmetic), W::width segments at a time.
-inline void wang_roots(const double* z_min, const double* k, const double* m, std::size_t n, double scale,
-                       double* eps_out, double* root_out) {
+// Per segment: Wang's ring count at its hull depth (wang_ring_count()'s arithmetic on the cached M, as a double:
+// an integer in [1, max_rings]) and whether max_rings clamped it (1 or 0), W::width segments at a time:
+// eps = scale z_min / k, c = ceil(sqrt(3 M / (4 eps))), max_rings where eps is not positive or M not finite, else
+// max(1, c) below max_rings and max_rings from there on (clamped unless c <= max_rings, so also for a NaN c).
+inline void wang_counts(const double* z_min, const double* k, const double* m, std::size_t n, double scale,
+                        double max_rings, double* raw_out, double* clamped_out) {
     auto run = [&]<class L>(std::size_t i, L) __attribute__((always_inline)) {
+        const L zero = L::splat(0.0), one = L::splat(1.0), most = L::splat(max_rings), mi = L::load(m + i);
         const L eps = (L::splat(scale) * L::load(z_min + i)) / L::load(k + i);
-        eps.store(eps_out + i);
-        sqrt_of((L::splat(3.0) * L::load(m + i)) / (L::splat(4.0) * eps)).store(root_out + i);
+        const L c = ceil_of(sqrt_of((L::splat(3.0) * mi) / (L::splat(4.0) * eps)));  // >= 0 or NaN: ceil_of exact
+        const auto ok = (zero < eps) & (abs_of(mi) <= L::splat(std::numeric_limits<double>::max()));
+        select(ok, select(c < most, max_of(c, one), most), most).store(raw_out + i);
+        select(ok, select(c <= most, zero, one), zero).store(clamped_out + i);
     };
     over_lanes(n, run);
 }
