@@ -728,6 +728,74 @@ double level0_deviation(const CubicBezier& c) {
     return std::abs(d) <= std::numeric_limits<double>::max() ? d : std::numeric_limits<double>::infinity();
 }
 
+// The per-segment pass's Wang counts (a lane kernel: ceil in lanes, by a sum with 2^52 on SSE2) equal the scalar
+// formula written out here (hull depth and off-axis factor from the control points in view space, the world
+// tolerance at them, Wang's count on the bounds' cached M, clamped at max_rings), segment by segment, with the
+// number of clamped segments: random wires of 2 .. 40 segments (tails of every lane width), the four camera kinds,
+// tolerances of 0.05 .. 4 px and max_rings of 1 .. 256 (many clamps). Node resolution and no coarse off-screen
+// segments, so every segment keeps its own count (the updates the sphere bound decides are left out).
+TEST(LodPerSegment, WangCountsEqualTheScalarFormula) {
+    Rng rng(61);
+    std::size_t checked = 0, segments = 0, clamped_total = 0, above_one = 0;
+    const uint32_t max_rings_of[] = {1, 2, 3, 5, 8, 256};
+    for (int w = 0; w < 240; ++w) {
+        const WireNodes nodes = make_wire(static_cast<Shape>(w % 3), rng);
+        Curve curve;
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.01f}, curve).ok);
+        LodBounds bounds;
+        compute_lod_bounds(curve, bounds);
+        const LodView view = make_camera(static_cast<CameraKind>(w % 4), curve, rng);
+        const LodSettings settings{.tolerance_px = std::pow(10.0, uniform(rng, -1.3, 0.6)),
+                                   .max_rings_per_segment = max_rings_of[w % 6],
+                                   .coarse_offscreen_segments = false,
+                                   .keep_node_resolution = true};
+        WireLod lod;
+        update_lod(curve, view, settings, lod, bounds);
+        if (!lod.visible || lod.bounded) continue;
+        const double max_rings = settings.max_rings_per_segment;
+        const double scale = settings.tolerance_px / view.focal_px;
+        const glm::dmat4& m = view.view_from_world;
+        uint32_t clamped = 0;
+        for (std::size_t i = 0; i < curve.segment_count(); ++i) {
+            const CubicBezier& c = curve.segments[i];
+            double zm = std::numeric_limits<double>::infinity(), a = 0.0, b = 0.0;
+            for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3}) {
+                const double qx = ((m[0][0] * p.x + m[1][0] * p.y) + m[2][0] * p.z) + m[3][0];
+                const double qy = ((m[0][1] * p.x + m[1][1] * p.y) + m[2][1] * p.z) + m[3][1];
+                const double qz = -(((m[0][2] * p.x + m[1][2] * p.y) + m[2][2] * p.z) + m[3][2]);
+                const double den = qz < view.near_m ? view.near_m : qz;
+                zm = qz < zm ? qz : zm;
+                a = std::max(a, std::abs(qx) / den);
+                b = std::max(b, std::abs(qy) / den);
+            }
+            const bool in_front = view.near_m <= zm;
+            a = in_front ? std::min(a, view.tan_half_x) : view.tan_half_x;
+            b = in_front ? std::min(b, view.tan_half_y) : view.tan_half_y;
+            const double z_min = std::max(zm, view.near_m), k = std::sqrt((1.0 + a * a) + b * b);
+            const double eps = (scale * z_min) / k, mm = bounds.wang_m(i);
+            uint32_t want = settings.max_rings_per_segment;
+            if (eps > 0.0 && std::isfinite(mm)) {
+                const double n = std::ceil(std::sqrt((3.0 * mm) / (4.0 * eps)));
+                if (n < max_rings) want = std::max<uint32_t>(1, static_cast<uint32_t>(n));
+                if (!(n <= max_rings)) ++clamped;
+            } else {
+                ++clamped;
+            }
+            ASSERT_EQ(lod.required[i], want) << "wire " << w << " segment " << i;
+            above_one += want > 1 ? 1 : 0;
+        }
+        ASSERT_EQ(lod.clamped_segments, clamped) << "wire " << w;
+        ++checked;
+        segments += curve.segment_count();
+        clamped_total += clamped;
+    }
+    std::printf("per-segment counts: %zu wires, %zu segments, %zu above one ring, %zu clamped\n", checked, segments,
+                above_one, clamped_total);
+    ASSERT_GE(checked, 120u);
+    ASSERT_GE(above_one, segments / 4);
+    ASSERT_GE(clamped_total, segments / 10);
+}
+
 // span_level0() skips the hull where a certificate shows it exceeds 3M/4 (hull_certified(), proof at it): its
 // deviations stay those of the full formula, bit for bit. Curves of 64 segments whose segments all pass it but one
 // probe, so that the probe alone decides its lane group's branch at every lane width: sagging segments (b1, b2 at
