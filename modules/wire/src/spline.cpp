@@ -260,6 +260,7 @@ struct Pool {
 struct Merged {
     std::vector<dvec3> p;
     std::vector<uint32_t> first, last;
+    bool identity = false;  // first and last hold 0 .. size-1 (nothing merged): kept for the next wire of that size
 };
 
 // Segment chords, structure of arrays. Segment k is at index k + 1; index 0 repeats the last segment and index
@@ -360,13 +361,19 @@ const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m,
         // length of a negated difference is the same number); nothing merges when all exceed eps.
         fill_chords(w.positions.data(), n, s.closed, ch);
         if (all_above(ch.len.data() + 1, ch.segs, eps)) {
-            m.first.resize(n), m.last.resize(n);
-            for (std::size_t i = 0; i < n; ++i) m.first[i] = m.last[i] = static_cast<uint32_t>(i);
+            // Already the identity of n nodes in the common case (the thread's build memory, reused by the
+            // thread's wires, most of one size and merging nothing): not rewritten per wire then.
+            if (!m.identity || m.first.size() != n) {
+                m.first.resize(n), m.last.resize(n);
+                for (std::size_t i = 0; i < n; ++i) m.first[i] = m.last[i] = static_cast<uint32_t>(i);
+                m.identity = true;
+            }
             count = n;
             return w.positions.data();
         }
     }
     m.p.clear(), m.first.clear(), m.last.clear();
+    m.identity = false;
     for (std::size_t i = 0; i < n; ++i) {
         if (!m.p.empty() && glm::length(w.positions[i] - m.p.back()) <= eps) {
             m.last.back() = static_cast<uint32_t>(i);

@@ -448,6 +448,51 @@ TEST(WireCurveHardCases, CoincidentNodesExactAnd1e9ApartAreMerged) {
     }
 }
 
+// A build keeps its merge map (which input node each curve node is) for the next wire when nothing merged: a
+// wire that merges in between, to the same node count, must not leave its map to the next one (nor a wire of
+// another count). Every build equals the first build of the same wire, source nodes and radii included.
+TEST(WireCurveHardCases, MergeMapOfOneWireIsNotLeftToTheNext) {
+    const WireNodes plain = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0), dvec3(3.0, 1.0, 0.5)});
+    WireNodes merging = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0),
+                                    dvec3(3.0, 1.0, 0.5)});
+    merging.radius_m = {0.01f, 0.02f, 0.03f, 0.04f, 0.05f};
+    const WireNodes longer = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0), dvec3(3.0, 1.0, 0.5),
+                                         dvec3(4.0, 0.0, 0.5)});
+    const WireNodes* const wires[] = {&plain, &merging, &longer};
+    const WireNodes* const order[] = {&plain, &merging, &plain, &longer, &plain, &merging, &longer, &merging, &plain};
+    for (const NamedSettings& v : spline_variants()) {
+        Curve first[3];
+        const auto slot = [&](const WireNodes* w) { return w == &plain ? 0 : w == &merging ? 1 : 2; };
+        for (const WireNodes* w : wires) ASSERT_TRUE(build_curve(*w, v.settings, first[slot(w)]).ok);
+        ASSERT_EQ(first[0].source_node, (std::vector<uint32_t>{0, 1, 2, 3})) << v.name;
+        ASSERT_EQ(first[1].source_node, (std::vector<uint32_t>{0, 1, 3, 4})) << v.name;
+        ASSERT_EQ(first[2].source_node, (std::vector<uint32_t>{0, 1, 2, 3, 4})) << v.name;
+        const auto same = [&](const Curve& c, const WireNodes* w, const char* how) {
+            const Curve& f = first[slot(w)];
+            EXPECT_EQ(c.source_node, f.source_node) << v.name << " " << how << " wire " << slot(w);
+            EXPECT_EQ(c.radius_m, f.radius_m) << v.name << " " << how << " wire " << slot(w);
+            ASSERT_EQ(c.segments.size(), f.segments.size()) << v.name << " " << how;
+            EXPECT_EQ(std::memcmp(c.segments.data(), f.segments.data(), c.segments.size() * sizeof(CubicBezier)), 0)
+                << v.name << " " << how << " wire " << slot(w);
+        };
+        for (const WireNodes* w : order) {  // one build's memory (build_curve's)
+            Curve c;
+            ASSERT_TRUE(build_curve(*w, v.settings, c).ok) << v.name;
+            same(c, w, "alone");
+        }
+        for (std::size_t i = 0; i + 4 <= std::size(order); ++i) {  // build_curves' four, each seeing the sequence
+            Curve c[4];
+            CurveBuildJob jobs[4];
+            for (std::size_t k = 0; k < 4; ++k) jobs[k] = {order[i + k], &v.settings, &c[k], {}};
+            build_curves(jobs);
+            for (std::size_t k = 0; k < 4; ++k) {
+                ASSERT_TRUE(jobs[k].status.ok) << v.name;
+                same(c[k], order[i + k], "grouped");
+            }
+        }
+    }
+}
+
 TEST(WireCurveHardCases, UnmergedNearCoincidentNodesGiveTheCentripetalLimit) {
     // With merging effectively off, 1e-9-apart nodes stay: the centripetal tangent there tends to 0 (it is
     // ~sqrt(1e-9) long), so the curve makes no loop: every sample stays within a few mm of the polyline.
