@@ -506,7 +506,8 @@ FrameStats compute_frames(const FrameInput& in, const FrameSettings& settings, s
         // Pass 3 writes the rings' normals and binormals.
         const CubicBezier* const segs = in.curve != nullptr ? in.curve->segments.data() : nullptr;
         // The points, in structure-of-arrays scratch (grows once per thread, then reused): position, tangent, the
-        // segment and parameter a step from the point runs along, and the ring index (-1: a crossed boundary).
+        // segment and parameter a step from the point runs along (segment starts: computed, see CarryChain), and
+        // the point of every ring (the other points are crossed boundaries).
         // Rings only at segment starts (t = 0, at most one per segment; the last may be at t = 1: LOD at or below the
         // node resolution, the common moving wire) with build_rings' tables: the points are the segment starts
         // from ring 0's on, in order, so they are copied from the tables in lanes and the rings written over their

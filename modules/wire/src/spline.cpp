@@ -1420,8 +1420,22 @@ Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
 }
 
 void build_curves(std::span<CurveBuildJob> jobs) {
-    assert(jobs.size() <= 4 && "build_curves: at most four wires");
-    const std::size_t count = std::min<std::size_t>(jobs.size(), 4);
+    if (jobs.size() > 4) {  // four at a time, in order
+        for (std::size_t first = 0; first < jobs.size(); first += 4) {
+            build_curves(jobs.subspan(first, std::min<std::size_t>(4, jobs.size() - first)));
+        }
+        return;
+    }
+    const std::size_t count = jobs.size();
+    // Two jobs writing one curve cannot be built side by side: what build_curve calls in order leave (the later
+    // job's curve).
+    for (std::size_t k = 1; k < count; ++k) {
+        for (std::size_t l = 0; l < k; ++l) {
+            if (jobs[k].out != jobs[l].out) continue;
+            for (CurveBuildJob& job : jobs) job.status = build_curve(*job.nodes, *job.settings, *job.out);
+            return;
+        }
+    }
     // Four builds in flight keep four builds' working memory per thread: only wires of up to kGroupNodes nodes
     // take the third and fourth (a group with a larger wire is built as two pairs, in the first two builds).
     constexpr std::size_t kGroupNodes = 1024;
@@ -1468,11 +1482,6 @@ void build_curves(std::span<CurveBuildJob> jobs) {
 
 std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0, Curve& out0,
                                            const WireNodes& nodes1, const SplineSettings& settings1, Curve& out1) {
-    if (&out0 == &out1) {  // one curve for both (the header asks for two): what two build_curve calls leave
-        Status st0 = build_curve(nodes0, settings0, out0);
-        Status st1 = build_curve(nodes1, settings1, out1);
-        return {std::move(st0), std::move(st1)};
-    }
     CurveBuildJob jobs[2] = {{&nodes0, &settings0, &out0, {}}, {&nodes1, &settings1, &out1, {}}};
     build_curves(jobs);
     return {std::move(jobs[0].status), std::move(jobs[1].status)};

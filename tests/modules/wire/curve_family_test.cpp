@@ -330,6 +330,36 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
             EXPECT_TRUE(same_curve(grouped[k], single)) << "large wire in slot " << slot << ", slot " << k;
         }
     }
+    // More than four jobs: four at a time, in order. Two jobs writing one curve (here slots 1 and 4, and a pair
+    // given one curve twice): each status as alone, and the curve holds the later job's (as build_curve calls
+    // in order leave it).
+    {
+        Curve outs[6], shared;
+        CurveBuildJob jobs[6];
+        for (std::size_t k = 0; k < 6; ++k) jobs[k] = {&all[k].nodes, &settings[0], &outs[k], {}};
+        build_curves(jobs);
+        for (std::size_t k = 0; k < 6; ++k) {
+            const Status alone = build_curve(all[k].nodes, settings[0], single);
+            EXPECT_EQ(jobs[k].status.ok, alone.ok) << "six jobs, slot " << k;
+            EXPECT_TRUE(same_curve(outs[k], single)) << "six jobs, slot " << k;
+        }
+        for (std::size_t k = 0; k < 6; ++k) jobs[k] = {&all[k + 6].nodes, &settings[0], &outs[k], {}};
+        jobs[1].out = jobs[4].out = &shared;
+        build_curves(std::span(jobs, 5));
+        for (std::size_t k = 0; k < 5; ++k) {
+            const Status alone = build_curve(all[k + 6].nodes, settings[0], single);
+            EXPECT_EQ(jobs[k].status.ok, alone.ok) << "shared curve, slot " << k;
+            if (k != 1) {
+                EXPECT_TRUE(same_curve(*jobs[k].out, single)) << "shared curve, slot " << k;
+            }
+        }
+        ASSERT_TRUE(build_curve(all[10].nodes, settings[0], single).ok);
+        EXPECT_TRUE(same_curve(shared, single)) << "the shared curve holds the later job's";
+        const auto [first, second] = build_curve_pair(all[12].nodes, settings[0], shared, all[13].nodes, settings[0], shared);
+        EXPECT_TRUE(first.ok && second.ok);
+        ASSERT_TRUE(build_curve(all[13].nodes, settings[0], single).ok);
+        EXPECT_TRUE(same_curve(shared, single)) << "a pair given one curve: the second wire's";
+    }
     EXPECT_GT(four_lane, 100);  // the four-lane solve did run
     std::printf("\n%d groups, %d of them four valid open same-size c2/automatic wires\n", groups, four_lane);
 }

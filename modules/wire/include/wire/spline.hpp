@@ -73,9 +73,10 @@ struct CurveBuildJob {
     Status status;                             ///< build_curve's status, set by the call
 };
 
-/// build_curve for up to four wires into distinct curves: the same outputs and statuses, bit for bit, as a
-/// build_curve call for each. Faster where open c2 or automatic wires have the same number of curve nodes: the
-/// tridiagonal solves, a serial chain of divisions per wire, run side by side (four, else two, at once).
+/// build_curve for every job, in order: the same outputs and statuses, bit for bit, as a build_curve call for each
+/// (also when two jobs write one curve, which then holds the later one). Faster where open c2 or automatic wires
+/// have the same number of curve nodes: their tridiagonal solves, a serial chain of divisions per wire, run side by
+/// side (four, else two, at once; any number of jobs is taken four at a time).
 void build_curves(std::span<CurveBuildJob> jobs);
 
 /// The thesis' curvature-driven tension for one node: R = theta*Iz*L / (A*dL^2); 0 if R > 100 (or dL = 0),
