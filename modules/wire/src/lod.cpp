@@ -1145,6 +1145,9 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     const bool keeps_coherence = use_bound && !bounds.transient && sb.inside;
     if (!keeps_coherence) merger.skip_margin();
     merger.set_depth_range(sb.z_lo_m, sb.z_hi_m, built_levels);
+    // Every segment lies in a span of both kinds (the common case on screen): the walk below writes each span's
+    // first entry over zeros (the zeroed walk), so nothing before it needs to fill the counts.
+    const bool zeroed_walk = merge && merger.writes_every_segment();
 
     // A sphere inside the frustum whose conservative side count is 3 (so the exact one is too) is decided
     // here.
@@ -1168,8 +1171,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
             decided = true;
             whole = true;
         } else if (one_ring_per_segment(bounds, sb)) {
-            // One ring each, unless the spans below overwrite every entry (the zeroed walk: then not filled twice).
-            if (!(merge && merger.writes_every_segment())) lod.required.assign(n, 1);
+            if (!zeroed_walk) lod.required.assign(n, 1);  // one ring each (the zeroed walk writes them itself)
             decided = true;
         }
         if (decided) {
@@ -1212,9 +1214,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     lod.visible = true;
     bool zeroed = false;
     uint32_t zeroed_changed = 0;
-    if (!whole && merge && merger.writes_every_segment()) {
-        // Every segment lies in a span of both kinds (the common case on screen): the walk writes each span's
-        // first entry over zeros, and the per-segment counts (and the hysteresis on them) are never read.
+    if (!whole && zeroed_walk) {
+        // The per-segment counts (and the hysteresis on them) are never read.
         lod.required.assign(n, 0);
         lod.counts.assign(n, 0);
         lod.spans = merger.apply_zeroed(lod.required, lod.counts, zeroed_changed);

@@ -152,7 +152,8 @@ struct Range {
     double slo = std::numeric_limits<double>::infinity(), shi = 0.0;
     // A constructor written here, not default member initializers: GCC compiles an implicit constructor outside
     // the `#pragma GCC target` region this file is included in, so without optimization (nothing inlined) it took
-    // the wide lanes' values through the baseline ABI and left them garbage (Debug builds' LOD ranges).
+    // the wide lanes' values through the baseline ABI and left them garbage (Debug builds' LOD ranges). The rule
+    // for every type in this file: a member of lane type is set by a written constructor or by the kernel itself.
     Range() : lo(W::splat(std::numeric_limits<double>::infinity())), hi(W::splat(0.0)) {}
     void add(W v) {
         lo = min_of(lo, v);

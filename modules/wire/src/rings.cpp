@@ -178,20 +178,24 @@ Interval integrate(const SegmentCoeffs& c, double ta, double tb) {
     }
 }
 
-/// The lengths of gauss_whole_segments() alone, and u = length u_per_m (integrate()'s constant-radius case: a wire
-/// of one radius). No select, so no WIRE_SELECT_KERNEL: that attribute keeps the loop from some of its -O3
-/// treatment (15% slower on AVX-512).
+/// Segment k's length (gauss_whole_segments()'s) and u = length u_per_m (integrate()'s constant-radius case).
+[[gnu::always_inline]] inline void whole_length(const double* __restrict b, std::size_t n, std::size_t k,
+                                               const double* __restrict u_per_m, double* __restrict length_m,
+                                               double* __restrict u) {
+    double speed[kGlPoints];
+    whole_segment_speeds(b, n, k, speed);
+    double len = 0.0;
+    for (int q = 0; q < kGlPoints; ++q) len += (1.0 * kGlW[q]) * speed[q];  // integrate()'s h w_q, h = 1
+    length_m[k] = len;
+    u[k] = len * u_per_m[k];
+}
+
+/// whole_length() of n segments (a wire of one radius). No select, so no WIRE_SELECT_KERNEL: that attribute keeps
+/// the loop from some of its -O3 treatment (15% slower on AVX-512).
 WIRE_VECTOR_CLONES void gauss_whole_lengths(const double* __restrict b, std::size_t n,
                                             const double* __restrict u_per_m, double* __restrict length_m,
                                             double* __restrict u) {
-    for (std::size_t k = 0; k < n; ++k) {
-        double speed[kGlPoints];
-        whole_segment_speeds(b, n, k, speed);
-        double len = 0.0;
-        for (int q = 0; q < kGlPoints; ++q) len += (1.0 * kGlW[q]) * speed[q];  // integrate()'s h w_q, h = 1
-        length_m[k] = len;
-        u[k] = len * u_per_m[k];
-    }
+    for (std::size_t k = 0; k < n; ++k) whole_length(b, n, k, u_per_m, length_m, u);
 }
 
 /// gauss_whole_lengths() and detail::boundary_tangents() in one pass over the segments (a wire of one radius whose
@@ -200,12 +204,7 @@ WIRE_VECTOR_CLONES void gauss_whole_lengths_and_tangents(const double* __restric
                                                          const double* __restrict u_per_m, double* __restrict length_m,
                                                          double* __restrict u, double* __restrict tangent) {
     for (std::size_t k = 0; k < n; ++k) {
-        double speed[kGlPoints];
-        whole_segment_speeds(b, n, k, speed);
-        double len = 0.0;
-        for (int q = 0; q < kGlPoints; ++q) len += (1.0 * kGlW[q]) * speed[q];
-        length_m[k] = len;
-        u[k] = len * u_per_m[k];
+        whole_length(b, n, k, u_per_m, length_m, u);
         detail::boundary_tangent(b, n, k, tangent, tangent + n, tangent + 2 * n, tangent + 3 * n);
     }
 }
@@ -365,7 +364,7 @@ struct SegmentTables {
             const double r_safe = std::max(uniform_r, 1e-30);
             const std::size_t n_stretch = std::min(curve.stretch.size(), n);
             // Every stretch given, positive and finite: the common case, in lanes.
-            const bool plain = plain_u_per_m(curve.stretch.data(), n_stretch, r_safe, u_per_m) && n_stretch == n;
+            const bool plain = n_stretch == n && plain_u_per_m(curve.stretch.data(), n, r_safe, u_per_m);
             if (!plain) {
                 for (std::size_t k = 0; k < n; ++k) {
                     double stretch = k < n_stretch ? static_cast<double>(curve.stretch[k]) : 1.0;

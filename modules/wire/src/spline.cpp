@@ -861,12 +861,16 @@ __attribute__((target("avx512f"))) bool node_segments_avx512(std::size_t count, 
 #pragma GCC diagnostic pop
 #endif
 
+#if defined(WIRE_HAS_VECTOR_CLONES)
+// Whether the CPU (and the OS) run AVX-512 code: decided once, when the library is loaded (not on every call).
+const bool kHasAvx512 = (__builtin_cpu_init(), __builtin_cpu_supports("avx512f"));
+#endif
+
 // node_segments_kernel's records and test, by the AVX-512 version where the CPU has it (`widest`; false: the loop).
 bool node_segments(std::size_t count, const double* p0, const double* p1, const double* Dx, const double* Dy,
                    const double* Dz, const double* len, double* out, double offset_limit, bool widest = true) {
 #if defined(WIRE_HAS_VECTOR_CLONES)
-    static const bool avx512 = (__builtin_cpu_init(), __builtin_cpu_supports("avx512f"));
-    if (widest && avx512 && count >= 8) return node_segments_avx512(count, p0, p1, Dx, Dy, Dz, len, out, offset_limit);
+    if (widest && kHasAvx512 && count >= 8) return node_segments_avx512(count, p0, p1, Dx, Dy, Dz, len, out, offset_limit);
 #endif
     (void)widest;
     return node_segments_kernel(count, p0, p1, Dx, Dy, Dz, len, out, offset_limit);
