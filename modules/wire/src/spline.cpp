@@ -577,15 +577,32 @@ void edge_kernel(std::size_t n, const double* __restrict tx, const double* __res
     }
 }
 
+// The spread test's threshold without square roots: with a = |k|^2 and b = |k~|^2 as computed, the exact test
+// leaves a node undecided when miss2 <= (kSpreadLo sum)^2 (both sides rounded), sum = sqrt(a) + sqrt(b) rounded.
+// kSpreadBound s2 >= miss2, s2 = a + b + 2 min(a, b) rounded, implies it (u = 2^-53, every value >= 0):
+// 1. sqrt(a), sqrt(b) and their sum are each rounded once: sum >= (sqrt a + sqrt b)(1 - u)^2, and
+//    (sqrt a + sqrt b)^2 = a + b + 2 sqrt(ab) >= a + b + 2 min(a, b) =: S, so sum^2 >= S (1 - u)^4.
+// 2. The threshold (kSpreadLo sum)^2 rounds twice more: it is >= kSpreadLo^2 S (1 - u)^7 (kSpreadLo the double).
+// 3. s2 <= S (1 + u)^2 (2 min(a, b) is exact), the bound's product <= kSpreadBound S (1 + u)^3; kSpreadBound =
+//    0.3024 < 0.3025 (1 - 2^-12) <= kSpreadLo^2 (1 - u)^7 / (1 + u)^3: so bound >= miss2 gives threshold >= miss2.
+// Ranges: s2 in [2^-900, 2^1000] keeps every value above normal numbers' range floor (sum >= 2^-451, the threshold
+// >= 2^-903: no underflow's absolute error) and finite (sum <= 2^501). A NaN fails a comparison. Nodes outside
+// the certificate (a node that may turn without support, or out of range) take the exact test with the roots.
+// (WireCurveSpread.CertificateEqualsTheExactTest tests it near the boundary.)
+constexpr double kSpreadBound = 0.3024;
+static_assert(kSpreadBound < 0.3025 * (1.0 - 0x1p-12) && 0.3025 <= kSpreadLo * kSpreadLo,
+              "kSpreadBound must stay below kSpreadLo^2 by more than the roundings of the proof");
+
 // Per node (arrays offset so that node i's incoming chord length, previous node's curvature and previous edge are
 // at index i, its own at i + 1, the next node's curvature at i + 2): the turn its neighbours predict, the spread's
-// ingredients |k|, |k| + |k~| and |k - k~|^2, and flag 1 where the spread must be decided (0: the neighbours
-// predict this turn, d <= kSpreadLo, decided on squares without the root; or straight here and around).
+// ingredients |k|^2, |k~|^2 and |k - k~|^2, and flag 1 where the spread may have to be decided (0: the neighbours
+// predict this turn, d <= kSpreadLo, shown on squares without a root by kSpreadBound; the flagged nodes, rare,
+// take the exact test in concentrated_turns).
 WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
 void spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
                    const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
                    const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
-                   const double* __restrict eq, double* __restrict lkv, double* __restrict sumv,
+                   const double* __restrict eq, double* __restrict lk2v, double* __restrict lp2v,
                    double* __restrict miss2v, double* __restrict flag) {
     for (std::size_t i = 0; i < count; ++i) {
         const double hin = len[i], hout = len[i + 1];
@@ -616,16 +633,38 @@ void spread_kernel(std::size_t count, const double* __restrict len, const double
         const double s = 1.0 / (hin + hout);
         const double px = (hout * fx + hin * bx) * s, py = (hout * fy + hin * by) * s, pz = (hout * fz + hin * bz) * s;
         const double vx = kx[i + 1], vy = ky[i + 1], vz = kz[i + 1];
-        const double lk = std::sqrt(vx * vx + vy * vy + vz * vz), lp = std::sqrt(px * px + py * py + pz * pz);
+        const double lk2 = vx * vx + vy * vy + vz * vz, lp2 = px * px + py * py + pz * pz;
         const double mx = vx - px, my = vy - py, mz = vz - pz;
-        const double sum = lk + lp, miss2 = mx * mx + my * my + mz * mz;
-        lkv[i] = lk;
-        sumv[i] = sum;
+        const double miss2 = mx * mx + my * my + mz * mz;
+        lk2v[i] = lk2;
+        lp2v[i] = lp2;
         miss2v[i] = miss2;
-        // sum > 0 and finite (lengths are >= 0 or NaN), and the miss beyond kSpreadLo of it.
-        const bool decide = (sum > 0.0) & (sum <= DBL_MAX) & !(miss2 <= (kSpreadLo * sum) * (kSpreadLo * sum));
-        flag[i] = decide ? 1.0 : 0.0;
+        const double s2 = (lk2 + lp2) + 2.0 * (lk2 < lp2 ? lk2 : lp2);
+        const bool predicted = (s2 >= 0x1p-900) & (s2 <= 0x1p1000) & (miss2 <= kSpreadBound * s2);
+        flag[i] = predicted ? 0.0 : 1.0;
     }
+}
+
+// The spread's exact test for a node: sum = |k| + |k~| > 0 and finite (lengths are >= 0 or NaN), and the miss
+// beyond kSpreadLo of it. lk = |k| and sum are returned for the weights.
+bool spread_decides(double lk2, double lp2, double miss2, double& lk, double& sum) {
+    lk = std::sqrt(lk2);
+    sum = lk + std::sqrt(lp2);
+    return (sum > 0.0) & (sum <= DBL_MAX) & !(miss2 <= (kSpreadLo * sum) * (kSpreadLo * sum));
+}
+
+// The exact test for the nodes spread_kernel flagged (its outputs, count nodes): a flag stays 1 where the spread
+// must be decided (lk2v, lp2v then hold |k| and |k| + |k~|), else becomes 0. Returns whether any stays 1.
+bool decide_flagged(std::size_t count, double* lk2v, double* lp2v, const double* miss2v, double* flag) {
+    bool any = false;
+    for (std::size_t i = 0; i < count; ++i) {
+        if (flag[i] == 0.0) continue;
+        double lk, sum;
+        const bool decide = spread_decides(lk2v[i], lp2v[i], miss2v[i], lk, sum);
+        lk2v[i] = lk, lp2v[i] = sum, flag[i] = decide ? 1.0 : 0.0;
+        any |= decide;
+    }
+    return any;
 }
 
 /// Per-node tension weights from the turning pattern (see the constants above): g in [0, 1] (concentrated
@@ -676,16 +715,18 @@ bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
     // What the neighbours predict at node i: their curvature vectors, carried to node i's tangent (a reversal,
     // any perpendicular axis: the sign is what matters), interpolated linearly in arc length; the spread's
     // ingredients per node.
-    double* __restrict lkv = pool.carve(n);
-    double* __restrict sumv = pool.carve(n);
+    double* __restrict lkv = pool.carve(n);  // |k|^2 from spread_kernel, |k| for the nodes to decide
+    double* __restrict sumv = pool.carve(n);  // |k~|^2 from spread_kernel, |k| + |k~| for the nodes to decide
     double* __restrict miss2v = pool.carve(n);
     double* __restrict flag = pool.carve(n);
     const std::size_t first = closed ? 0 : 1, end = closed ? n : n - 1;
     spread_kernel(end - first, len + first, kx + first, ky + first, kz + first, ax + first, ay + first, az + first,
                   ec + first, eq + first, lkv + first, sumv + first, miss2v + first, flag + first);
-    // The rare nodes whose turn the neighbours do not predict (the common case, d <= kSpreadLo: g = 0 and
-    // straight = 0), and not straight here and around: none in most wires (one vector test).
+    // The rare nodes whose turn the neighbours may not predict (the common case, d <= kSpreadLo: g = 0 and
+    // straight = 0), and not straight here and around: none in most wires (one vector test). The flagged ones
+    // take the exact test; a wire none of whose nodes it decides is left as one without flags.
     if (all_within(flag + first, end - first, 0.5)) return false;
+    if (!decide_flagged(end - first, lkv + first, sumv + first, miss2v + first, flag + first)) return false;
     g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
     static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
     for (std::size_t i = first; i < end; ++i) {
@@ -1492,6 +1533,23 @@ std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const Spline
 }
 
 namespace detail {
+
+std::size_t spread_test(std::size_t count, const double* len, const double* kx, const double* ky, const double* kz,
+                        const double* ax, const double* ay, const double* az, const double* ec, const double* eq,
+                        double* lk, double* sum, double* miss2, double* flag, bool certified) {
+    spread_kernel(count, len, kx, ky, kz, ax, ay, az, ec, eq, lk, sum, miss2, flag);
+    const std::size_t uncertain = static_cast<std::size_t>(std::count(flag, flag + count, 1.0));
+    if (certified) {
+        decide_flagged(count, lk, sum, miss2, flag);
+        return uncertain;
+    }
+    for (std::size_t i = 0; i < count; ++i) {  // the exact test on every node, as before the certificate
+        double l, s;
+        flag[i] = spread_decides(lk[i], sum[i], miss2[i], l, s) ? 1.0 : 0.0;
+        lk[i] = l, sum[i] = s;
+    }
+    return uncertain;
+}
 
 bool node_segment_records(std::size_t count, const double* p0, const double* p1, const double* Dx, const double* Dy,
                           const double* Dz, const double* len, double* out, double offset_limit, bool widest) {

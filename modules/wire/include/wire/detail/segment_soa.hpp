@@ -58,6 +58,16 @@ void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty,
 bool node_segment_records(std::size_t count, const double* p0, const double* p1, const double* Dx, const double* Dy,
                           const double* Dz, const double* len, double* out, double offset_limit, bool widest = true);
 
+/// The automatic spline's spread test on count nodes (concentrated_turns' arrays, spline.cpp: node i's incoming
+/// chord length, previous curvature vector and previous edge at index i, its own at i + 1, the next curvature
+/// vector at i + 2): flag[i] 1 where the spread is decided, and there lk[i] = |k|, sum[i] = |k| + |k~| and miss2[i]
+/// = |k - k~|^2. `certified`: as build_curve runs it (the root-free certificate, the exact test only where it
+/// fails); else the exact test on every node. Both must give the same flags and values (tests compare them).
+/// Returns the number of nodes the certificate left to the exact test.
+std::size_t spread_test(std::size_t count, const double* len, const double* kx, const double* ky, const double* kz,
+                        const double* ax, const double* ay, const double* az, const double* ec, const double* eq,
+                        double* lk, double* sum, double* miss2, double* flag, bool certified);
+
 /// boundary_tangents()' work for segment k (of n laid out by transpose_segments()). Always inlined: GCC inlines
 /// nothing else into a kernel compiled for another instruction set (WIRE_VECTOR_CLONES), and build_rings' Gauss
 /// lengths kernel does this in the same pass over the segments.
