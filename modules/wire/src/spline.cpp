@@ -670,7 +670,8 @@ bool decide_flagged(std::size_t count, double* lk2v, double* lp2v, const double*
 /// Per-node tension weights from the turning pattern (see the constants above): g in [0, 1] (concentrated
 /// turn), straight in [0, 1] (end of a load-free span), and the diagonal addition w they give (0 where both are 0).
 /// n curve nodes. Returns false when every weight is 0 (no node to decide: most wires), leaving the outputs
-/// untouched (not zero-filled); else every output is resized to n.
+/// untouched (not zero-filled) or zero-filled (nodes the spread certificate left to the exact test, none decided);
+/// else every output is resized to n.
 bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vector<double>& g,
                         std::vector<double>& straight, std::vector<double>& w) {
     if (n < 3) return false;
@@ -723,22 +724,25 @@ bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
     spread_kernel(end - first, len + first, kx + first, ky + first, kz + first, ax + first, ay + first, az + first,
                   ec + first, eq + first, lkv + first, sumv + first, miss2v + first, flag + first);
     // The rare nodes whose turn the neighbours may not predict (the common case, d <= kSpreadLo: g = 0 and
-    // straight = 0), and not straight here and around: none in most wires (one vector test). The flagged ones
-    // take the exact test; a wire none of whose nodes it decides is left as one without flags.
+    // straight = 0), and not straight here and around: none in many wires (one vector test). The flagged ones
+    // take the exact test.
     if (all_within(flag + first, end - first, 0.5)) return false;
-    if (!decide_flagged(end - first, lkv + first, sumv + first, miss2v + first, flag + first)) return false;
     g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
     static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
+    bool any = false;
     for (std::size_t i = first; i < end; ++i) {
         if (flag[i] == 0.0) continue;
-        const double sum = sumv[i], miss2 = miss2v[i];
+        double lk, sum;
+        if (!spread_decides(lkv[i], sumv[i], miss2v[i], lk, sum)) continue;  // within the certificate's margin
+        any = true;
+        const double miss2 = miss2v[i];
         const double hin = len[i], hout = len[i + 1];
         const double inv_sum = 1.0 / sum;
         const double d = std::sqrt(miss2) * inv_sum;
         // Turning below ~1e-6 rad is rounding noise of collinear nodes (and invisible): nothing to decide.
         const double turn = 0.5 * sum * (hin + hout);
         const double unshared = smoothstep(kSpreadLo, kSpreadHi, d) * smoothstep(1e-8, 1e-6, turn);
-        const double share = lkv[i] * inv_sum;
+        const double share = lk * inv_sum;
         g[i] = unshared * smoothstep(kShareLo, kShareHi, share);
         straight[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, share));
         // Log-uniform in g (an untensed weight adds 0: expm1(0) = 0 exactly, so the call is skipped).
@@ -746,7 +750,7 @@ bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
         const double ws = straight[i] != 0.0 ? std::expm1(straight[i] * log_straight) : 0.0;
         w[i] = wc + ws;
     }
-    return true;
+    return any;
 }
 
 // n zeros (per thread; grown when needed, never written): the weights of a wire with no tensed node.
