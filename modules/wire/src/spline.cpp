@@ -599,11 +599,12 @@ static_assert(kSpreadBound < 0.3025 * (1.0 - 0x1p-12) && 0.3025 <= kSpreadLo * k
 // predict this turn, d <= kSpreadLo, shown on squares without a root by kSpreadBound; the flagged nodes, rare,
 // take the exact test in concentrated_turns).
 WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
-void spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
+std::size_t spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
                    const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
                    const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
                    const double* __restrict eq, double* __restrict lk2v, double* __restrict lp2v,
                    double* __restrict miss2v, double* __restrict flag) {
+    std::size_t flagged = 0;
     for (std::size_t i = 0; i < count; ++i) {
         const double hin = len[i], hout = len[i + 1];
         // Forwards along the previous edge (index i) from node i-1 (index i of k).
@@ -642,7 +643,9 @@ void spread_kernel(std::size_t count, const double* __restrict len, const double
         const double s2 = (lk2 + lp2) + 2.0 * (lk2 < lp2 ? lk2 : lp2);
         const bool predicted = (s2 >= 0x1p-900) & (s2 <= 0x1p1000) & (miss2 <= kSpreadBound * s2);
         flag[i] = predicted ? 0.0 : 1.0;
+        flagged += predicted ? 0 : 1;
     }
+    return flagged;
 }
 
 // The spread's exact test for a node: sum = |k| + |k~| > 0 and finite (lengths are >= 0 or NaN), and the miss
@@ -721,12 +724,13 @@ bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
     double* __restrict miss2v = pool.carve(n);
     double* __restrict flag = pool.carve(n);
     const std::size_t first = closed ? 0 : 1, end = closed ? n : n - 1;
-    spread_kernel(end - first, len + first, kx + first, ky + first, kz + first, ax + first, ay + first, az + first,
-                  ec + first, eq + first, lkv + first, sumv + first, miss2v + first, flag + first);
+    const std::size_t flagged =
+        spread_kernel(end - first, len + first, kx + first, ky + first, kz + first, ax + first, ay + first,
+                      az + first, ec + first, eq + first, lkv + first, sumv + first, miss2v + first, flag + first);
     // The rare nodes whose turn the neighbours may not predict (the common case, d <= kSpreadLo: g = 0 and
     // straight = 0), and not straight here and around: none in many wires (one vector test). The flagged ones
     // take the exact test.
-    if (all_within(flag + first, end - first, 0.5)) return false;
+    if (flagged == 0) return false;
     g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
     static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
     bool any = false;
@@ -1541,8 +1545,7 @@ namespace detail {
 std::size_t spread_test(std::size_t count, const double* len, const double* kx, const double* ky, const double* kz,
                         const double* ax, const double* ay, const double* az, const double* ec, const double* eq,
                         double* lk, double* sum, double* miss2, double* flag, bool certified) {
-    spread_kernel(count, len, kx, ky, kz, ax, ay, az, ec, eq, lk, sum, miss2, flag);
-    const std::size_t uncertain = static_cast<std::size_t>(std::count(flag, flag + count, 1.0));
+    const std::size_t uncertain = spread_kernel(count, len, kx, ky, kz, ax, ay, az, ec, eq, lk, sum, miss2, flag);
     if (certified) {
         decide_flagged(count, lk, sum, miss2, flag);
         return uncertain;
