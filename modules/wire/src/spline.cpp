@@ -685,9 +685,8 @@ bool decide_flagged(std::size_t count, double* lk2v, double* lp2v, const double*
 
 /// Per-node tension weights from the turning pattern (see the constants above): g in [0, 1] (concentrated
 /// turn), straight in [0, 1] (end of a load-free span), and the diagonal addition w they give (0 where both are 0).
-/// n curve nodes. Returns false when every weight is 0 (no node to decide: most wires), leaving the outputs
-/// untouched (not zero-filled) or zero-filled (nodes the spread certificate left to the exact test, none decided);
-/// else every output is resized to n.
+/// n curve nodes. Returns false when every weight is 0 (no node to decide, or none that gets a weight: most
+/// wires), leaving the outputs untouched (not zero-filled); else every output is resized to n.
 bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vector<double>& g,
                         std::vector<double>& straight, std::vector<double>& w) {
     if (n < 3) return false;
@@ -747,14 +746,12 @@ bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
     // straight = 0), and not straight here and around: none in many wires (one vector test). The flagged ones
     // take the exact test.
     if (flagged == 0) return false;
-    g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
     static const double log_max = std::log1p(kMaxNodeTension), log_straight = std::log1p(kStraightTension);
     bool any = false;
     for (std::size_t i = first; i < end; ++i) {
         if (flag[i] == 0.0) continue;
         double lk, sum;
         if (!spread_decides(lkv[i], sumv[i], miss2v[i], lk, sum)) continue;  // within the certificate's margin
-        any = true;
         const double miss2 = miss2v[i];
         const double hin = len[i], hout = len[i + 1];
         const double inv_sum = 1.0 / sum;
@@ -762,6 +759,12 @@ bool concentrated_turns(const Chords& ch, std::size_t n, bool closed, std::vecto
         // Turning below ~1e-6 rad is rounding noise of collinear nodes (and invisible): nothing to decide.
         const double turn = 0.5 * sum * (hin + hout);
         const double unshared = smoothstep(kSpreadLo, kSpreadHi, d) * smoothstep(1e-8, 1e-6, turn);
+        // Smoothsteps are +0 .. 1 (or NaN): an unshared turn of 0 gives g = straight = w = +0, the fill's values,
+        // so the outputs are filled only at the first node that gets a weight (many wires' flagged nodes are
+        // straight ones, turn < 1e-8, and none does).
+        if (unshared == 0.0) continue;
+        if (!any) g.assign(n, 0.0), straight.assign(n, 0.0), w.assign(n, 0.0);
+        any = true;
         const double share = lk * inv_sum;
         g[i] = unshared * smoothstep(kShareLo, kShareHi, share);
         straight[i] = unshared * (1.0 - smoothstep(kStraightLo, kStraightHi, share));
