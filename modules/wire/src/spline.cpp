@@ -601,7 +601,7 @@ void edge_kernel(std::size_t n, const double* __restrict tx, const double* __res
 // Ranges: s2 in [2^-900, 2^1000] keeps every value above normal numbers' range floor (sum >= 2^-451, the threshold
 // >= 2^-903: no underflow's absolute error) and finite (sum <= 2^501). A NaN fails a comparison. Nodes outside
 // the certificate (a node that may turn without support, or out of range) take the exact test with the roots.
-// (WireCurveSpread.CertificateEqualsTheExactTest tests it near the boundary.)
+// (WireCurveFamilies.SpreadCertificateEqualsTheExactTest tests it near the boundary.)
 constexpr double kSpreadBound = 0.3024;
 static_assert(kSpreadBound < 0.3025 * (1.0 - 0x1p-12) && 0.3025 <= kSpreadLo * kSpreadLo,
               "kSpreadBound must stay below kSpreadLo^2 by more than the roundings of the proof");
