@@ -609,14 +609,14 @@ static_assert(kSpreadBound < 0.3025 * (1.0 - 0x1p-12) && 0.3025 <= kSpreadLo * k
 // Per node (arrays offset so that node i's incoming chord length, previous node's curvature and previous edge are
 // at index i, its own at i + 1, the next node's curvature at i + 2): the turn its neighbours predict, the spread's
 // ingredients |k|^2, |k~|^2 and |k - k~|^2, and flag 1 where the spread may have to be decided (0: the neighbours
-// predict this turn, d <= kSpreadLo, shown on squares without a root by kSpreadBound; the flagged nodes, rare,
-// take the exact test in concentrated_turns).
+// predict this turn, d <= kSpreadLo, shown on squares without a root by kSpreadBound; the flagged nodes, about one
+// a wire on a swaying cable, take the exact test in concentrated_turns). Returns the number of flagged nodes.
 WIRE_VECTOR_CLONES WIRE_SELECT_KERNEL
 std::size_t spread_kernel(std::size_t count, const double* __restrict len, const double* __restrict kx,
-                   const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
-                   const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
-                   const double* __restrict eq, double* __restrict lk2v, double* __restrict lp2v,
-                   double* __restrict miss2v, double* __restrict flag) {
+                          const double* __restrict ky, const double* __restrict kz, const double* __restrict ax,
+                          const double* __restrict ay, const double* __restrict az, const double* __restrict ec,
+                          const double* __restrict eq, double* __restrict lk2v, double* __restrict lp2v,
+                          double* __restrict miss2v, double* __restrict flag) {
     std::size_t flagged = 0;
     for (std::size_t i = 0; i < count; ++i) {
         const double hin = len[i], hout = len[i + 1];
@@ -669,8 +669,9 @@ bool spread_decides(double lk2, double lp2, double miss2, double& lk, double& su
     return (sum > 0.0) & (sum <= DBL_MAX) & !(miss2 <= (kSpreadLo * sum) * (kSpreadLo * sum));
 }
 
-// The exact test for the nodes spread_kernel flagged (its outputs, count nodes): a flag stays 1 where the spread
-// must be decided (lk2v, lp2v then hold |k| and |k| + |k~|), else becomes 0. Returns whether any stays 1.
+// The exact test for the nodes spread_kernel flagged (its outputs, count nodes), as concentrated_turns' weight loop
+// applies it, for the tests (detail::spread_test): a flag stays 1 where the spread must be decided (lk2v, lp2v then
+// hold |k| and |k| + |k~|), else becomes 0. Returns whether any stays 1.
 bool decide_flagged(std::size_t count, double* lk2v, double* lp2v, const double* miss2v, double* flag) {
     bool any = false;
     for (std::size_t i = 0; i < count; ++i) {
