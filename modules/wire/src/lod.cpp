@@ -114,7 +114,7 @@ const EdgeFactors& edge_factors(const LodView& view) {
 // bits, without a division's latency at the start of every wire's update.
 bool same_bits(double a, double b) { return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b); }
 double focal_over_tolerance(double focal_px, double eps) {
-    thread_local double f = std::numeric_limits<double>::quiet_NaN(), e = f, q = f;
+    thread_local double f = std::numeric_limits<double>::quiet_NaN(), e = f, q = f;  // NaN / NaN: that NaN
     if (!same_bits(f, focal_px) || !same_bits(e, eps)) {
         f = focal_px;
         e = eps;
@@ -123,7 +123,7 @@ double focal_over_tolerance(double focal_px, double eps) {
     return q;
 }
 double new_span_scale(double band) {
-    thread_local double b = std::numeric_limits<double>::quiet_NaN(), q = 1.0;
+    thread_local double b = std::numeric_limits<double>::quiet_NaN(), q = b;  // 1 / (1 + NaN): that NaN
     if (!same_bits(b, band)) {
         b = band;
         q = band < 0.0 ? 1.0 : 1.0 / (1.0 + band);
