@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -106,29 +105,6 @@ const EdgeFactors& edge_factors(const LodView& view) {
         e = {tx, ty, std::sqrt(1.0 + tx * tx), std::sqrt(1.0 + ty * ty), std::sqrt(1.0 + tx * tx + ty * ty)};
     }
     return e;
-}
-
-// Quotients every update of a frame divides again on the same operands: the tolerance factor focal / eps (the span
-// walk and update_lod_once()'s level stop) and the new-span threshold 1 / (1 + band). The last operands' are kept per
-// thread (compared bit for bit, so a -0 is not taken for a +0): the same operation on the same operands, the same
-// bits, without a division's latency at the start of every wire's update.
-bool same_bits(double a, double b) { return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b); }
-double focal_over_tolerance(double focal_px, double eps) {
-    thread_local double f = std::numeric_limits<double>::quiet_NaN(), e = f, q = f;  // NaN / NaN: that NaN
-    if (!same_bits(f, focal_px) || !same_bits(e, eps)) {
-        f = focal_px;
-        e = eps;
-        q = focal_px / eps;
-    }
-    return q;
-}
-double new_span_scale(double band) {
-    thread_local double b = std::numeric_limits<double>::quiet_NaN(), q = b;  // 1 / (1 + NaN): that NaN
-    if (!same_bits(b, band)) {
-        b = band;
-        q = band < 0.0 ? 1.0 : 1.0 / (1.0 + band);
-    }
-    return q;
 }
 
 // The frustum planes in view space, tested against points inflated by a radius: bit i is set when the point is
@@ -613,7 +589,7 @@ public:
         : b_(b),
           view_(view),
           tf_(view),
-          c_(focal_over_tolerance(view.focal_px, eps)),
+          c_(view.focal_px / eps),
           k_(k),
           k_cap_(edge_factors(view).corner),
           closed_(closed),
@@ -1164,7 +1140,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
         sb.k = edge_factors(view).corner;
     }
     SpanMerger merger(bounds, view, lim.eps, sb.inside, sb.k, curve.closed,
-                      settings.coarse_offscreen_segments, new_span_scale(lim.band), old);
+                      settings.coarse_offscreen_segments, lim.band < 0.0 ? 1.0 : 1.0 / (1.0 + lim.band), old);
     // The margin only serves a Coherence, which is kept for bounds that outlive this update and a wire inside.
     const bool keeps_coherence = use_bound && !bounds.transient && sb.inside;
     if (!keeps_coherence) merger.skip_margin();
@@ -1589,7 +1565,7 @@ bool update_lod_once(const Curve& curve, const BoundingSphere& sphere, const Lod
     const double extent = (std::abs(sphere.centre_m.x) + std::abs(sphere.centre_m.y) + std::abs(sphere.centre_m.z)) +
                           sphere.radius_m;
     const double eye = (std::abs(view.eye_m.x) + std::abs(view.eye_m.y)) + std::abs(view.eye_m.z);
-    const TopLevels stop{focal_over_tolerance(view.focal_px, eps), sb.k, zh + 1e-6 * ((zh + extent) + eye)};
+    const TopLevels stop{view.focal_px / eps, sb.k, zh + 1e-6 * ((zh + extent) + eye)};
     const bool may_stop = sb.inside && !settings.keep_node_resolution && extent <= 1e149 && eye <= 1e149 &&
                           zh > 0.0 && zh <= 1e149 && std::isfinite(stop.c * stop.k);
     const std::size_t built = compute_lod_bounds_impl(curve, bounds, &sphere, may_stop ? &stop : nullptr);

@@ -26,7 +26,6 @@
 #include <numbers>
 #include <random>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace wire {
@@ -1009,59 +1008,6 @@ TEST(LodCheapPass, UpdateOnceEqualsTheFullBounds) {
     std::printf("%zu updates, %zu visible, %zu with levels left out\n", updates, visible, left_out);
     EXPECT_GT(visible, updates / 2);
     EXPECT_GT(left_out, updates / 5);
-}
-
-// The update keeps focal / eps and 1 / (1 + band) per thread for the last operands: updates that alternate between
-// tolerances, bands and focal lengths on one thread must each equal the same update made alone on a fresh thread
-// (whose first update divides anew). 60 random wires, two views of different focal lengths, four settings.
-TEST(LodCheapPass, KeptQuotientsFollowTheSettings) {
-    Rng rng(59);
-    // The last one's band is NaN: its threshold 1 / (1 + NaN) is NaN (no new span passes), also on a fresh thread.
-    const LodSettings settings[4] = {{},
-                                     {.tolerance_px = 2.0, .hysteresis_band = 0.3},
-                                     {.hysteresis_band = -1.0},
-                                     {.hysteresis_band = std::numeric_limits<double>::quiet_NaN()}};
-    struct Case {
-        Curve curve;
-        BoundingSphere sphere;
-        LodView view;
-        int setting;
-        WireLod alone;
-    };
-    std::vector<Case> cases;
-    for (int i = 0; i < 60; ++i) {
-        Curve curve;
-        ASSERT_TRUE(family_curve(i, rng, curve));
-        const BoundingSphere sphere = curve_bounding_sphere(curve);
-        for (const double fov : {kFov, 0.6 * kFov}) {
-            // The whole wire in view, 1.5 to 20 times as far as the distance that fills the view.
-            const double d = sphere.radius_m / std::tan(0.5 * fov) * std::exp(uniform(rng, 0.4, 3.0));
-            const glm::dvec3 eye = sphere.centre_m + random_unit(rng) * d;
-            glm::dvec3 up(0, 1, 0);
-            if (glm::length(glm::cross(glm::normalize(sphere.centre_m - eye), up)) < 1e-3) up = glm::dvec3(1, 0, 0);
-            const LodView view = LodView::perspective(eye, sphere.centre_m, up, fov, kWidth, kHeight, 0.05, 1e6);
-            if (sphere_outside_view(sphere, view)) continue;  // update_lod_once()'s precondition
-            for (int k = 0; k < 4; ++k) cases.push_back({curve, sphere, view, (i + k) % 4, {}});
-        }
-    }
-    for (Case& c : cases)  // alone: the first update of a fresh thread
-        std::thread([&c, &settings] { update_lod_once(c.curve, c.sphere, c.view, settings[c.setting], c.alone); })
-            .join();
-    auto bits = [](double x) { return std::bit_cast<uint64_t>(x); };
-    std::size_t merged = 0;
-    for (std::size_t i = 0; i < cases.size(); ++i) {  // one thread, the settings and views alternating
-        const Case& c = cases[i];
-        WireLod lod;
-        update_lod_once(c.curve, c.sphere, c.view, settings[c.setting], lod);
-        ASSERT_EQ(lod.counts, c.alone.counts) << "case " << i;
-        ASSERT_EQ(lod.required, c.alone.required) << "case " << i;
-        ASSERT_EQ(lod.spans, c.alone.spans) << "case " << i;
-        ASSERT_EQ(lod.sides, c.alone.sides) << "case " << i;
-        ASSERT_EQ(bits(lod.radius_px), bits(c.alone.radius_px)) << "case " << i;
-        merged += lod.spans > 0 ? 1 : 0;
-    }
-    std::printf("%zu updates, %zu with merged spans\n", cases.size(), merged);
-    EXPECT_GT(merged, cases.size() / 5);  // the quotients decide spans in a fair share of them
 }
 
 // The coherence test of the cheap pass (a wire whose decisions cannot have changed keeps its state) answers
