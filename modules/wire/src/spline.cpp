@@ -1103,20 +1103,15 @@ void thomas_quad_kernel(std::size_t n, const double* __restrict a_, const double
     f[n - 1] = fb;
     for (int q = 0; q < 3; ++q) u[q] = r[q][n - 1] * inv, r[q][n - 1] = u[q];
     std::size_t i = 1, j = n - 2;
-    // The top chain's row i and the bottom chain's row j (no lambdas: a target clone would not inline them).
-#define WIRE_TOP(i)                                                                                        \
+    // Row k of one chain (no lambdas: a target clone would not inline them): the top chain's row i is
+    // WIRE_ROW(i, a, c, ft, t), the bottom chain's row j WIRE_ROW(j, c, a, fb, u) (its sub- and super-diagonals
+    // swap roles). fv and v are the chain's factor and right-hand sides, carried from row to row.
+#define WIRE_ROW(k, sub, super, fv, v)                                                                     \
     {                                                                                                      \
-        const v4d ai = a[i], it = one / (b[i] - ai * ft);                                                  \
-        ft = c[i] * it;                                                                                    \
-        f[i] = ft;                                                                                         \
-        for (int q = 0; q < 3; ++q) t[q] = (r[q][i] - ai * t[q]) * it, r[q][i] = t[q];                     \
-    }
-#define WIRE_BOTTOM(j)                                                                                     \
-    {                                                                                                      \
-        const v4d cj = c[j], ib = one / (b[j] - cj * fb);                                                  \
-        fb = a[j] * ib;                                                                                    \
-        f[j] = fb;                                                                                         \
-        for (int q = 0; q < 3; ++q) u[q] = (r[q][j] - cj * u[q]) * ib, r[q][j] = u[q];                     \
+        const v4d sk = sub[k], ik = one / (b[k] - sk * fv);                                                \
+        fv = super[k] * ik;                                                                                \
+        f[k] = fv;                                                                                         \
+        for (int q = 0; q < 3; ++q) v[q] = (r[q][k] - sk * v[q]) * ik, r[q][k] = v[q];                     \
     }
 #define WIRE_BACK(i, v)                                                                                    \
     {                                                                                                      \
@@ -1124,11 +1119,11 @@ void thomas_quad_kernel(std::size_t n, const double* __restrict a_, const double
         for (int q = 0; q < 3; ++q) v[q] = r[q][i] - fi * v[q], r[q][i] = v[q];                            \
     }
     for (; i < p && j > p; ++i, --j) {
-        WIRE_TOP(i)
-        WIRE_BOTTOM(j)
+        WIRE_ROW(i, a, c, ft, t)
+        WIRE_ROW(j, c, a, fb, u)
     }
-    for (; i < p; ++i) WIRE_TOP(i)
-    for (; j > p; --j) WIRE_BOTTOM(j)
+    for (; i < p; ++i) WIRE_ROW(i, a, c, ft, t)
+    for (; j > p; --j) WIRE_ROW(j, c, a, fb, u)
     // Row p, as thomas_kernel's.
     inv = one / (b[p] - a[p] * ft - c[p] * fb);
     for (int q = 0; q < 3; ++q) t[q] = (r[q][p] - a[p] * t[q] - c[p] * u[q]) * inv, r[q][p] = t[q], u[q] = t[q];
@@ -1145,8 +1140,7 @@ void thomas_quad_kernel(std::size_t n, const double* __restrict a_, const double
         ++j;
         WIRE_BACK(j, u)
     }
-#undef WIRE_TOP
-#undef WIRE_BOTTOM
+#undef WIRE_ROW
 #undef WIRE_BACK
 }
 
