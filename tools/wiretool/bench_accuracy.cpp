@@ -10,7 +10,7 @@
 #include <wire/frames.hpp>
 #include <wire/lod.hpp>
 #include <wire/multires.hpp>
-#include <wire/reference.hpp>
+#include <wire/testing/reference.hpp>
 #include <wire/rings.hpp>
 #include <wire/spline.hpp>
 #include <wire/tessellate.hpp>

@@ -4,7 +4,7 @@
 // accuracy.md, and one panel of speed_vs_error.png.
 #include "bench_families.hpp"
 
-#include <wire/families.hpp>
+#include <wire/testing/families.hpp>
 #include <wire/spline.hpp>
 
 #include <cstdio>

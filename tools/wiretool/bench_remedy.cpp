@@ -4,7 +4,7 @@
 #include "bench_common.hpp"
 #include "commands.hpp"
 
-#include <wire/remedy_family.hpp>
+#include <wire/testing/remedy_family.hpp>
 
 #include <algorithm>
 #include <cstdio>

@@ -12,7 +12,7 @@
 #include <engine/platform/context.hpp>
 #include <wire/io/wire_json.hpp>
 #include <wire/lod.hpp>
-#include <wire/reference.hpp>
+#include <wire/testing/reference.hpp>
 #include <wire/render/upload_plan.hpp>
 #include <wire/render/wire_renderer.hpp>
 #include <wire/rings.hpp>

@@ -4,7 +4,7 @@
 #include "wire/bezier.hpp"
 #include "wire/multires.hpp"
 #include "wire/nodes.hpp"
-#include "wire/reference.hpp"
+#include "wire/testing/reference.hpp"
 #include "wire/spline.hpp"
 
 #include <glm/geometric.hpp>

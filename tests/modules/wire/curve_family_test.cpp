@@ -6,7 +6,7 @@
 #include "wire/bezier.hpp"
 #include "wire/curve.hpp"
 #include "wire/detail/segment_soa.hpp"
-#include "wire/families.hpp"
+#include "wire/testing/families.hpp"
 #include "wire/spline.hpp"
 
 #include <glm/geometric.hpp>

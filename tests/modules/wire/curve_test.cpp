@@ -5,8 +5,8 @@
 #include "wire/bezier.hpp"
 #include "wire/curve.hpp"
 #include "wire/nodes.hpp"
-#include "wire/reference.hpp"
-#include "wire/remedy_family.hpp"
+#include "wire/testing/reference.hpp"
+#include "wire/testing/remedy_family.hpp"
 #include "wire/spline.hpp"
 #include "wire/status.hpp"
 

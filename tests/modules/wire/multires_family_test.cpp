@@ -5,7 +5,7 @@
 // against the exact curve of the same nodes) never exceeds those pops; with no event running the drawn curve
 // is the exact one (to 1e-6 m; in fact bit for bit), which happens at most max_blend_s after the last event.
 #include "wire/multires.hpp"
-#include "wire/remedy_family.hpp"
+#include "wire/testing/remedy_family.hpp"
 
 #include <gtest/gtest.h>
 

@@ -13,7 +13,7 @@
 //                           wire's origin (ring 0): centres, unit tangents, double-reflection frames, texture u by
 //                           the same 3-point Gauss rule
 // Usage: example_float_precision [cases_per_family=60]
-#include "wire/families.hpp"
+#include "wire/testing/families.hpp"
 #include "wire/rings.hpp"
 #include "wire/spline.hpp"
 #include "wire/tessellate.hpp"

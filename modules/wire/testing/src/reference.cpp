@@ -1,5 +1,5 @@
 // The exact catenary reference (DESIGN 4.8).
-#include "wire/reference.hpp"
+#include "wire/testing/reference.hpp"
 
 #include <glm/geometric.hpp>
 

@@ -1,8 +1,9 @@
 // Random families of realistic wires with an exact answer (see families.hpp).
-#include "wire/families.hpp"
+#include "wire/testing/families.hpp"
+#include "wire/testing/random.hpp"
 
 #include "wire/bezier.hpp"
-#include "wire/reference.hpp"
+#include "wire/testing/reference.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -17,26 +18,9 @@ namespace {
 using glm::dvec3;
 constexpr double kPi = std::numbers::pi;
 
-/// splitmix64: the same numbers on every platform and standard library (std distributions are not).
-struct Rng {
-    uint64_t s;
-    explicit Rng(uint64_t seed) : s(seed) {}
-    uint64_t next() {
-        uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-    double log_uniform(double lo, double hi) { return std::exp(uniform(std::log(lo), std::log(hi))); }
-    int integer(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<uint64_t>(hi - lo + 1)); }
-    dvec3 unit() {  // uniform on the sphere
-        const double z = uniform(-1.0, 1.0), a = uniform(0.0, 2.0 * kPi), r = std::sqrt(std::max(0.0, 1.0 - z * z));
-        return {r * std::cos(a), r * std::sin(a), z};
-    }
-};
+using Rng = testing::Random;
 
-Rng case_rng(uint64_t seed, int index) { return Rng(seed * 0x100000001B3ull + static_cast<uint64_t>(index) * 0x9E3779B97F4A7C15ull); }
+Rng case_rng(uint64_t seed, int index) { return Rng{seed * 0x100000001B3ull + static_cast<uint64_t>(index) * 0x9E3779B97F4A7C15ull}; }
 
 /// A unit vector perpendicular to d (any).
 dvec3 perpendicular(const dvec3& d) {

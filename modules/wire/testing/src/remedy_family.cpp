@@ -1,8 +1,9 @@
 // Random node-event families for the pop-free remedy and the exact curve distance they are measured with.
-#include "wire/remedy_family.hpp"
+#include "wire/testing/remedy_family.hpp"
+#include "wire/testing/random.hpp"
 
 #include "wire/bezier.hpp"
-#include "wire/reference.hpp"
+#include "wire/testing/reference.hpp"
 #include "wire/spline.hpp"
 
 #include <glm/geometric.hpp>
@@ -19,22 +20,7 @@ namespace {
 
 using glm::dvec3;
 
-// splitmix64: the same numbers on every platform (std distributions are implementation-defined).
-struct Rng {
-    uint64_t state;
-    uint64_t next() {
-        uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
-    int integer(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<uint64_t>(hi - lo + 1)); }
-    dvec3 direction() {
-        const double z = uniform(-1.0, 1.0), phi = uniform(0.0, 2.0 * std::numbers::pi), r = std::sqrt(1.0 - z * z);
-        return {r * std::cos(phi), r * std::sin(phi), z};
-    }
-};
+using Rng = testing::Random;
 
 // Foot points on one curve: per-segment bounding spheres of the control points for pruning, and a warm start
 // (the previous query's foot) for the usual case of queries that walk along the curve.
@@ -168,7 +154,7 @@ WireNodes closed_loop(Rng& rng, double& length_m) {
     const double r = length_m / (2.0 * std::numbers::pi);
     const double a = r * rng.uniform(1.0, 1.3), b = r * rng.uniform(0.7, 1.0), h = rng.uniform(0.0, 1.0);
     const int lobes = rng.integer(2, 3), n = rng.integer(24, 48);
-    const dvec3 axis = rng.direction();
+    const dvec3 axis = rng.unit();
     const dvec3 u = glm::normalize(glm::cross(axis, std::abs(axis.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0)));
     const dvec3 v = glm::cross(axis, u);
     const dvec3 centre(rng.uniform(-50.0, 50.0), rng.uniform(0.0, 20.0), rng.uniform(-50.0, 50.0));
@@ -303,7 +289,7 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
                 nodes.ids.erase(nodes.ids.begin() + static_cast<std::ptrdiff_t>(victim));
             } else {  // an end node re-created by the physics under a new id, up to 2 mm from where it was
                 const std::size_t at = rng.integer(0, 1) == 0 ? 0 : n - 1;
-                nodes.positions[at] += rng.uniform(0.0, 2e-3) * rng.direction();
+                nodes.positions[at] += rng.uniform(0.0, 2e-3) * rng.unit();
                 nodes.ids[at] = next_id++;
             }
             step(type);
