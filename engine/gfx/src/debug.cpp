@@ -112,6 +112,16 @@ void enable_debug_output(const DebugOutputDesc& desc) {
     glDebugMessageCallback(on_debug_message, &g_state);
 }
 
+std::string buffer_label(unsigned name) {
+    if (!glIsBuffer(name)) return {};
+    GLsizei length = 0;
+    glGetObjectLabel(GL_BUFFER, name, 0, &length, nullptr);
+    std::string label(static_cast<std::size_t>(length) + 1, '\0');
+    glGetObjectLabel(GL_BUFFER, name, static_cast<GLsizei>(label.size()), &length, label.data());
+    label.resize(static_cast<std::size_t>(length));
+    return label;
+}
+
 void disable_debug_output() {
     glDebugMessageCallback(nullptr, nullptr);
     glDisable(GL_DEBUG_OUTPUT);

@@ -27,4 +27,8 @@ struct DebugOutputDesc {
 void enable_debug_output(const DebugOutputDesc& desc = {});
 void disable_debug_output();
 
+// The KHR_debug label of the buffer object `name` ("" when it is no buffer or has no label). Drivers recycle
+// deleted names, so a test that a buffer was deleted checks that its name is gone or now labels another object.
+std::string buffer_label(unsigned name);
+
 }  // namespace engine::gfx
