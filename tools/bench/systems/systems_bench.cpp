@@ -2,8 +2,8 @@
 // hanging wires seen by a moving camera: CPU time per frame and per system, counts, upload bytes, measured
 // screen error, and a uniform tessellation with the same maximum screen error as the baseline. Writes
 // bench.csv and bench.md.
-#include "bench_common.hpp"
-#include "commands.hpp"
+#include "bench/common.hpp"
+#include "wiretool/commands.hpp"
 
 #include <engine/ecs/registry.hpp>
 #include <engine/gfx/gpu_timer.hpp>

@@ -2,9 +2,9 @@
 // (catenary, helix, stretched run + tight bend, hairpin, smooth random curve, churn), every spline method,
 // three frame methods and five LOD tolerances; per row time, size, world/screen/twist error and pops. Writes
 // accuracy.csv, accuracy.md, stability.md and speed_vs_error.png (gnuplot, when installed).
-#include "bench_common.hpp"
-#include "bench_families.hpp"
-#include "commands.hpp"
+#include "bench/common.hpp"
+#include "bench/accuracy/families.hpp"
+#include "wiretool/commands.hpp"
 
 #include <wire/bezier.hpp>
 #include <wire/frames.hpp>
