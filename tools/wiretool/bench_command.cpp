@@ -1,7 +1,7 @@
 // `wiretool bench`: standard scenes through the wire systems (bench.csv, bench.md) and speed against error on
 // reference scenes (accuracy.csv, accuracy.md, stability.md, speed_vs_error.png). A contract: see
 // docs/speed_vs_error.md.
-#include "bench_common.hpp"
+#include "bench/common.hpp"
 #include "commands.hpp"
 
 #include <cstdio>

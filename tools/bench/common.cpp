@@ -1,5 +1,5 @@
 // `wiretool bench`: shared helpers (clocks, medians, upload sizes, tables).
-#include "bench_common.hpp"
+#include "bench/common.hpp"
 
 #include <wire/render/upload_plan.hpp>
 

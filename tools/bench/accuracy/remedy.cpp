@@ -1,8 +1,8 @@
 // `wiretool bench`: the pop-free remedy over random node-event families (wire/remedy_family.hpp), per spline
 // method: remedy_families.csv and remedy_families.md (distributions of the instant pop, the per-frame jump, the
 // lag and the settling time; the worst ratios and the worst case).
-#include "bench_common.hpp"
-#include "commands.hpp"
+#include "bench/common.hpp"
+#include "wiretool/commands.hpp"
 
 #include <wire/testing/remedy_family.hpp>
 

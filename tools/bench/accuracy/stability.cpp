@@ -1,6 +1,6 @@
 // `wiretool bench`, part 3: the hard cases of DESIGN §5 run through the wire pipeline (and the bend chain),
 // as a table: what was tried, what came out, and the largest error measured for it.
-#include "bench_common.hpp"
+#include "bench/common.hpp"
 
 #include <curved_space/chain.hpp>
 #include <wire/pipeline.hpp>

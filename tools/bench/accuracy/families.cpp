@@ -2,7 +2,7 @@
 // (the same seed and counts as tests/modules/wire/curve_family_test.cpp), reported as distributions of the
 // per-case maximum deviation from the exact curve. Writes families.csv and families.md, a Markdown section for
 // accuracy.md, and one panel of speed_vs_error.png.
-#include "bench_families.hpp"
+#include "bench/accuracy/families.hpp"
 
 #include <wire/testing/families.hpp>
 #include <wire/spline.hpp>

@@ -1,8 +1,8 @@
-// `wiretool bench`: the random-family part (bench_families.cpp). Runs when the scene `families` is selected
+// `wiretool bench`: the random-family part (families.cpp). Runs when the scene `families` is selected
 // (every run without --scenes); writes families.csv / families.md and adds a section and a plot panel.
 #pragma once
 
-#include "bench_common.hpp"
+#include "bench/common.hpp"
 
 #include <cstddef>
 #include <filesystem>
