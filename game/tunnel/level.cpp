@@ -5,6 +5,7 @@
 
 #include <curved_space/gpu.hpp>
 #include <engine/assets/gltf.hpp>
+#include <engine/assets/mesh_building.hpp>
 #include <engine/assets/subdivide.hpp>
 #include <engine/ecs/registry.hpp>
 #include <engine/gfx/gpu_timer.hpp>
@@ -72,41 +73,6 @@ struct FixedCable {
     double x = 0.0, y = 0.0;  // unbent cross-section position
     std::size_t cable = 0;
 };
-
-// A quad as two triangles (a,b,c), (a,c,d) with one normal (make_control_mesh recovers the quad; the
-// different normals of neighbouring faces make every box edge a crease, so refined boxes stay boxes).
-void add_quad(engine::assets::MeshData& m, const std::array<glm::dvec3, 4>& p, const glm::dvec3& normal) {
-    const auto base = static_cast<uint32_t>(m.vertex_count());
-    const glm::vec2 uv[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    for (int i = 0; i < 4; ++i) {
-        m.positions.insert(m.positions.end(), {static_cast<float>(p[static_cast<std::size_t>(i)].x),
-                                               static_cast<float>(p[static_cast<std::size_t>(i)].y),
-                                               static_cast<float>(p[static_cast<std::size_t>(i)].z)});
-        m.normals.insert(m.normals.end(), {static_cast<float>(normal.x), static_cast<float>(normal.y),
-                                           static_cast<float>(normal.z)});
-        m.uvs.insert(m.uvs.end(), {uv[i].x, uv[i].y});
-    }
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
-// A box centred at c with half extents h along the orthonormal axes u, v, w (right-handed), faces outward.
-void add_box(engine::assets::MeshData& m, const glm::dvec3& c, const glm::dvec3& u, const glm::dvec3& v,
-             const glm::dvec3& w, const glm::dvec3& h) {
-    const glm::dvec3 axes[3] = {u * h.x, v * h.y, w * h.z};
-    for (int a = 0; a < 3; ++a) {
-        const glm::dvec3 n = axes[a];
-        const glm::dvec3 s = axes[(a + 1) % 3];
-        const glm::dvec3 t = axes[(a + 2) % 3];
-        for (double sign : {1.0, -1.0}) {
-            const glm::dvec3 f = c + sign * n;
-            const glm::dvec3 dir = glm::normalize(sign * n);
-            if (sign > 0.0)
-                add_quad(m, {f - s - t, f + s - t, f + s + t, f - s + t}, dir);
-            else
-                add_quad(m, {f - s - t, f - s + t, f + s + t, f + s - t}, dir);
-        }
-    }
-}
 
 // ---- contact geometry in the unbent tunnel space (see LevelShapes) ----
 
@@ -588,7 +554,7 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings_in)
         const double r0 = rho - 0.3 * f.radius;
         const double r1 = shapes.rib_inner_radius_m + 0.02;
         for (const glm::dvec2& rz : shapes.rib_z_m)
-            add_box(clips, glm::dvec3(0.0, 0.0, 0.5 * (rz.x + rz.y)) + u * (0.5 * (r0 + r1)), u, v, w,
+            engine::assets::add_box(clips, glm::dvec3(0.0, 0.0, 0.5 * (rz.x + rz.y)) + u * (0.5 * (r0 + r1)), u, v, w,
                     {0.5 * (r1 - r0), f.radius + 0.008, 0.04});
         wire::WireNodes nodes;
         for (double z = 0.0; z <= total + 1e-9; z += 0.5)
