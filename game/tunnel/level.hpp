@@ -12,10 +12,12 @@
 //   wire.curve .. wire.draw_list   (wire::systems::install)
 //   tunnel.pieces   clear, per-piece subdivision level, bent instanced pieces (GL)
 //   wire.render     WireRenderer draws the frame's DrawList (GL)
-// Needs a current GL 4.5 context (engine::platform::Context) for create() and frame().
+// Needs a current GL 4.5 context (engine::platform::Context) for create() and frame(). level.cpp lists the
+// files that implement the level, one concept each.
 #pragma once
 
 #include "tunnel/rope.hpp"
+#include "tunnel/rope_contact.hpp"
 
 #include <curved_space/chain.hpp>
 #include <engine/assets/mesh_data.hpp>
@@ -39,6 +41,7 @@ namespace tunnel {
 
 using engine::platform::Error;
 using engine::platform::Expected;
+using engine::platform::Status;
 
 /// Fixed at creation. Zero means default.
 struct LevelSettings {
@@ -119,21 +122,6 @@ struct CableInfo {
     glm::dvec2 section_m{0.0};  ///< fixed cables: unbent cross-section position (x, y); runs along all z
 };
 
-/// The level geometry the ropes collide with, in the unbent tunnel space (z along the chain, piece k covers
-/// [4k, 4k + 4)), measured from the refined meshes at the highest cached level.
-struct LevelShapes {
-    double wall_radius_m = 0.0;       ///< the wall's inner surface (smallest distance from the axis)
-    double rib_inner_radius_m = 0.0;  ///< the ribs' inner faces
-    std::vector<glm::dvec2> rib_z_m;  ///< z range of each rib within a piece
-    glm::dvec2 walkway_min_m{0.0};    ///< walkway cross-section box (x, y), all along z
-    glm::dvec2 walkway_max_m{0.0};
-    struct Cable {
-        glm::dvec2 section_m{0.0};
-        double radius_m = 0.0;
-    };
-    std::vector<Cable> cables;  ///< the fixed wall cables
-};
-
 class Level {
 public:
     /// Loads the pieces, refines and uploads the cached subdivision levels, compiles the shaders, spawns the
@@ -177,8 +165,18 @@ public:
     [[nodiscard]] const engine::assets::MeshData& refined_mesh(std::size_t group) const;
 
 private:
-    struct State;
+    struct State;  // level_state.hpp
     Level();
+    // Creation, in order (create()): pieces (piece_meshes), anchors, chain (level_animation), wire renderer
+    // (level_render), fixed cables and clips (level_cables), ropes (rope_driving), settling, systems.
+    Status load_pieces();
+    void build_chain();
+    Status create_wire_renderer();
+    Status spawn_fixed_cables();
+    void spawn_ropes();
+    void settle();
+    void install_systems();
+    // The frame's systems and their parts.
     void animate(double time_s);
     void update_ropes(double dt_s);
     void update_cables();

@@ -1,9 +1,8 @@
 // PieceRenderer: bent, instanced tunnel pieces (see piece_renderer.hpp).
 #include "tunnel/piece_renderer.hpp"
 
+#include <engine/gfx/draw.hpp>
 #include <engine/gfx/resources.hpp>
-
-#include <epoxy/gl.h>
 
 #include <glm/geometric.hpp>
 
@@ -215,15 +214,10 @@ std::size_t PieceRenderer::begin(const PieceFrame& frame) {
     }
     if (s.segments && bytes > 0) s.segments.update(0, std::as_bytes(frame.segments));
     // Bind exactly the records of this frame: the shader's binary search uses the array's length().
-    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, curved_space::segment_buffer_binding, s.segments.id(), 0,
-                      static_cast<GLsizeiptr>(bytes));
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW);
+    gfx::bind_storage_range(curved_space::segment_buffer_binding, s.segments, 0, bytes);
+    gfx::set_opaque_state();
     s.wireframe = frame.wireframe;
-    if (frame.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+    if (frame.wireframe) gfx::set_wireframe(true);
     s.program.use();
     s.program.set("u_clip_from_rel", frame.clip_from_rel);
     s.program.set("u_to_light", frame.to_light);
@@ -240,19 +234,16 @@ void PieceRenderer::draw(MeshHandle mesh, Surface surface, const glm::vec3& albe
     const GpuPieceMesh& m = s.meshes[mesh];
     s.program.set("u_albedo", albedo);
     s.program.set("u_surface", static_cast<int>(surface));
-    m.vao.bind();
     for (std::size_t first = 0; first < piece_z_m.size(); first += kMaxInstances) {
         const std::size_t count = std::min<std::size_t>(kMaxInstances, piece_z_m.size() - first);
-        glProgramUniform1fv(s.program.id(), s.loc_piece_z, static_cast<GLsizei>(count),
-                            piece_z_m.data() + first);
-        glDrawElementsInstanced(GL_TRIANGLES, static_cast<GLsizei>(m.index_count), GL_UNSIGNED_INT, nullptr,
-                                static_cast<GLsizei>(count));
+        s.program.set(s.loc_piece_z, piece_z_m.subspan(first, count));
+        gfx::draw_instanced(m.vao, m.index_count, count);
     }
 }
 
 void PieceRenderer::end() {
-    if (state_->wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    glBindVertexArray(0);
+    if (state_->wireframe) gfx::set_wireframe(false);
+    gfx::unbind_vertex_array();
 }
 
 }  // namespace tunnel

@@ -1,7 +1,7 @@
 // Draws the tunnel's environment pieces bent along the curved space on the GPU: each refined piece mesh is
 // laid along +z once and drawn instanced, instance k shifted to its piece's start z and bent in the vertex
-// shader by curved_space's cs_bend() with the frame's segment records (camera-relative SSBO). The only tunnel
-// file that touches GL.
+// shader by curved_space's cs_bend() with the frame's segment records (camera-relative SSBO). Its GL goes
+// through engine/gfx (resources, draw).
 #pragma once
 
 #include <curved_space/gpu.hpp>

@@ -1,6 +1,8 @@
 // Coarse tunnel pieces: deliberately few quads (they are refined at run time for the bend they get).
 #include "tunnel_pieces.hpp"
 
+#include <engine/assets/mesh_building.hpp>
+
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 
@@ -11,50 +13,14 @@
 namespace tunnel {
 namespace {
 
+using engine::assets::add_quad;
 using engine::assets::MeshData;
 constexpr double kPi = 3.14159265358979323846;
-
-// Appends quad p0..p3 as the triangle pair (0,1,2), (0,2,3) with its own vertices (flat normal, so every
-// edge to a differently facing quad is a hard edge). The winding is flipped if needed so the front faces
-// `facing` (the side the quad is seen from).
-void add_quad(MeshData& m, std::array<glm::vec3, 4> p, std::array<glm::vec2, 4> uv, glm::vec3 facing) {
-    glm::vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
-    if (glm::dot(n, facing) < 0.0f) {
-        std::swap(p[1], p[3]);
-        std::swap(uv[1], uv[3]);
-        n = -n;
-    }
-    n = glm::normalize(n);
-    const auto base = static_cast<std::uint32_t>(m.vertex_count());
-    for (int k = 0; k < 4; ++k) {
-        m.positions.insert(m.positions.end(), {p[k].x, p[k].y, p[k].z});
-        m.normals.insert(m.normals.end(), {n.x, n.y, n.z});
-        m.uvs.insert(m.uvs.end(), {uv[k].x, uv[k].y});
-    }
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-}
-
-std::array<glm::vec2, 4> unit_uv() { return {glm::vec2(0, 0), {1, 0}, {1, 1}, {0, 1}}; }
 
 // Ring direction i of `around` (vertex angles offset by half a segment so the floor is a flat face).
 glm::vec3 radial(int i, int around) {
     const double a = (i + 0.5) * 2.0 * kPi / around - kPi / 2;
     return {static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f};
-}
-
-// A closed box of quads between lo and hi, `segments_z` quads along z on its four long sides.
-void add_box(MeshData& m, glm::vec3 lo, glm::vec3 hi, int segments_z) {
-    for (int s = 0; s < segments_z; ++s) {
-        const float z0 = lo.z + (hi.z - lo.z) * static_cast<float>(s) / static_cast<float>(segments_z);
-        const float z1 = lo.z + (hi.z - lo.z) * static_cast<float>(s + 1) / static_cast<float>(segments_z);
-        const std::array<glm::vec2, 4> uv{glm::vec2(0, z0), {1, z0}, {1, z1}, {0, z1}};
-        add_quad(m, {glm::vec3(lo.x, hi.y, z0), {hi.x, hi.y, z0}, {hi.x, hi.y, z1}, {lo.x, hi.y, z1}}, uv, {0, 1, 0});
-        add_quad(m, {glm::vec3(lo.x, lo.y, z0), {hi.x, lo.y, z0}, {hi.x, lo.y, z1}, {lo.x, lo.y, z1}}, uv, {0, -1, 0});
-        add_quad(m, {glm::vec3(lo.x, lo.y, z0), {lo.x, hi.y, z0}, {lo.x, hi.y, z1}, {lo.x, lo.y, z1}}, uv, {-1, 0, 0});
-        add_quad(m, {glm::vec3(hi.x, lo.y, z0), {hi.x, hi.y, z0}, {hi.x, hi.y, z1}, {hi.x, lo.y, z1}}, uv, {1, 0, 0});
-    }
-    add_quad(m, {glm::vec3(lo.x, lo.y, lo.z), {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z}}, unit_uv(), {0, 0, -1});
-    add_quad(m, {glm::vec3(lo.x, lo.y, hi.z), {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}}, unit_uv(), {0, 0, 1});
 }
 
 }  // namespace
@@ -96,10 +62,10 @@ std::vector<MeshData> wall_details(const TunnelSpec& spec) {
             const float u1 = static_cast<float>(i + 1) / static_cast<float>(spec.around);
             const std::array<glm::vec2, 4> uv{glm::vec2(u0, 0), {u1, 0}, {u1, 1}, {u0, 1}};
             const auto p = [](glm::vec3 dir, float r, float z) { return glm::vec3(r * dir.x, r * dir.y, z); };
-            add_quad(rib, {p(a, r_in, z0), p(b, r_in, z0), p(b, r_in, z1), p(a, r_in, z1)}, uv, -mid);
-            add_quad(rib, {p(a, r_out, z0), p(b, r_out, z0), p(b, r_out, z1), p(a, r_out, z1)}, uv, mid);
-            add_quad(rib, {p(a, r_in, z0), p(b, r_in, z0), p(b, r_out, z0), p(a, r_out, z0)}, uv, {0, 0, -1});
-            add_quad(rib, {p(a, r_in, z1), p(b, r_in, z1), p(b, r_out, z1), p(a, r_out, z1)}, uv, {0, 0, 1});
+            add_quad(rib, {.corners = {p(a, r_in, z0), p(b, r_in, z0), p(b, r_in, z1), p(a, r_in, z1)}, .uvs = uv, .facing = -mid});
+            add_quad(rib, {.corners = {p(a, r_out, z0), p(b, r_out, z0), p(b, r_out, z1), p(a, r_out, z1)}, .uvs = uv, .facing = mid});
+            add_quad(rib, {.corners = {p(a, r_in, z0), p(b, r_in, z0), p(b, r_out, z0), p(a, r_out, z0)}, .uvs = uv, .facing = {0, 0, -1}});
+            add_quad(rib, {.corners = {p(a, r_in, z1), p(b, r_in, z1), p(b, r_out, z1), p(a, r_out, z1)}, .uvs = uv, .facing = {0, 0, 1}});
         }
         // Smooth around the ring, hard at its four corner circles: the inner and outer bands get radial
         // normals (equal where neighbouring quads meet), the flat end faces keep +-z, so only the corner
@@ -117,7 +83,7 @@ std::vector<MeshData> wall_details(const TunnelSpec& spec) {
     }
     MeshData walkway;
     walkway.name = "walkway";
-    add_box(walkway, {-1.1f, spec.walkway_top_y_m - 0.1f, 0.0f}, {1.1f, spec.walkway_top_y_m, spec.length_m}, spec.along);
+    engine::assets::add_box_along_z(walkway, {-1.1f, spec.walkway_top_y_m - 0.1f, 0.0f}, {1.1f, spec.walkway_top_y_m, spec.length_m}, spec.along);
     out.push_back(std::move(walkway));
     return out;
 }
@@ -161,8 +127,9 @@ std::vector<MeshData> cable_hooks(const TunnelSpec& spec) {
             // Outward in the profile plane: the profile runs counter-clockwise in (s, y), so right of e.
             const glm::vec3 facing(in * e.y, -e.x, 0.0f);
             const float len = glm::length(e);
-            add_quad(m, {P(q0, -half_z), P(q1, -half_z), P(q1, half_z), P(q0, half_z)},
-                     {glm::vec2(0, 0), {len, 0}, {len, 2 * half_z}, {0, 2 * half_z}}, facing);
+            add_quad(m, {.corners = {P(q0, -half_z), P(q1, -half_z), P(q1, half_z), P(q0, half_z)},
+                         .uvs = {glm::vec2(0, 0), {len, 0}, {len, 2 * half_z}, {0, 2 * half_z}},
+                         .facing = facing});
         }
         const std::array<std::array<int, 4>, 3> caps{{{0, 1, 6, 7}, {1, 2, 3, 6}, {6, 3, 4, 5}}};
         for (float z : {-half_z, half_z})
@@ -173,7 +140,7 @@ std::vector<MeshData> cable_hooks(const TunnelSpec& spec) {
                     p[static_cast<std::size_t>(k)] = P(profile[static_cast<std::size_t>(cap[static_cast<std::size_t>(k)])], z);
                     uv[static_cast<std::size_t>(k)] = profile[static_cast<std::size_t>(cap[static_cast<std::size_t>(k)])];
                 }
-                add_quad(m, p, uv, {0, 0, z});
+                add_quad(m, {.corners = p, .uvs = uv, .facing = {0, 0, z}});
             }
         out.push_back(std::move(m));
     }

@@ -1,6 +1,8 @@
 // LitRenderer: one program, one draw call per mesh.
 #include "engine/gfx/lit_renderer.hpp"
 
+#include "engine/gfx/draw.hpp"
+
 #include <epoxy/gl.h>
 
 #include <glm/geometric.hpp>
@@ -47,11 +49,7 @@ Expected<LitRenderer> LitRenderer::create() {
 }
 
 void LitRenderer::begin(const glm::mat4& clip_from_world, const DirectionalLight& light) const {
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW);
+    set_opaque_state();
     program_.use();
     program_.set("u_clip_from_world", clip_from_world);
     program_.set("u_to_light", glm::normalize(light.to_light));

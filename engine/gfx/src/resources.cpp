@@ -225,6 +225,9 @@ void Program::set(const char* name, const glm::mat3& m) const {
 void Program::set(const char* name, const glm::mat4& m) const {
     glProgramUniformMatrix4fv(id(), uniform_location(name), 1, GL_FALSE, glm::value_ptr(m));
 }
+void Program::set(int location, std::span<const float> values) const {
+    glProgramUniform1fv(id(), location, static_cast<GLsizei>(values.size()), values.data());
+}
 
 // ---- Textures --------------------------------------------------------------------------------------------
 

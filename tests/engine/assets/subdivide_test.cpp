@@ -1,6 +1,7 @@
 // Catmull-Clark refinement (counts, finiteness, uvs, watertightness, errors), the screen-error level choice
 // measured against a finely refined bent reference, and the tunnel assets (load, quads, bytes = tool output).
 #include <engine/assets/gltf.hpp>
+#include <engine/assets/mesh_building.hpp>
 #include <engine/assets/subdivide.hpp>
 
 #include <curved_space/chain.hpp>
@@ -37,17 +38,9 @@ fs::path temp_dir() {
     return p;
 }
 
-// Appends a quad (a, b, c, d counter-clockwise seen from the front) as the triangle pair (a,b,c), (a,c,d)
-// with its own four vertices (flat normal, given uvs).
+// A quad (a, b, c, d counter-clockwise seen from the front) with its own four vertices, flat normal, given uvs.
 void add_quad(MeshData& m, std::array<glm::vec3, 4> p, std::array<glm::vec2, 4> uv) {
-    const auto base = static_cast<std::uint32_t>(m.vertex_count());
-    const glm::vec3 n = glm::normalize(glm::cross(p[1] - p[0], p[2] - p[0]));
-    for (int k = 0; k < 4; ++k) {
-        m.positions.insert(m.positions.end(), {p[k].x, p[k].y, p[k].z});
-        m.normals.insert(m.normals.end(), {n.x, n.y, n.z});
-        m.uvs.insert(m.uvs.end(), {uv[k].x, uv[k].y});
-    }
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    engine::assets::add_quad(m, {.corners = p, .uvs = uv});
 }
 
 // A strip of `n` unit quads in the z = 0 plane along +x, uv = (x / n, y).

@@ -157,6 +157,8 @@ public:
     void set(const char* name, const glm::vec4& v) const;
     void set(const char* name, const glm::mat3& m) const;
     void set(const char* name, const glm::mat4& m) const;
+    // Uniform array elements [0, values.size()) at `location` (from uniform_location; -1 is a no-op).
+    void set(int location, std::span<const float> values) const;
 
 private:
     friend Expected<Program> make_program(const ProgramDesc& desc);
