@@ -43,10 +43,14 @@ PyObject* g_wire_error = nullptr;
 // ---- numpy -> WireNodes ----
 
 /// (N, 3) float64 positions (anything numpy converts), N >= 0; `what` names the argument in messages.
-void read_positions(const DoubleArray& a, const std::string& what, std::vector<glm::dvec3>& out) {
+void check_positions(const DoubleArray& a, const std::string& what) {
     if (a.ndim() != 2 || a.shape(1) != 3)
         value_error(what + ": expected an array of shape (N, 3), got " + std::to_string(a.ndim()) + " dimensions" +
                     (a.ndim() == 2 ? " (N, " + std::to_string(a.shape(1)) + ")" : std::string()));
+}
+
+void read_positions(const DoubleArray& a, const std::string& what, std::vector<glm::dvec3>& out) {
+    check_positions(a, what);
     const auto n = static_cast<std::size_t>(a.shape(0));
     const double* p = a.data();
     out.resize(n);
@@ -203,6 +207,15 @@ public:
     void set_nodes(Entity w, const DoubleArray& positions, const std::optional<IdArray>& ids,
                    const std::optional<FloatArray>& stretch, const std::optional<FloatArray>& radii) {
         check(w);
+        // Positions only, on a wire without per-node arrays (the common physics step): written in place, so the
+        // wire's node buffer is reused instead of a new one allocated every step.
+        const wire::systems::Nodes& current = registry_.get<wire::systems::Nodes>(w);
+        if (!ids && !stretch && !radii && current.ids.empty() && current.stretch.empty() &&
+            current.radius_m.empty()) {
+            check_positions(positions, "positions");  // before edit_nodes stamps the wire as changed
+            read_positions(positions, "positions", wire::systems::edit_nodes(registry_, w).positions);
+            return;
+        }
         wire::systems::set_nodes(registry_, w, to_nodes(positions, ids, stretch, radii));
     }
 
