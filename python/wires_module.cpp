@@ -1,6 +1,7 @@
-// The Python module `wires` (pybind11): a wire runtime a simulation script drives with numpy arrays. Everything runs
-// through the C++ runtime itself (wire entities in the ECS registry, the installed wire systems, the wire renderer
-// in a GL context, wire::systems::wire_ring_set for read-back); this file only converts arrays and errors.
+// The Python module `wires` (pybind11): a wire runtime a simulation script drives with numpy arrays.
+// Everything runs through the C++ runtime itself (wire entities in the ECS registry, the installed wire
+// systems, the wire renderer in a GL context, wire::systems::wire_ring_set for read-back); this file only
+// converts arrays and errors.
 #include <engine/ecs/registry.hpp>
 #include <engine/ecs/schedule.hpp>
 #include <engine/gfx/lit_renderer.hpp>
@@ -12,11 +13,11 @@
 #include <wire/systems/api.hpp>
 #include <wire/systems/systems.hpp>
 
-#include <glm/glm.hpp>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <tbb/global_control.h>
+#include <glm/glm.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -38,14 +39,17 @@ using IdArray = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
 /// Raised for wires whose nodes the runtime rejects (a ValueError carrying the runtime's message).
 PyObject* g_wire_error = nullptr;
 
-[[noreturn]] void value_error(const std::string& message) { throw py::value_error(message); }
+[[noreturn]] void value_error(const std::string& message) {
+    throw py::value_error(message);
+}
 
 // ---- numpy -> WireNodes ----
 
 /// (N, 3) float64 positions (anything numpy converts), N >= 0; `what` names the argument in messages.
 void check_positions(const DoubleArray& a, const std::string& what) {
     if (a.ndim() != 2 || a.shape(1) != 3)
-        value_error(what + ": expected an array of shape (N, 3), got " + std::to_string(a.ndim()) + " dimensions" +
+        value_error(what + ": expected an array of shape (N, 3), got " + std::to_string(a.ndim()) +
+                    " dimensions" +
                     (a.ndim() == 2 ? " (N, " + std::to_string(a.shape(1)) + ")" : std::string()));
 }
 
@@ -58,7 +62,8 @@ void read_positions(const DoubleArray& a, const std::string& what, std::vector<g
 }
 
 template <class T, class Array>
-void read_per_node(const std::optional<Array>& a, std::size_t n, const std::string& what, std::vector<T>& out) {
+void read_per_node(const std::optional<Array>& a, std::size_t n, const std::string& what,
+                   std::vector<T>& out) {
     out.clear();
     if (!a) return;
     if (a->ndim() != 1 || static_cast<std::size_t>(a->shape(0)) != n)
@@ -94,7 +99,8 @@ wire::SplineSettings spline_of(const std::string& name) {
     wire::io::WireSpec spec;
     spec.spline_type = name;
     wire::PipelineSettings s;
-    if (wire::Status st = wire::io::resolve_settings(spec, {}, s); !st.ok) value_error("spline: " + st.message);
+    if (wire::Status st = wire::io::resolve_settings(spec, {}, s); !st.ok)
+        value_error("spline: " + st.message);
     return s.spline;
 }
 
@@ -114,8 +120,8 @@ glm::dvec3 vec3_of(const std::vector<double>& v, const char* what) {
 
 py::dict rings_dict(const wire::RingSet& r) {
     const auto n = static_cast<py::ssize_t>(r.params.size());
-    py::array_t<double> centres({n, py::ssize_t{3}}), tangents({n, py::ssize_t{3}}), normals({n, py::ssize_t{3}}),
-        binormals({n, py::ssize_t{3}});
+    py::array_t<double> centres({n, py::ssize_t{3}}), tangents({n, py::ssize_t{3}}),
+        normals({n, py::ssize_t{3}}), binormals({n, py::ssize_t{3}});
     py::array_t<double> radius(n), u(n), t(n);
     py::array_t<uint32_t> segment(n);
     double *c = centres.mutable_data(), *ta = tangents.mutable_data(), *no = normals.mutable_data(),
@@ -169,7 +175,8 @@ public:
         if (!gl) throw std::runtime_error("cannot create a GL context: " + gl.error().message);
         gl_ = std::move(gl).value();
         auto renderer = wire::render::WireRenderer::create();
-        if (!renderer) throw std::runtime_error("cannot create the wire renderer: " + renderer.error().message);
+        if (!renderer)
+            throw std::runtime_error("cannot create the wire renderer: " + renderer.error().message);
         renderer_ = std::move(renderer).value();
         const engine::platform::Extent size = gl_->framebuffer_size();
         ctx_.viewport_width_px = size.width;
@@ -180,16 +187,17 @@ public:
     }
     Runtime(const Runtime&) = delete;
     Runtime& operator=(const Runtime&) = delete;
-    /// Several runtimes may live in one process, each with its own context: the renderer's GL objects are deleted
-    /// with this runtime's context current.
+    /// Several runtimes may live in one process, each with its own context: the renderer's GL objects are
+    /// deleted with this runtime's context current.
     ~Runtime() { gl_->make_current(); }
 
     Entity spawn(const DoubleArray& positions, const std::optional<IdArray>& ids,
-                 const std::optional<FloatArray>& stretch, const std::optional<FloatArray>& radii, float radius_m,
-                 uint32_t material, const std::string& spline, bool closed, bool caps, uint32_t max_sides,
-                 float blend_s) {
+                 const std::optional<FloatArray>& stretch, const std::optional<FloatArray>& radii,
+                 float radius_m, uint32_t material, const std::string& spline, bool closed, bool caps,
+                 uint32_t max_sides, float blend_s) {
         if (!(radius_m > 0.0f) || !std::isfinite(radius_m))
-            value_error("radius: must be a positive finite number of metres, got " + std::to_string(radius_m));
+            value_error("radius: must be a positive finite number of metres, got " +
+                        std::to_string(radius_m));
         if (material >= renderer_.materials().size())
             value_error("material " + std::to_string(material) + " does not exist (the renderer has " +
                         std::to_string(renderer_.materials().size()) + "; add_material() adds one)");
@@ -207,8 +215,8 @@ public:
     void set_nodes(Entity w, const DoubleArray& positions, const std::optional<IdArray>& ids,
                    const std::optional<FloatArray>& stretch, const std::optional<FloatArray>& radii) {
         check(w);
-        // Positions only, on a wire without per-node arrays (the common physics step): written in place, so the
-        // wire's node buffer is reused instead of a new one allocated every step.
+        // Positions only, on a wire without per-node arrays (the common physics step): written in place, so
+        // the wire's node buffer is reused instead of a new one allocated every step.
         const wire::systems::Nodes& current = registry_.get<wire::systems::Nodes>(w);
         if (!ids && !stretch && !radii && current.ids.empty() && current.stretch.empty() &&
             current.radius_m.empty()) {
@@ -219,8 +227,9 @@ public:
         wire::systems::set_nodes(registry_, w, to_nodes(positions, ids, stretch, radii));
     }
 
-    /// Positions of many wires at once: (W, N, 3), wire k gets positions[k] (ids and the other arrays unchanged).
-    /// Written in place (edit_nodes), so a frame of 1,000 wires costs one Python call and no allocation.
+    /// Positions of many wires at once: (W, N, 3), wire k gets positions[k] (ids and the other arrays
+    /// unchanged). Written in place (edit_nodes), so a frame of 1,000 wires costs one Python call and no
+    /// allocation.
     void set_positions(const std::vector<Entity>& wires, const DoubleArray& positions) {
         if (positions.ndim() != 3 || positions.shape(2) != 3 ||
             static_cast<std::size_t>(positions.shape(0)) != wires.size())
@@ -231,8 +240,10 @@ public:
         const double* p = positions.data();
         for (std::size_t k = 0; k < wires.size(); ++k) {
             const wire::systems::Nodes& current = registry_.get<wire::systems::Nodes>(wires[k]);
-            if (current.size() != n && (!current.ids.empty() || !current.stretch.empty() || !current.radius_m.empty()))
-                value_error(wire::systems::describe_entity(wires[k]) + ": has " + std::to_string(current.size()) +
+            if (current.size() != n &&
+                (!current.ids.empty() || !current.stretch.empty() || !current.radius_m.empty()))
+                value_error(wire::systems::describe_entity(wires[k]) + ": has " +
+                            std::to_string(current.size()) +
                             " nodes with per-node arrays; set_positions gives " + std::to_string(n) +
                             " (use set_nodes to change the node count)");
         }
@@ -240,7 +251,8 @@ public:
             wire::WireNodes& nodes = wire::systems::edit_nodes(registry_, wires[k]);
             nodes.positions.resize(n);
             const double* src = p + 3 * n * k;
-            for (std::size_t i = 0; i < n; ++i) nodes.positions[i] = {src[3 * i], src[3 * i + 1], src[3 * i + 2]};
+            for (std::size_t i = 0; i < n; ++i)
+                nodes.positions[i] = {src[3 * i], src[3 * i + 1], src[3 * i + 2]};
         }
     }
 
@@ -249,8 +261,8 @@ public:
         registry_.destroy(w);
     }
 
-    void set_camera(const std::vector<double>& eye, const std::vector<double>& target, const std::vector<double>& up,
-                    double fov_deg, double near_m, double far_m) {
+    void set_camera(const std::vector<double>& eye, const std::vector<double>& target,
+                    const std::vector<double>& up, double fov_deg, double near_m, double far_m) {
         const glm::dvec3 e = vec3_of(eye, "eye"), t = vec3_of(target, "target"), u = vec3_of(up, "up");
         if (!(glm::length(t - e) > 0.0)) value_error("camera: eye and target must differ");
         if (!(glm::length(glm::cross(glm::normalize(t - e), u)) > 1e-9))
@@ -268,22 +280,24 @@ public:
         eye_m_ = e;
     }
 
-    /// Runs the wire systems once (curve, lod, rings, mesh, draw list). New wire errors raise WireError after the
-    /// frame: the bad wire is skipped (it keeps its last valid curve), the rest of the scene was updated.
+    /// Runs the wire systems once (curve, lod, rings, mesh, draw list). New wire errors raise WireError after
+    /// the frame: the bad wire is skipped (it keeps its last valid curve), the rest of the scene was updated.
     void update(double dt_s) {
-        if (!(dt_s >= 0.0) || !std::isfinite(dt_s)) value_error("dt: must be a finite number of seconds >= 0");
+        if (!(dt_s >= 0.0) || !std::isfinite(dt_s))
+            value_error("dt: must be a finite number of seconds >= 0");
         errors_.clear();
         schedule_.run(registry_, dt_s);
         if (!errors_.empty()) {
             std::string message;
-            for (const wire::systems::ErrorReport& e : errors_) message += (message.empty() ? "" : "\n") + e.message;
+            for (const wire::systems::ErrorReport& e : errors_)
+                message += (message.empty() ? "" : "\n") + e.message;
             PyErr_SetString(g_wire_error, message.c_str());
             throw py::error_already_set();
         }
     }
 
-    /// Draws the last update's draw list into the framebuffer and reads it back: (height, width, 4) uint8, row 0
-    /// the top of the image.
+    /// Draws the last update's draw list into the framebuffer and reads it back: (height, width, 4) uint8,
+    /// row 0 the top of the image.
     py::array_t<uint8_t> render(const std::vector<double>& clear) {
         if (clear.size() != 4) value_error("clear: expected 4 numbers (r, g, b, a) in [0, 1]");
         gl_->make_current();
@@ -302,8 +316,8 @@ public:
         return out;
     }
 
-    /// Pixel coordinates (x right, y down, pixel centres at +0.5) and NDC depth of world points, (N, 3) -> (N, 3);
-    /// points behind the eye get NaN.
+    /// Pixel coordinates (x right, y down, pixel centres at +0.5) and NDC depth of world points, (N, 3) ->
+    /// (N, 3); points behind the eye get NaN.
     py::array_t<double> project(const DoubleArray& points) const {
         std::vector<glm::dvec3> p;
         read_positions(points, "points", p);
@@ -373,7 +387,8 @@ public:
 
     double tolerance_px() const { return ctx_.lod.tolerance_px > 0.0 ? ctx_.lod.tolerance_px : 0.5; }
     void set_tolerance_px(double px) {
-        if (!(px > 0.0) || !std::isfinite(px)) value_error("lod_tolerance_px: must be a positive number of pixels");
+        if (!(px > 0.0) || !std::isfinite(px))
+            value_error("lod_tolerance_px: must be a positive number of pixels");
         ctx_.lod.tolerance_px = px;
     }
     std::pair<int, int> size() const {
@@ -423,7 +438,8 @@ py::dict mesh_rings(const DoubleArray& positions, const std::optional<IdArray>& 
     overrides.rings_per_segment = rings_per_segment;
     overrides.tolerance_m = tolerance_m;
     wire::PipelineSettings settings;
-    if (wire::Status st = wire::io::resolve_settings(spec, overrides, settings); !st.ok) value_error(st.message);
+    if (wire::Status st = wire::io::resolve_settings(spec, overrides, settings); !st.ok)
+        value_error(st.message);
     wire::WirePipeline pipeline;
     if (wire::Status st = pipeline.update(to_nodes(positions, ids, stretch, radii), settings); !st.ok) {
         PyErr_SetString(g_wire_error, st.message.c_str());
@@ -435,12 +451,14 @@ py::dict mesh_rings(const DoubleArray& positions, const std::optional<IdArray>& 
 }  // namespace
 
 PYBIND11_MODULE(wires, m) {
-    m.doc() = "Wire rendering runtime: wires from numpy node arrays, drawn by the C++ wire systems and renderer";
+    m.doc() =
+        "Wire rendering runtime: wires from numpy node arrays, drawn by the C++ wire systems and renderer";
     // WireError(ValueError): a wire's nodes rejected by the runtime, with its message (wire, node, problem).
-    g_wire_error = PyErr_NewExceptionWithDoc("wires.WireError",
-                                             "A wire's nodes were rejected by the runtime (the message names the "
-                                             "wire entity, the node and the problem).",
-                                             PyExc_ValueError, nullptr);
+    g_wire_error =
+        PyErr_NewExceptionWithDoc("wires.WireError",
+                                  "A wire's nodes were rejected by the runtime (the message names the "
+                                  "wire entity, the node and the problem).",
+                                  PyExc_ValueError, nullptr);
     if (g_wire_error == nullptr) throw py::error_already_set();
     m.attr("WireError") = py::handle(g_wire_error);
 
@@ -451,41 +469,48 @@ PYBIND11_MODULE(wires, m) {
         .def("__hash__", [](Entity e) { return engine::ecs::to_integral(e); })
         .def("__repr__", [](Entity e) { return "<wires.Wire " + wire::systems::describe_entity(e) + ">"; });
 
-    py::class_<Runtime>(m, "Runtime", "A scene: GL context (headless EGL or a window), wire renderer, ECS systems")
+    py::class_<Runtime>(m, "Runtime",
+                        "A scene: GL context (headless EGL or a window), wire renderer, ECS systems")
         .def(py::init<int, int, bool, const std::string&, int, bool>(), py::arg("width") = 1280,
-             py::arg("height") = 720, py::arg("headless") = true, py::arg("path") = "cpu", py::arg("threads") = 0,
-             py::arg("pop_free") = true,
-             "path: 'cpu' (meshes) or 'gpu' (ring records); threads: worker threads of the systems (0: all cores)")
+             py::arg("height") = 720, py::arg("headless") = true, py::arg("path") = "cpu",
+             py::arg("threads") = 0, py::arg("pop_free") = true,
+             "path: 'cpu' (meshes) or 'gpu' (ring records); threads: worker threads of the systems (0: all "
+             "cores)")
         .def("spawn", &Runtime::spawn, py::arg("positions"), py::arg("ids") = py::none(),
              py::arg("stretch") = py::none(), py::arg("radii") = py::none(), py::arg("radius") = 0.01f,
-             py::arg("material") = 0u, py::arg("spline") = "auto", py::arg("closed") = false, py::arg("caps") = true,
-             py::arg("max_sides") = 0u, py::arg("blend_s") = 0.0f,
-             "A new wire from (N, 3) node positions in metres; ids (stable across updates), stretch and per-node radii "
+             py::arg("material") = 0u, py::arg("spline") = "auto", py::arg("closed") = false,
+             py::arg("caps") = true, py::arg("max_sides") = 0u, py::arg("blend_s") = 0.0f,
+             "A new wire from (N, 3) node positions in metres; ids (stable across updates), stretch and "
+             "per-node radii "
              "optional. Bad nodes are reported by the next update().")
-        .def("set_nodes", &Runtime::set_nodes, py::arg("wire"), py::arg("positions"), py::arg("ids") = py::none(),
-             py::arg("stretch") = py::none(), py::arg("radii") = py::none(),
+        .def("set_nodes", &Runtime::set_nodes, py::arg("wire"), py::arg("positions"),
+             py::arg("ids") = py::none(), py::arg("stretch") = py::none(), py::arg("radii") = py::none(),
              "Replaces a wire's nodes (what the physics computed this step)")
         .def("set_positions", &Runtime::set_positions, py::arg("wires"), py::arg("positions"),
              "Positions of many wires in one call: positions has shape (len(wires), N, 3)")
         .def("destroy", &Runtime::destroy, py::arg("wire"))
         .def("set_camera", &Runtime::set_camera, py::arg("eye"), py::arg("target"),
-             py::arg("up") = std::vector<double>{0.0, 1.0, 0.0}, py::arg("fov_deg") = 60.0, py::arg("near") = 0.1,
-             py::arg("far") = 1000.0)
+             py::arg("up") = std::vector<double>{0.0, 1.0, 0.0}, py::arg("fov_deg") = 60.0,
+             py::arg("near") = 0.1, py::arg("far") = 1000.0)
         .def_property("lod_tolerance_px", &Runtime::tolerance_px, &Runtime::set_tolerance_px)
         .def("add_material", &Runtime::add_material, py::arg("tint"),
-             "Adds a material (linear RGB tint of the weave texture); returns its index. Material 0 is copper.")
+             "Adds a material (linear RGB tint of the weave texture); returns its index. Material 0 is "
+             "copper.")
         .def("update", &Runtime::update, py::arg("dt") = 1.0 / 60.0,
              "Runs the wire systems once; raises WireError naming the wire and node of any new bad input")
         .def("render", &Runtime::render, py::arg("clear") = std::vector<double>{0.10, 0.10, 0.12, 1.0},
-             "Draws the last update and returns the image, shape (height, width, 4), uint8 RGBA, row 0 at the top")
+             "Draws the last update and returns the image, shape (height, width, 4), uint8 RGBA, row 0 at "
+             "the top")
         .def_static(
             "save_png",
-            [](const std::string& path, const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& img) {
+            [](const std::string& path,
+               const py::array_t<uint8_t, py::array::c_style | py::array::forcecast>& img) {
                 if (img.ndim() != 3 || img.shape(2) != 4)
                     value_error("image: expected shape (height, width, 4) uint8");
-                engine::platform::Image image{.width = static_cast<int>(img.shape(1)),
-                                              .height = static_cast<int>(img.shape(0)),
-                                              .rgba = std::vector<uint8_t>(img.data(), img.data() + img.size())};
+                engine::platform::Image image{
+                    .width = static_cast<int>(img.shape(1)),
+                    .height = static_cast<int>(img.shape(0)),
+                    .rgba = std::vector<uint8_t>(img.data(), img.data() + img.size())};
                 if (auto st = engine::platform::write_png(path, image); !st)
                     throw std::runtime_error(path + ": " + st.error().message);
             },
@@ -493,7 +518,8 @@ PYBIND11_MODULE(wires, m) {
         .def("project", &Runtime::project, py::arg("points"),
              "(N, 3) world points -> (N, 3): pixel x, pixel y (0 at the top), NDC depth; NaN behind the eye")
         .def("rings", &Runtime::rings, py::arg("wire"),
-             "The wire's current rings as numpy arrays (centres, tangents, normals, binormals, radius, u, segment, t); "
+             "The wire's current rings as numpy arrays (centres, tangents, normals, binormals, radius, u, "
+             "segment, t); "
              "None while it is culled or not updated yet")
         .def("error", &Runtime::error, py::arg("wire"), "The wire's current error message, or None")
         .def_property_readonly("stats", &Runtime::stats)
