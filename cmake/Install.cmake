@@ -3,9 +3,11 @@
 # installs the libraries below with their public headers (each target's include/ folder, whole) into P/lib and
 # P/include, and P/lib/cmake/wires/{wiresConfig,wiresConfigVersion,wiresTargets,wiresDependencies}.cmake.
 # find_package(wires 0.2) then gives the namespaced targets wires::<export name>. Target-based: sources and
-# headers added to these targets need no change here. Tests, tools, the game and examples are not installed.
-# The libraries load nothing from disk at run time (the wire shaders are compiled into wire_render), so nothing
-# else is installed.
+# headers added to these targets need no change here. The libraries load nothing from disk at run time (the wire
+# shaders are compiled into wire_render).
+# Programs: P/bin/wiretool and P/bin/tunnel, with the tunnel's assets in P/share/wires/tunnel (found relative to
+# the executable, so the prefix can be moved); the Python module `wires`, when built, in P/<WIRES_PYTHON_INSTALL_DIR>
+# (python/CMakeLists.txt). Tests, benchmarks and examples are not installed.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -50,3 +52,7 @@ install(FILES
   ${CMAKE_BINARY_DIR}/package/wiresConfigVersion.cmake
   ${CMAKE_CURRENT_LIST_DIR}/wiresDependencies.cmake
   DESTINATION ${WIRES_INSTALL_CMAKEDIR})
+
+# Programs (README "Using the installed package"): relocatable, they name no path of this machine.
+install(TARGETS wiretool tunnel RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(DIRECTORY ${WIRE_ASSET_DIR}/tunnel/ DESTINATION ${TUNNEL_ASSETS_DESTINATION})

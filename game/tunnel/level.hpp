@@ -49,7 +49,8 @@ struct LevelSettings {
     uint32_t seed = 0;               ///< phases of the bend animation; 0 -> 1
     double bend_scale = 0.0;         ///< multiplies the base bend angles; 0 -> 1
     std::string asset_dir{};         ///< folder of straight_section.glb, wall_details.glb, cable_hooks.glb,
-                                     ///< anchors.json; empty -> the repository's assets/tunnel
+                                     ///< anchors.json; empty -> assets/tunnel, relative to the working directory
+                                     ///< (the tunnel program passes the folder it found beside itself)
     int max_subdivision_level = -1;  ///< highest refinement level cached; -1 -> 4
     double prewarm_s = 0.0;          ///< rope simulation before frame 0 (settles the cables); 0 -> 3 s
 };

@@ -1,7 +1,9 @@
 // build/bin/tunnel: the tunnel level. In a window: fly-through (Tab: free camera), debug panel, F12
 // screenshot. Headless (--headless, or automatically without a display): renders N frames at a fixed step,
-// writes PNGs of chosen frames and DIR/stats.json (see tunnel/stats_json.hpp).
-//   tunnel [--headless] [--frames N] [--out DIR] [--capture-every K] [--width W] [--height H]
+// writes PNGs of chosen frames and DIR/stats.json (see tunnel/stats_json.hpp). The level's assets are found
+// relative to the executable (TUNNEL_ASSETS_FROM_EXE: bin/../share/wires/tunnel, installed or in the build tree), so
+// an installed prefix can be moved; --assets DIR overrides.
+//   tunnel [--headless] [--frames N] [--out DIR] [--capture-every K] [--width W] [--height H] [--assets DIR]
 #include "tunnel/debug_ui.hpp"
 #include "tunnel/level.hpp"
 #include "tunnel/stats_json.hpp"
@@ -43,7 +45,35 @@ struct Args {
     bool wireframe = false;
     bool frames_given = false;  // window: close after `frames` frames
     int screenshot_frame = -1;  // window: screenshot (with the panel) at this frame
+    std::string assets;         // level assets; empty: found relative to the executable
 };
+
+#ifndef TUNNEL_ASSETS_FROM_EXE
+#define TUNNEL_ASSETS_FROM_EXE "../share/wires/tunnel"
+#endif
+
+/// The folder of the running executable (/proc/self/exe; argv[0] where /proc is missing).
+std::filesystem::path executable_dir(const char* argv0) {
+    std::error_code ec;
+    std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (ec) exe = std::filesystem::absolute(argv0, ec);
+    return exe.parent_path();
+}
+
+/// The level's assets: --assets, else TUNNEL_ASSETS_FROM_EXE relative to the executable (the same relative place in
+/// the build tree and in an installed prefix; no absolute path is compiled in). Empty with a message if not found.
+std::string find_assets(const Args& args, const char* argv0, std::string& error) {
+    const std::filesystem::path dir =
+        args.assets.empty() ? (executable_dir(argv0) / TUNNEL_ASSETS_FROM_EXE).lexically_normal()
+                            : std::filesystem::path(args.assets);
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(dir / "straight_section.glb", ec)) return dir.string();
+    error = "no level assets in " + dir.string() + " (straight_section.glb missing); " +
+            (args.assets.empty() ? "the executable expects them at " TUNNEL_ASSETS_FROM_EXE
+                                   " relative to its folder, or pass --assets DIR"
+                                 : "check --assets");
+    return {};
+}
 
 std::string frame_png(const std::string& dir, uint64_t frame) {
     char name[64];
@@ -286,8 +316,16 @@ int main(int argc, char** argv) {
     app.add_option("--lod-tolerance", args.lod_tolerance_px, "wire LOD screen error in pixels (default 0.5)")
         ->check(CLI::PositiveNumber);
     app.add_flag("--wireframe", args.wireframe, "draw wireframe");
+    app.add_option("--assets", args.assets,
+                   "folder of the level's assets (default: " TUNNEL_ASSETS_FROM_EXE " relative to the executable)");
     CLI11_PARSE(app, argc, argv);
     args.frames_given = frames->count() > 0;
+    std::string assets_error;
+    const std::string asset_dir = find_assets(args, argv[0], assets_error);
+    if (asset_dir.empty()) {
+        std::fprintf(stderr, "tunnel: %s\n", assets_error.c_str());
+        return 2;
+    }
 
     platform::ContextDesc desc{
         .backend = args.headless ? platform::Backend::headless : platform::Backend::automatic,
@@ -299,7 +337,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "tunnel: %s\n", ctx.error().message.c_str());
         return 1;
     }
-    auto level = tunnel::Level::create({.pieces = args.pieces, .seed = args.seed});
+    auto level = tunnel::Level::create({.pieces = args.pieces, .seed = args.seed, .asset_dir = asset_dir});
     if (!level) {
         std::fprintf(stderr, "tunnel: %s\n", level.error().message.c_str());
         return 1;

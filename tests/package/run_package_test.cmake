@@ -1,9 +1,11 @@
 # ctest package_install: the installed CMake package end to end. Run as
 #   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -DCXX_COMPILER=... [-DLAUNCHER=...]
 #         [-DCONFIG=Release] -P run_package_test.cmake
+#         [-DPYTHON_MODULE_DIR=lib/python3/site-packages]
 # 1. cmake --install BUILD_DIR into WORK_DIR/stage, then moves it to WORK_DIR/prefix (the package must be
-#    relocatable); 2. checks the layout (config + version files, no tools or tests installed, no installed file
-#    naming the source or build tree) and the version rule; 3. configures, builds and runs tests/package against
+#    relocatable); 2. checks the layout (config + version files, bin/ holding wiretool and tunnel only, the tunnel's
+#    assets, the Python module when built, no tests installed, no installed file naming the source or build tree)
+#    and the version rule; 3. configures, builds and runs tests/package against
 #    it with nothing but CMAKE_PREFIX_PATH pointing at the prefix: the README example (wires_consumer) and the
 #    repository's modules/wire/systems/examples/spawn_wires.cpp linking only wires::wire_systems.
 foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
@@ -42,9 +44,25 @@ foreach(h wire/systems/api.hpp wire/render/wire_renderer.hpp engine/ecs/registry
     message(FATAL_ERROR "package test: header include/${h} was not installed")
   endif()
 endforeach()
+# Programs and the tunnel's assets (README "Using the installed package"); no tests, benchmarks or examples.
 file(GLOB top RELATIVE "${prefix}" "${prefix}/*")
-if(NOT top STREQUAL "include;lib")
-  message(FATAL_ERROR "package test: the prefix holds '${top}', expected only include and lib (no tools, tests)")
+if(NOT top STREQUAL "bin;include;lib;share")
+  message(FATAL_ERROR "package test: the prefix holds '${top}', expected bin, include, lib and share")
+endif()
+file(GLOB programs RELATIVE "${prefix}/bin" "${prefix}/bin/*")
+if(NOT programs STREQUAL "tunnel;wiretool")
+  message(FATAL_ERROR "package test: bin holds '${programs}', expected tunnel and wiretool only (no tests, benchmarks)")
+endif()
+foreach(f straight_section.glb wall_details.glb cable_hooks.glb anchors.json)
+  if(NOT EXISTS "${prefix}/share/wires/tunnel/${f}")
+    message(FATAL_ERROR "package test: the tunnel's asset share/wires/tunnel/${f} was not installed")
+  endif()
+endforeach()
+if(PYTHON_MODULE_DIR)
+  file(GLOB module "${prefix}/${PYTHON_MODULE_DIR}/wires*.so")
+  if(NOT module)
+    message(FATAL_ERROR "package test: the Python module was not installed into ${PYTHON_MODULE_DIR}")
+  endif()
 endif()
 file(GLOB_RECURSE installed "${prefix}/*")
 # Test support (modules/wire/testing: random families, exact references) is never installed: no header, and no

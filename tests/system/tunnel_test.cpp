@@ -56,7 +56,7 @@ std::unique_ptr<platform::Context> make_context() {
 }
 
 std::unique_ptr<tunnel::Level> make_level() {
-    auto level = tunnel::Level::create({});
+    auto level = tunnel::Level::create({.asset_dir = WIRE_ASSET_DIR "/tunnel"});
     if (!level) {
         ADD_FAILURE() << "Level::create: " << level.error().message;
         return nullptr;
@@ -365,8 +365,9 @@ struct RunFigures {
         0.0;  // after the run: drawn (pop-free) rope curves vs the curves of their nodes
 };
 
-RunFigures run_figures(platform::Context& ctx, const tunnel::LevelSettings& settings, int frames) {
+RunFigures run_figures(platform::Context& ctx, tunnel::LevelSettings settings, int frames) {
     RunFigures out;
+    settings.asset_dir = WIRE_ASSET_DIR "/tunnel";
     auto created = tunnel::Level::create(settings);
     if (!created) {
         ADD_FAILURE() << "Level::create: " << created.error().message;

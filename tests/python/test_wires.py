@@ -1,0 +1,258 @@
+"""The Python module `wires` (python/wires_module.cpp) against the runtime it binds: errors, rings, pixels, memory.
+
+Run by ctest (python_wires) as PYTHONPATH=build/python /usr/bin/python3 -m pytest -q tests/python, with WIRETOOL
+pointing at build/bin/wiretool. Every test builds its own runtime.
+"""
+import csv
+import json
+import math
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import wires
+
+WIRETOOL = os.environ.get("WIRETOOL", str(Path(__file__).resolve().parents[2] / "build" / "bin" / "wiretool"))
+CLEAR = (0.10, 0.10, 0.12, 1.0)
+
+
+def hanging(n=16, sag=0.2, z=0.0):
+    """A cable across the default view: x in [-1.5, 1.5], sagging by `sag` in the middle."""
+    s = np.linspace(0.0, 1.0, n)
+    return np.stack([-1.5 + 3.0 * s, 0.3 - 4.0 * sag * s * (1.0 - s), np.full(n, z)], axis=1)
+
+
+def background(pixels):
+    """True where a pixel is the clear colour (within 12/255)."""
+    clear = np.array(CLEAR[:3]) * 255.0
+    return np.all(np.abs(pixels[..., :3].astype(float) - clear) <= 12.0, axis=-1)
+
+
+def rss_kib():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") // 1024
+
+
+# ---- errors: Python exceptions with the runtime's messages; the runtime stays usable ----
+
+def test_bad_nodes_raise_the_runtime_message_and_the_scene_goes_on():
+    rt = wires.Runtime(320, 180)
+    good = rt.spawn(hanging(), radius=0.03)
+    bad_nodes = hanging(z=0.5)
+    bad_nodes[3, 1] = np.nan
+    bad = rt.spawn(bad_nodes, radius=0.03)
+    with pytest.raises(wires.WireError) as raised:
+        rt.update()
+    assert isinstance(raised.value, ValueError)
+    assert str(raised.value) == f"wire entity {bad.id} (index {bad.id}, version 0): node 3: position.y is NaN"
+    assert rt.error(bad) == str(raised.value)
+    assert rt.error(good) is None
+    assert rt.rings(good) is not None  # the rest of the frame went on
+    assert rt.stats["visible_wires"] == 1
+
+    # Reported once: the next frame does not raise again for the same error.
+    rt.update()
+    # A node id used twice names both nodes.
+    ids = np.arange(16)
+    ids[9] = 4
+    rt.set_nodes(bad, hanging(z=0.5), ids=ids)
+    with pytest.raises(wires.WireError, match=r"node 9: id 4 is used twice \(also node 4\)"):
+        rt.update()
+    # Fixed: drawn again, no error.
+    rt.set_nodes(bad, hanging(z=0.5))
+    rt.update()
+    assert rt.error(bad) is None
+    assert rt.stats["visible_wires"] == 2
+    assert rt.render().shape == (180, 320, 4)
+
+
+def test_bad_arguments_raise_value_error_and_change_nothing():
+    rt = wires.Runtime(160, 90)
+    w = rt.spawn(hanging(), radius=0.03)
+    rt.update()
+    before = rt.rings(w)
+    with pytest.raises(ValueError, match=r"positions: expected an array of shape \(N, 3\)"):
+        rt.set_nodes(w, hanging()[:, :2])
+    with pytest.raises(ValueError, match=r"ids: expected one value per node \(shape \(16,\)\)"):
+        rt.set_nodes(w, hanging(), ids=np.arange(15))
+    with pytest.raises(ValueError, match=r"stretch: expected one value per node"):
+        rt.spawn(hanging(), stretch=np.ones(3))
+    with pytest.raises(ValueError, match=r"ids: node 2: id -1 is outside"):
+        rt.set_nodes(w, hanging(), ids=np.array([0, 1, -1] + list(range(3, 16))))
+    with pytest.raises(ValueError, match=r"unknown spline type 'bezier'"):
+        rt.spawn(hanging(), spline="bezier")
+    with pytest.raises(ValueError, match=r"material 7 does not exist"):
+        rt.spawn(hanging(), material=7)
+    with pytest.raises(ValueError, match=r"radius: must be a positive"):
+        rt.spawn(hanging(), radius=-1.0)
+    with pytest.raises(ValueError, match=r"camera: eye and target must differ"):
+        rt.set_camera((0, 0, 1), (0, 0, 1))
+    with pytest.raises(ValueError, match=r"positions: expected an array of shape \(1, N, 3\)"):
+        rt.set_positions([w], hanging())
+    rt.destroy(w)
+    with pytest.raises(ValueError, match=rf"wire entity {w.id} .* is not a live wire"):
+        rt.set_nodes(w, hanging())
+    # Still usable.
+    w2 = rt.spawn(hanging(), radius=0.03)
+    rt.update()
+    after = rt.rings(w2)
+    np.testing.assert_array_equal(before["centres"], after["centres"])
+
+
+# ---- rings: the same as `wiretool mesh --csv` and `wiretool view --csv` for the same file ----
+
+def read_ring_csv(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+
+
+def wire_file(tmp_path):
+    rng = np.random.default_rng(7)
+    nodes = hanging(12, 0.25) + rng.normal(0.0, 0.05, (12, 3))
+    stretch = 1.0 + 0.2 * rng.random(12)
+    doc = {"radius": 0.04, "spline": {"type": "auto"}, "nodes": [{"p": list(p), "id": 10 + i, "stretch": float(s)}
+                                     for i, (p, s) in enumerate(zip(nodes, stretch))]}
+    path = tmp_path / "cable.json"
+    path.write_text(json.dumps(doc))
+    return path, nodes, np.arange(10, 22), stretch.astype(np.float32)
+
+
+def assert_rings_equal(rings, table):
+    np.testing.assert_array_equal(rings["segment"], table["segment"])
+    np.testing.assert_array_equal(rings["t"], table["t"])  # %.17g: exact
+    np.testing.assert_array_equal(rings["centres"], np.stack([table["x"], table["y"], table["z"]], axis=1))
+    np.testing.assert_array_equal(rings["u"], table["u"])
+    np.testing.assert_array_equal(rings["radius"].astype(np.float32), table["radius"].astype(np.float32))
+    for key, cols in (("tangents", "t"), ("normals", "n"), ("binormals", "b")):
+        csv_frame = np.stack([table[cols + "x"], table[cols + "y"], table[cols + "z"]], axis=1)
+        np.testing.assert_allclose(rings[key], csv_frame, rtol=0, atol=5e-9)  # %.9g columns
+
+
+def test_mesh_rings_equal_wiretool_mesh_csv(tmp_path):
+    path, nodes, ids, stretch = wire_file(tmp_path)
+    out = tmp_path / "rings.csv"
+    subprocess.run([WIRETOOL, "mesh", str(path), "--csv", str(out)], check=True)
+    rings = wires.mesh_rings(nodes, ids=ids, stretch=stretch, radius=0.04)
+    assert_rings_equal(rings, read_ring_csv(out))
+
+
+def test_runtime_rings_equal_wiretool_view_csv(tmp_path):
+    path, nodes, ids, stretch = wire_file(tmp_path)
+    out = tmp_path / "view.csv"
+    eye, target = (0.4, 0.6, 4.0), (0.0, 0.0, 0.0)
+    subprocess.run([WIRETOOL, "view", str(path), "--size", "640x360", "--camera", ",".join(map(str, eye + target)),
+                    "--csv", str(out)], check=True)
+    # wiretool view's clip planes (view_command.cpp): around the nodes' bounding sphere.
+    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+    centre, radius = 0.5 * (lo + hi), 0.5 * math.sqrt(float(np.dot(hi - lo, hi - lo))) + 0.04
+    reach = 1.25 * radius
+    d = np.array(eye) - centre
+    distance = math.sqrt(float(np.dot(d, d)))
+    far = 1.01 * (distance + reach)
+    near = max(0.5 * (distance - reach), max(1e-5 * far, min(0.05, 0.01 * reach)))
+
+    rt = wires.Runtime(640, 360)
+    w = rt.spawn(nodes, ids=ids, stretch=stretch, radius=0.04)
+    rt.set_camera(eye, target, near=near, far=far)
+    rt.update()
+    assert_rings_equal(rt.rings(w), read_ring_csv(out))
+
+
+# ---- pixels: the wire is drawn where its nodes project ----
+
+def test_image_shows_the_wire_where_its_nodes_project(tmp_path):
+    width, height = 480, 270
+    rt = wires.Runtime(width, height)
+    blue = rt.add_material((0.4, 0.7, 1.0))
+    nodes = hanging(16, 0.2)
+    w = rt.spawn(nodes, radius=0.03, material=blue)
+    rt.set_camera((0.0, 0.0, 5.0), (0.0, 0.0, 0.0))
+    rt.update()
+    image = rt.render(clear=CLEAR)
+    assert image.shape == (height, width, 4) and image.dtype == np.uint8
+    drawn = ~background(image)
+    bluish = drawn & (image[..., 2].astype(int) > image[..., 0].astype(int) + 20)
+    for x, y, _ in rt.project(nodes):
+        xi, yi = int(x), int(y)
+        assert bluish[max(yi - 2, 0):yi + 3, max(xi - 2, 0):xi + 3].any(), f"no wire pixel at node ({x:.1f}, {y:.1f})"
+    # Nowhere else: the top and bottom fifth are empty.
+    assert not drawn[: height // 5].any() and not drawn[height - height // 5:].any()
+    # Moved nodes move the picture.
+    rt.set_nodes(w, nodes + np.array([0.0, -0.8, 0.0]))
+    rt.update()
+    moved = ~background(rt.render(clear=CLEAR))
+    assert moved[height - height // 5:].any() or moved[int(height * 0.6):].sum() > drawn[int(height * 0.6):].sum()
+    png = tmp_path / "wire.png"
+    wires.Runtime.save_png(str(png), image)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# ---- memory: 1,000 updates of a wire do not grow it ----
+
+def test_a_wire_updated_1000_times_does_not_grow_memory():
+    rt = wires.Runtime(320, 180)
+    nodes = hanging(64, 0.3)
+    w = rt.spawn(nodes, radius=0.02)
+    rt.set_camera((0.0, 0.0, 5.0), (0.0, 0.0, 0.0))
+    k = np.arange(64)
+
+    def step(i):
+        moved = nodes.copy()
+        moved[1:-1, 2] += 0.05 * np.sin(0.1 * i + 0.2 * k[1:-1])
+        rt.set_nodes(w, moved)
+        rt.update()
+        if i % 100 == 0:
+            rt.render()
+
+    for i in range(200):  # warm-up: containers at their working capacity, allocator pools settled
+        step(i)
+    systems_before, rss_before = rt.memory(w), rss_kib()
+    for i in range(200, 1200):
+        step(i)
+    systems_after, rss_after = rt.memory(w), rss_kib()
+    assert systems_after == systems_before
+    # A leak of 256 bytes per update would add 250 KiB; allow half of that for allocator noise.
+    assert rss_after - rss_before < 128, f"RSS grew by {rss_after - rss_before} KiB over 1,000 updates"
+
+
+# ---- many wires in one call ----
+
+def test_set_positions_equals_set_nodes():
+    frames = [np.stack([hanging(32, 0.1 + 0.05 * i, z=-0.2 * i) for i in range(5)]) + 0.01 * f for f in range(3)]
+    a, b = wires.Runtime(320, 180), wires.Runtime(320, 180)
+    wa = [a.spawn(p, radius=0.02) for p in frames[0]]
+    wb = [b.spawn(p, radius=0.02) for p in frames[0]]
+    for rt in (a, b):
+        rt.set_camera((0.0, 0.5, 5.0), (0.0, 0.0, 0.0))
+    for positions in frames[1:]:
+        a.set_positions(wa, positions)
+        for w, p in zip(wb, positions):
+            b.set_nodes(w, p)
+        a.update()
+        b.update()
+    for x, y in zip(wa, wb):
+        for key, value in a.rings(x).items():
+            np.testing.assert_array_equal(value, b.rings(y)[key])
+    np.testing.assert_array_equal(a.render(), b.render())
+
+
+# ---- the README's example runs as written ----
+
+def test_readme_python_example_runs(tmp_path, monkeypatch):
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    section = readme[readme.index("## Python\n"):]
+    begin = section.index("```python\n") + len("```python\n")
+    code = section[begin:section.index("```", begin)]
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "README.md (## Python)", "exec"), scope)
+    assert sorted(p.name for p in tmp_path.glob("rope_*.png")) == [f"rope_{f:04d}.png" for f in (0, 30, 60, 90)]
+    rings = scope["rings"]
+    assert rings["centres"].shape[1] == 3 and len(rings["u"]) == len(rings["centres"]) >= 2
+    assert np.all(np.diff(rings["u"]) > 0)
+    # The rope swung down from its horizontal start: its free end is well below the hook.
+    assert scope["x"][-1, 1] < 0.0
