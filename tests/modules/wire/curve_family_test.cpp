@@ -5,9 +5,9 @@
 
 #include "wire/bezier.hpp"
 #include "wire/curve.hpp"
-#include "wire/detail/segment_soa.hpp"
-#include "wire/testing/families.hpp"
 #include "wire/spline.hpp"
+#include "wire/testing/families.hpp"
+#include "wire/testing/spline_hooks.hpp"
 
 #include <glm/geometric.hpp>
 
