@@ -21,7 +21,7 @@ namespace wire::simd {
 inline double min_of(double x, double y) { return y < x ? y : x; }
 inline double max_of(double x, double y) { return x < y ? y : x; }
 
-// Lanes for the span hierarchy's kernels (lod_span_kernels.inl): the kernels are written once over a lane type,
+// Lanes for the span hierarchy's kernels (lod/span_kernels.inl): the kernels are written once over a lane type,
 // L1 (one double: the scalar code), L2 (two doubles in an SSE2 register) or L4 (four in an AVX register, where
 // the CPU has AVX2), so every lane does exactly the scalar arithmetic (each operation the IEEE one, correctly
 // rounded, no fused multiply-add): results are bit-identical whichever runs. min_of / max_of / select keep the

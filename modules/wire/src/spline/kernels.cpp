@@ -16,7 +16,7 @@ namespace wire::curve_stage {
 // compiled without trapping math: GCC turns their `?:` into vector blends only then. That changes no value (every
 // operation is still performed and rounded as written; NaN comparisons keep their meaning), only whether an
 // operation whose result is discarded may raise a floating-point exception flag, which nothing here reads
-// (WIRE_SELECT_KERNEL, wire/detail/segment_soa.hpp).
+// (WIRE_SELECT_KERNEL, simd/dispatch.hpp).
 // Each kernel is also compiled for AVX-512 and AVX2 machines, picked at load time (WIRE_VECTOR_CLONES: 8 and 4
 // lanes where baseline x86-64 has 2; 1.44 -> 1.12 ms for the stage on 1,000 moving 64-node wires); every clone's
 // results are bit-identical to the baseline's (see the macro).
