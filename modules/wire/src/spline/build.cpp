@@ -363,7 +363,7 @@ Status end_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& 
     }
     out.closed = closed;
     out.source_node = m.first;
-    const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : 0.01f;
+    const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : kDefaultWireRadius_m;
     if (nodes.radius_m.empty()) {
         out.radius_m.assign(n, wire_radius);
     } else {
