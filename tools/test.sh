@@ -45,10 +45,13 @@ if [ "$run_debug" -eq 1 ]; then
   cmake -S . -B build-debug "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug -DWIRE_BUILD_BENCHMARKS=OFF \
     -DWIRE_WERROR="$werror"
   # wire_curve_test is left out: 150 s at -O0, and the kernels it covers are also in wire_curve_family_test.
-  debug_tests=(wire_curve_family_test wire_ring_test wire_systems_test wire_systems_alloc_test)
+  debug_tests=(wire_curve_family_test wire_ring_test wire_lod_test wire_systems_test wire_systems_alloc_test)
   cmake --build build-debug --parallel "$jobs" --target "${debug_tests[@]}"
   for t in "${debug_tests[@]}"; do build-debug/bin/"$t" --gtest_brief=1; done
-  for lanes in 2 4; do WIRE_LOD_LANES="$lanes" build-debug/bin/wire_systems_test --gtest_brief=1; done
+  # The LOD's lane kernels at the narrower widths too (wire_lod_test: the LOD proof; the systems drive them too).
+  for lanes in 2 4; do
+    for t in wire_lod_test wire_systems_test; do WIRE_LOD_LANES="$lanes" build-debug/bin/"$t" --gtest_brief=1; done
+  done
 fi
 
 # 3. The same tests under AddressSanitizer + UndefinedBehaviorSanitizer (any report fails the test).

@@ -2,6 +2,9 @@
 #include "wire/frames.hpp"
 #include "wire/detail/segment_soa.hpp"
 
+#include "simd/dispatch.hpp"  // WIRE_VECTOR_CLONES
+#include "simd/transpose.hpp"
+
 #include <glm/mat3x3.hpp>
 
 #include <algorithm>
@@ -260,19 +263,15 @@ namespace {
 template <class Segment>
 [[gnu::always_inline]] inline void transpose_of(Segment segment, std::size_t n, std::size_t stride, double* out) {
     static_assert(sizeof(CubicBezier) == 12 * sizeof(double), "CubicBezier: 12 doubles, b0 to b3");
-    using V = double __attribute__((vector_size(32)));  // 4 doubles (two SSE registers on the baseline)
+    using V = simd::v4d;  // 4 doubles (two SSE registers on the baseline)
     std::size_t k = 0;
     for (; k + 4 <= n; k += 4) {
         const double* in[4] = {&segment(k).b0.x, &segment(k + 1).b0.x, &segment(k + 2).b0.x, &segment(k + 3).b0.x};
         for (std::size_t g = 0; g < 3; ++g) {  // doubles 4g .. 4g + 3 of each of the four segments
             V r[4];
             for (std::size_t s = 0; s < 4; ++s) std::memcpy(&r[s], in[s] + 4 * g, sizeof(V));
-            const V t0 = __builtin_shufflevector(r[0], r[1], 0, 4, 2, 6);
-            const V t1 = __builtin_shufflevector(r[0], r[1], 1, 5, 3, 7);
-            const V t2 = __builtin_shufflevector(r[2], r[3], 0, 4, 2, 6);
-            const V t3 = __builtin_shufflevector(r[2], r[3], 1, 5, 3, 7);
-            const V c[4] = {__builtin_shufflevector(t0, t2, 0, 1, 4, 5), __builtin_shufflevector(t1, t3, 0, 1, 4, 5),
-                            __builtin_shufflevector(t0, t2, 2, 3, 6, 7), __builtin_shufflevector(t1, t3, 2, 3, 6, 7)};
+            V c[4];
+            simd::transpose4x4(r, c);
             for (std::size_t j = 0; j < 4; ++j) std::memcpy(out + (4 * g + j) * stride + k, &c[j], sizeof(V));
         }
     }

@@ -3,6 +3,8 @@
 
 #include "wire/detail/segment_soa.hpp"
 
+#include "simd/dispatch.hpp"  // WIRE_VECTOR_CLONES, WIRE_SELECT_KERNEL
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>

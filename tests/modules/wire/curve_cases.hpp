@@ -12,9 +12,19 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace wire::testing {
+
+inline constexpr double kPi = 3.14159265358979323846;
+
+/// Nodes at the given positions (no other per-node array).
+inline WireNodes make_nodes(std::vector<glm::dvec3> p) {
+    WireNodes n;
+    n.positions = std::move(p);
+    return n;
+}
 
 /// 20 m cable hanging between (0,0,0) and (16,2,0) (y up): the DESIGN 4.8 catenary.
 inline Catenary hanging_cable() {

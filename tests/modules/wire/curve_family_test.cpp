@@ -5,9 +5,9 @@
 
 #include "wire/bezier.hpp"
 #include "wire/curve.hpp"
-#include "wire/detail/segment_soa.hpp"
-#include "wire/testing/families.hpp"
 #include "wire/spline.hpp"
+#include "wire/testing/families.hpp"
+#include "wire/testing/spline_hooks.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -420,7 +420,7 @@ TEST(WireCurveFamilies, RecordKernelEqualsThePortableLoopBitForBit) {
 
 TEST(WireCurveFamilies, SpreadCertificateEqualsTheExactTest) {
     // The automatic spline's spread test skips the square roots where a root-free bound shows that a node's
-    // turn is predicted by its neighbours (kSpreadBound, spline.cpp, with its proof), and takes the exact test
+    // turn is predicted by its neighbours (kSpreadBound, src/spline/tension.cpp, with its proof), and takes the exact test
     // elsewhere; the flags, and |k|, |k| + |k~| and |k - k~|^2 where a node is flagged, must be the exact test's
     // on every node. Inputs: every family's nodes (curvature vectors, bisector tangents and edge rotations as
     // concentrated_turns computes them, closed), then nodes built on the bound's boundary: k~ = P exactly (no

@@ -1,7 +1,6 @@
-/// \file
-/// The interface between the wire systems (CPU: which wires, what geometry) and the wire renderer (GL: upload
-/// and draw): one DrawItem per visible wire per frame. Plain data; the arrays are owned by the systems and
-/// stay valid until the next frame's systems run.
+// The interface between the wire systems (CPU: which wires, what geometry) and the wire renderer (GL: upload
+// and draw): one DrawItem per visible wire per frame. Plain data; the arrays are owned by the systems and
+// stay valid until the next frame's systems run.
 #pragma once
 
 #include "wire/rings.hpp"

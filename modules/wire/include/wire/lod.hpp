@@ -114,6 +114,8 @@ struct LodSettings {
     /// 0.5 px (a wire one pixel across); negative: never.
     double strip_radius_px = 0.0;
     double line_radius_px = 0.0;
+
+    friend bool operator==(const LodSettings&, const LodSettings&) = default;
 };
 
 /// One wire's LOD state for one camera (kept between frames for hysteresis).

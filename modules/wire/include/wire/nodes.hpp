@@ -1,5 +1,4 @@
-/// \file
-/// Input of the curve stage: a wire's lumped-element nodes (struct of arrays) and the spline settings.
+// Input of the curve stage: a wire's lumped-element nodes (struct of arrays) and the spline settings.
 #pragma once
 
 #include <glm/vec3.hpp>
@@ -44,6 +43,9 @@ enum class SplineKind : uint8_t {
     linear,           ///< straight segments (degenerate cubics), for baselines
 };
 
+/// The radius of a wire whose settings and nodes give none (0): 1 cm. Metres.
+inline constexpr float kDefaultWireRadius_m = 0.01f;
+
 /// Settings of the curve stage. Default-initialized (`SplineSettings{}` or `{.closed = true}`) is sensible:
 /// centripetal Catmull-Rom, no tension, open wire, radius 1 cm, merge epsilon 1e-9 of the scene scale.
 struct SplineSettings {
@@ -54,13 +56,16 @@ struct SplineSettings {
     double continuity = 0.0;  ///< Kochanek-Bartels continuity, wire-wide (non-zero breaks C1 on purpose)
     bool curvature_tension = true;  ///< use R = theta*Iz*L/(A*dL^2) for nodes that carry the physics arrays
     bool closed = false;            ///< closed loop: the last node connects back to the first
-    float radius_m = 0.01f;         ///< the wire's radius, used where a node's radius is 0; must be > 0 (0: 1 cm)
+    /// The wire's radius, used where a node's radius is 0; must be > 0 (0: kDefaultWireRadius_m, 1 cm).
+    float radius_m = kDefaultWireRadius_m;
     /// Nodes closer than merge_epsilon_rel * max(bounding-box diagonal, 1e-300) are merged (the first one is kept).
     /// 1e-9 sits ~3 decades below any physical spacing (a 100,000-node wire spaces at 1e-5 of its diagonal, the
     /// DESIGN spacing ratio 1e6 at 1e-6) and ~6 decades above double rounding (2.2e-16 relative), so it merges
     /// only nodes that are coincident up to noise. 0: default 1e-9. A floor of 64 ulps of the coordinates
     /// (far from the origin) is always applied.
     double merge_epsilon_rel = 1e-9;
+
+    friend bool operator==(const SplineSettings&, const SplineSettings&) = default;
 };
 
 }  // namespace wire

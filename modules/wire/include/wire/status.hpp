@@ -1,5 +1,4 @@
-/// \file
-/// Result of a wire-module operation that can fail on bad input: ok, or a message naming what is wrong.
+// Result of a wire-module operation that can fail on bad input: ok, or a message naming what is wrong.
 #pragma once
 
 #include <string>

@@ -24,7 +24,6 @@ using engine::ecs::Entity;
 using engine::ecs::Registry;
 
 constexpr uint32_t kDefaultMaxSides = 16;
-constexpr float kDefaultRadius = 0.01f;
 
 template <class Fn>
 void parallel_over(std::size_t n, Fn&& fn) {
@@ -41,12 +40,6 @@ void sort_unique(std::vector<Entity>& v) {
     v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
-bool same_spline(const SplineSettings& a, const SplineSettings& b) {
-    return a.kind == b.kind && a.alpha == b.alpha && a.tension == b.tension && a.bias == b.bias &&
-           a.continuity == b.continuity && a.curvature_tension == b.curvature_tension && a.closed == b.closed &&
-           a.radius_m == b.radius_m && a.merge_epsilon_rel == b.merge_epsilon_rel;
-}
-
 bool same_lod(const LodSettings& a, const LodSettings& b) {
     return a.tolerance_px == b.tolerance_px && a.max_rings_per_segment == b.max_rings_per_segment &&
            a.max_sides == b.max_sides && a.hysteresis_band == b.hysteresis_band &&
@@ -57,7 +50,7 @@ bool same_lod(const LodSettings& a, const LodSettings& b) {
 SplineSettings spline_of(const Style& style) {
     SplineSettings s = style.spline;
     s.closed = style.closed;
-    s.radius_m = style.radius_m > 0.0f ? style.radius_m : kDefaultRadius;
+    s.radius_m = style.radius_m > 0.0f ? style.radius_m : kDefaultWireRadius_m;
     return s;
 }
 
@@ -248,7 +241,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         step.spline = spline_of(*job.style);
         step.released_spline = c.spline;
         const SplineSettings& spline = step.spline;
-        if (c.builds == 0 || !same_spline(spline, c.spline) || c.geomorph != pop_free || c.blend_s != job.style->blend_s) {
+        if (c.builds == 0 || spline != c.spline || c.geomorph != pop_free || c.blend_s != job.style->blend_s) {
             c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
             c.spline = spline;
             c.geomorph = pop_free;

@@ -1,5 +1,4 @@
-// Internal: building the per-segment and per-node kernels (instruction-set clones, select kernels) and the
-// structure-of-arrays copy of a curve's segments they read.
+// Internal: the structure-of-arrays copy of a curve's segments that the per-segment kernels read (frames.cpp).
 #pragma once
 
 #include "wire/curve.hpp"
@@ -8,29 +7,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-
-/// On x86-64 with GCC: the function is compiled for AVX-512, AVX2 and the baseline (SSE2), and the loader picks the
-/// widest one the CPU has (an ifunc: one indirect call per call). Only for loops written so the compiler vectorizes
-/// them. Every clone gives the same results, bit for bit: wire_core is compiled with -ffp-contract=off (no fused
-/// multiply-add changes a rounding) and these loops use only correctly rounded operations (+, -, *, /, sqrt, min,
-/// max, comparisons). Elsewhere (Clang, sanitizers, other CPUs): one plain function.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(WIRE_NO_VECTOR_CLONES) && \
-    !defined(__SANITIZE_ADDRESS__)
-#define WIRE_HAS_VECTOR_CLONES 1  // also for hand-made versions chosen at load time (spline.cpp's all_within)
-#define WIRE_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define WIRE_VECTOR_CLONES
-#endif
-
-/// A kernel whose `?:` selects should become vector blends: GCC if-converts them only without trapping math. No
-/// value changes (every operation is still performed and rounded as written; NaN comparisons keep their meaning);
-/// only whether an operation whose result is discarded may raise a floating-point exception flag, which nothing
-/// here reads.
-#if defined(__GNUC__) && !defined(__clang__)
-#define WIRE_SELECT_KERNEL __attribute__((optimize("no-trapping-math")))
-#else
-#define WIRE_SELECT_KERNEL
-#endif
 
 namespace wire::detail {
 
@@ -49,27 +25,8 @@ void gather_segments(const CubicBezier* segments, const uint32_t* index, std::si
 /// (the caller takes unit_tangent()'s one-sided limits there). In frames.cpp.
 void boundary_tangents(const double* soa, std::size_t n, double* tx, double* ty, double* tz, double* ok);
 
-/// Bezier records (12 doubles each, segment k's at out + 12k) of `count` segments from their start and end nodes
-/// (3 doubles each, at p0 + 3k and p1 + 3k), node tangents per unit chord (Dx, Dy, Dz: the start node's at k, the
-/// end node's at k + 1) and chord lengths len[k]: b1 = b0 + u0, b2 = b3 - u1 with u0 = (D[k] len[k]) / 3 and
-/// u1 = (D[k + 1] len[k]) / 3. Returns whether every offset u is within +-offset_limit (false for NaN).
-/// build_curve's record pass (spline.cpp): a hand-written AVX-512 version where the CPU has one and count >= 8;
-/// `widest` false: the portable loop, the same bits (tests compare the two).
-bool node_segment_records(std::size_t count, const double* p0, const double* p1, const double* Dx, const double* Dy,
-                          const double* Dz, const double* len, double* out, double offset_limit, bool widest = true);
-
-/// The automatic spline's spread test on count nodes (concentrated_turns' arrays, spline.cpp: node i's incoming
-/// chord length, previous curvature vector and previous edge at index i, its own at i + 1, the next curvature
-/// vector at i + 2): flag[i] 1 where the spread is decided, and there lk[i] = |k|, sum[i] = |k| + |k~| and miss2[i]
-/// = |k - k~|^2. `certified`: as build_curve runs it (the root-free certificate, the exact test only where it
-/// fails); else the exact test on every node. Both must give the same flags and values (tests compare them).
-/// Returns the number of nodes the certificate left to the exact test.
-std::size_t spread_test(std::size_t count, const double* len, const double* kx, const double* ky, const double* kz,
-                        const double* ax, const double* ay, const double* az, const double* ec, const double* eq,
-                        double* lk, double* sum, double* miss2, double* flag, bool certified);
-
 /// boundary_tangents()' work for segment k (of n laid out by transpose_segments()). Always inlined: GCC inlines
-/// nothing else into a kernel compiled for another instruction set (WIRE_VECTOR_CLONES), and build_rings' Gauss
+/// nothing else into a kernel compiled for another instruction set (WIRE_VECTOR_CLONES, src/simd/dispatch.hpp), and build_rings' Gauss
 /// lengths kernel does this in the same pass over the segments.
 [[gnu::always_inline]] inline void boundary_tangent(const double* __restrict b, std::size_t n, std::size_t k,
                                                     double* __restrict tx, double* __restrict ty,

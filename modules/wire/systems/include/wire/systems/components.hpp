@@ -22,7 +22,7 @@ struct Nodes : WireNodes {};
 
 /// How the wire looks. Zero means default.
 struct Style {
-    float radius_m = 0.01f;       ///< tube radius where a node's radius is 0; 0 -> 1 cm
+    float radius_m = kDefaultWireRadius_m;  ///< tube radius where a node's radius is 0; 0 -> 1 cm
     uint32_t max_sides = 0;       ///< upper clamp of the LOD's radial sides; 0 -> 16
     SplineSettings spline{.kind = SplineKind::automatic};  ///< curve settings (default: automatic, the best measured;
                                                            ///< spline.closed and spline.radius_m come from this Style)

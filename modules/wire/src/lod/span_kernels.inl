@@ -1,6 +1,6 @@
-// The span hierarchy's kernels (compute_lod_bounds), included by lod.cpp once per lane width: W is the wide lane
-// type (L1, L2, L4 or L8 of lod.cpp); narrower lanes do the tail (L4 where WIRE_LOD_TAIL4 is defined, L2, L1). Not
-// a header: no include guard, no namespace of its own.
+// The span hierarchy's kernels (compute_lod_bounds), included by lod/span_kernels.cpp once per lane width: W is the
+// wide lane type (L1, L2, L4 or L8 of simd/lanes.hpp); narrower lanes do the tail (L4 where WIRE_LOD_TAIL4 is
+// defined, L2, L1). Not a header: no include guard, no namespace of its own.
 
 // Runs run(i, L{}) over [0, n) in groups of L::width consecutive items, the widest lanes first: full groups, then
 // one last group that ends at n and overlaps the one before (its items are computed again, bit for bit, and stored

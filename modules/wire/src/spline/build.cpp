@@ -1,0 +1,466 @@
+// The curve stage: a wire's nodes -> its Bezier segments (spline.hpp): the checks, the merge, each spline kind's
+// Hermite tangents, the tangent systems' solves (two or four wires side by side) and the records.
+#include "wire/spline.hpp"
+
+#include "spline/kernels.hpp"
+#include "spline/merge.hpp"
+#include "spline/scratch.hpp"
+#include "spline/tension.hpp"
+#include "spline/tridiagonal.hpp"
+#include "spline/validate.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <span>
+#include <utility>
+#include <vector>
+
+namespace wire {
+
+using namespace curve_stage;
+
+namespace {
+
+// The log-domain knot ratio's clamp, exp(-+300), for the pow-free alphas.
+const double kMinKnotRatio = std::exp(-300.0);
+const double kMaxKnotRatio = std::exp(300.0);
+
+// Per-segment Hermite tangents (per unit of the segment parameter u): t0 at the start, t1 at the end; structure
+// of arrays, the six arrays one after the other in one buffer (checked in one pass).
+struct Tangents {
+    std::vector<double> buf;
+    double *t0x = nullptr, *t0y = nullptr, *t0z = nullptr, *t1x = nullptr, *t1y = nullptr, *t1z = nullptr;
+    void resize(std::size_t segs) {
+        buf.resize(6 * segs);
+        t0x = buf.data(), t0y = t0x + segs, t0z = t0y + segs, t1x = t0z + segs, t1y = t1x + segs, t1z = t1y + segs;
+    }
+    void set0(std::size_t k, const dvec3& v) { t0x[k] = v.x, t0y[k] = v.y, t0z[k] = v.z; }
+    void set1(std::size_t k, const dvec3& v) { t1x[k] = v.x, t1y[k] = v.y, t1z[k] = v.z; }
+    void scale0(std::size_t k, double s) { t0x[k] = t0x[k] * s, t0y[k] = t0y[k] * s, t0z[k] = t0z[k] * s; }
+    void scale1(std::size_t k, double s) { t1x[k] = t1x[k] * s, t1y[k] = t1y[k] * s, t1z[k] = t1z[k] * s; }
+};
+
+// n zeros (per thread; grown when needed, never written): the weights of a wire with no tensed node.
+const double* zeros(std::size_t n) {
+    thread_local std::vector<double> z;
+    if (z.size() < n) z.resize(n);
+    return z.data();
+}
+
+// Node tangents per unit chord, node i's at i and index n repeating node 0's (x, y, z arrays, per-thread memory
+// valid until the next solve).
+struct NodeTangents {
+    const double *x = nullptr, *y = nullptr, *z = nullptr;
+};
+
+// Segment tangents from node tangents (for the kinds that then scale them per node).
+void segment_tangents(const NodeTangents& D, const Chords& ch, Tangents& tg) {
+    const double* const len = ch.len.data() + 1;  // segment k's length
+    tangents_kernel(ch.segs, D.x, len, tg.t0x, tg.t1x);
+    tangents_kernel(ch.segs, D.y, len, tg.t0y, tg.t1y);
+    tangents_kernel(ch.segs, D.z, len, tg.t0z, tg.t1z);
+}
+
+/// The nu-spline (Nielson 1974) with chordal knots: C1, and at node i the jump of the second derivative is
+/// proportional to the tangent (tension w_i, from concentrated_turns; g and gs its weights). Rows as the C2
+/// spline's (w = 0: c2) with w_i added to the diagonal; open ends not-a-knot, blending to free ends (zero
+/// curvature) as the neighbouring node gets tensed.
+/// The setup: everything but the solve of an open wire's interior rows (ts.pending), which solve() or
+/// thomas_pair() does before finish_tangents(). `pool` holds the system until then.
+void start_tangents(const Chords& ch, std::size_t n, bool closed, const double* g, const double* gs,
+                    const double* w, Pool& pool, TangentSolve& ts) {
+    const std::size_t segs = ch.segs;
+    const double* __restrict ex = ch.ex.data();  // node i: incoming chord at i, outgoing at i + 1
+    const double* __restrict ey = ch.ey.data();
+    const double* __restrict ez = ch.ez.data();
+    const double* __restrict len = ch.len.data();
+    // Working memory: the caller's, reused (no allocation per call once large enough). D (node tangents per
+    // unit chord) has index n repeating node 0's.
+    pool.reset(3 * (n + 1) + 4 * n);
+    double* const D[3] = {pool.carve(n + 1), pool.carve(n + 1), pool.carve(n + 1)};
+    double* __restrict a = pool.carve(n);
+    double* __restrict b = pool.carve(n);
+    double* __restrict c = pool.carve(n);
+    ts = TangentSolve{{D[0], D[1], D[2]}, a, b, c, pool.carve(n), n, 0, false};
+    // Rows i0 .. i0 + rows - 1 of the interior system, their right-hand sides in place in D.
+    const auto fill_rows = [&](std::size_t i0, std::size_t rows) {
+        in_whole_blocks(rows, [&](std::size_t o, std::size_t count) {
+            const std::size_t j = i0 + o;
+            rows_kernel(count, w + j, ex + j, ey + j, ez + j, len + j, a + o, b + o, c + o, D[0] + j, D[1] + j,
+                        D[2] + j);
+        });
+    };
+    const auto node = [&](std::size_t i) { return dvec3(D[0][i], D[1][i], D[2][i]); };
+    const auto set_node = [&](std::size_t i, const dvec3& v) { D[0][i] = v.x, D[1][i] = v.y, D[2][i] = v.z; };
+    if (closed) {
+        fill_rows(0, n);
+        thomas_cyclic(a, b, c, n, D);
+    } else if (n == 2) {
+        set_node(0, ch.e(0)), set_node(1, ch.e(0));
+    } else {
+        const auto s = [&](std::size_t k) { return ch.e(k); };
+        // End rows beta D0 + D1 = r: not-a-knot (beta = h1/(h0+h1)) blending to free (beta = 2, r = 3 s0).
+        const double h0 = ch.l(0), h1 = ch.l(1), hL = ch.l(segs - 1), hP = ch.l(segs - 2);
+        const dvec3 r0n = (s(0) * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s(1)) / ((h0 + h1) * (h0 + h1));
+        const dvec3 rln = (s(segs - 1) * (hP * (3.0 * hL + 2.0 * hP)) + (hL * hL) * s(segs - 2)) / ((hP + hL) * (hP + hL));
+        // The not-a-knot end makes the first (last) two segments one cubic, which overshoots when either
+        // node it spans is tensed (its tangent nearly vanishes): then the end becomes free.
+        const auto tensed = [&](std::size_t i) { return std::max(g[i], gs[i]); };
+        const double g0 = std::max(tensed(1), n > 3 ? tensed(2) : 0.0), gl = std::max(tensed(n - 2), n > 3 ? tensed(n - 3) : 0.0);
+        const double beta0 = (1.0 - g0) * h1 / (h0 + h1) + 2.0 * g0, betal = (1.0 - gl) * hP / (hP + hL) + 2.0 * gl;
+        const dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s(0), rl = (1.0 - gl) * rln + (3.0 * gl) * s(segs - 1);
+        const std::size_t m = n - 2;
+        fill_rows(1, m);  // row j is node j + 1's
+        if (m == 1) {
+            // 3 nodes: not-a-knot at both ends is the interpolating parabola (one cubic through 3 points is
+            // not determined: the elimination below would be singular); it blends with the tensed solution
+            // with free ends as the middle node gets tensed.
+            const double g1 = g[1];
+            const dvec3 p0 = s(0) - h0 * (s(1) - s(0)) / (h0 + h1), p1 = (h1 * s(0) + h0 * s(1)) / (h0 + h1);
+            const dvec3 p2 = s(1) + h1 * (s(1) - s(0)) / (h0 + h1);
+            // Free ends: 2 D0 + D1 = 3 s0, 2 D2 + D1 = 3 s1, middle row a D0 + (2 + w) D1 + c D2 = r.
+            const dvec3 t1 = (node(1) - 1.5 * (a[0] * s(0) + c[0] * s(1))) / (b[0] - 0.5 * (a[0] + c[0]));
+            const dvec3 t0 = 0.5 * (3.0 * s(0) - t1), t2 = 0.5 * (3.0 * s(1) - t1);
+            set_node(0, (1.0 - g1) * p0 + g1 * t0);
+            set_node(1, (1.0 - g1) * p1 + g1 * t1);
+            set_node(2, (1.0 - g1) * p2 + g1 * t2);
+        } else {
+            // Eliminate D0 and D[n-1] (pivots stay >= 1: a/beta <= 1); the interior rows are solved next.
+            set_node(1, node(1) - (a[0] / beta0) * r0), b[0] -= a[0] / beta0, a[0] = 0.0;
+            set_node(m, node(m) - (c[m - 1] / betal) * rl), b[m - 1] -= c[m - 1] / betal, c[m - 1] = 0.0;
+            ts.m = m, ts.pending = true;
+            ts.r0 = r0, ts.rl = rl, ts.beta0 = beta0, ts.betal = betal;
+        }
+    }
+}
+
+// The end nodes from the solved interior (an open wire's), and index n; the node tangents.
+NodeTangents finish_tangents(const TangentSolve& ts) {
+    double* const* D = ts.D;
+    const std::size_t n = ts.n;
+    const auto node = [&](std::size_t i) { return dvec3(D[0][i], D[1][i], D[2][i]); };
+    const auto set_node = [&](std::size_t i, const dvec3& v) { D[0][i] = v.x, D[1][i] = v.y, D[2][i] = v.z; };
+    if (ts.pending) {
+        set_node(0, (ts.r0 - node(1)) / ts.beta0);
+        set_node(n - 1, (ts.rl - node(n - 2)) / ts.betal);
+    }
+    D[0][n] = D[0][0], D[1][n] = D[1][0], D[2][n] = D[2][0];
+    return {D[0], D[1], D[2]};
+}
+
+}  // namespace
+
+double curvature_tension(double theta_rad, double iz_m4, double length_m, double delta_length_m, double area_m2) {
+    const double den = area_m2 * delta_length_m * delta_length_m;
+    if (!(den > 0.0) || !std::isfinite(den)) return 0.0;
+    const double R = std::abs(theta_rad * iz_m4 * length_m) / den;
+    if (!(R <= 100.0)) return 0.0;
+    return 1.0 - std::tanh(R / 50.0);
+}
+
+// Empties `c` keeping its capacity: a Curve reused across frames does not allocate.
+void clear_curve(Curve& c) {
+    c.segments.clear(), c.source_node.clear(), c.radius_m.clear(), c.stretch.clear();
+    c.closed = false;
+}
+
+namespace {
+
+// One wire's working memory in the curve stage (per thread, reused: no allocation per call once it is large
+// enough), and what its build carries from begin_curve to end_curve.
+struct CurveBuild {
+    Merged m;
+    Chords ch;
+    Tangents tg;
+    std::vector<double> g, gs, w;  // automatic: tension weights
+    Pool pool;                     // c2, automatic: the tangent system
+    TangentSolve ts;
+    const dvec3* P = nullptr;      // the curve's nodes (merged)
+    std::size_t n = 0, segs = 0;
+    bool physics = false;          // the physics arrays drive a curvature tension
+    bool solved = false;           // c2, automatic: node tangents in ts (once ts.pending is solved)
+};
+
+// Catmull-Rom / Kochanek-Bartels segment tangents into build.tg (see spline.hpp).
+void catmull_rom_tangents(const WireNodes& nodes, const SplineSettings& settings, CurveBuild& build) {
+    const Merged& m = build.m;
+    const Chords& ch = build.ch;
+    Tangents& tg = build.tg;
+    const std::size_t n = build.n, segs = build.segs;
+    const bool closed = settings.closed, physics = build.physics;
+    const double alpha = settings.alpha;
+    for (std::size_t j = 0; j < n; ++j) {
+        const uint32_t src = m.first[j];
+        const bool has_in = closed || j > 0, has_out = closed || j + 1 < n;
+        const std::size_t kin = has_in ? (j == 0 ? segs - 1 : j - 1) : 0;
+        const std::size_t kout = has_out ? (j == segs ? 0 : j) : segs - 1;
+        // Open ends reflect the missing neighbour (P[-1] = 2P[0]-P[1]): the missing chord equals the other.
+        const dvec3 din = has_in ? ch.d(kin) : ch.d(kout);
+        const dvec3 dout = has_out ? ch.d(kout) : ch.d(kin);
+        const double lin = has_in ? ch.l(kin) : ch.l(kout);
+        const double lout = has_out ? ch.l(kout) : ch.l(kin);
+
+        const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
+        const double b = nodes.kb_bias.empty() ? settings.bias : nodes.kb_bias[src];
+        const double c = nodes.kb_continuity.empty() ? settings.continuity : nodes.kb_continuity[src];
+        double t_curv = 0.0;
+        if (physics) {
+            t_curv = curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
+                                       nodes.delta_length_m[src], nodes.area_m2[src]);
+        }
+        const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
+        const double keep = 1.0 - t;
+
+        // Only the knot ratio matters; computed in the log domain so extreme alpha or spacing cannot give 0/0.
+        // alpha 1 and 0.5 (chordal, centripetal): the ratio itself and its square root, no log/exp; the
+        // same clamp as the log domain's (both lengths are > 0 and finite, so the ratio is never 0/0).
+        double rho;
+        if (alpha == 1.0 || alpha == 0.5) {
+            rho = lout / lin;
+            if (alpha == 0.5) rho = std::sqrt(rho);
+            rho = std::clamp(rho, kMinKnotRatio, kMaxKnotRatio);
+        } else {
+            const double lr = alpha == 0.0 ? 0.0 : std::clamp(alpha * (std::log(lout) - std::log(lin)), -300.0, 300.0);
+            rho = std::exp(lr);
+        }
+        const double w = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);  // w + iw = 1
+        const dvec3 start = keep * (((1.0 + b) * (1.0 + c) * rho * w) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
+        const dvec3 end = keep * (((1.0 + b) * (1.0 - c) * w) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
+        if (has_out) tg.set0(kout, start);
+        if (has_in) tg.set1(kin, end);
+    }
+}
+
+// build_curve without its clearing of `out` on entry, in two halves around the tridiagonal solve of c2 and
+// automatic curves (b.ts.pending: solve() or thomas_pair() runs it in between). Every field of `out` is
+// overwritten on success (the segments resized, not cleared first: a curve reused for the same wire is not
+// zero-filled before it is written), and build_curve clears it on failure.
+Status begin_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out, CurveBuild& b) {
+    b.ts.pending = false, b.solved = false;
+    if (Status st = check_settings(settings); !st) return st;
+    if (Status st = check_sizes(nodes); !st) return st;
+    const bool physics = settings.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
+                         !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
+    if (Status st = check_nodes(nodes, physics); !st) return st;
+
+    Merged& m = b.m;
+    Chords& ch = b.ch;
+    std::size_t n = 0;
+    const dvec3* const P = merge_nodes(nodes, settings, m, ch, n);
+    const bool closed = settings.closed;
+    if (n < 2) {
+        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(nodes.size()) +
+                             " node(s) and " + std::to_string(n) + " after merging coincident ones");
+    }
+    if (closed && n < 3) {
+        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(n) +
+                             " after merging coincident ones");
+    }
+    const std::size_t segs = closed ? n : n - 1;
+
+    std::vector<float>& seg_stretch = out.stretch;  // built in place
+    seg_stretch.assign(segs, 1.0f);
+    if (!nodes.stretch.empty()) {
+        for (std::size_t k = 0; k < segs; ++k) seg_stretch[k] = nodes.stretch[m.last[k]];
+    }
+
+    b.P = P, b.n = n, b.segs = segs, b.physics = physics;
+
+    // Segment tangents (t0 at a segment's start, t1 at its end); c2 and automatic: node tangents, from the
+    // tangent system set up here and solved before end_curve.
+    Tangents& tg = b.tg;
+    tg.resize(segs);
+    const SplineKind kind = settings.kind;
+    if (kind == SplineKind::linear) {
+        for (std::size_t k = 0; k < segs; ++k) tg.set0(k, ch.d(k)), tg.set1(k, ch.d(k));
+    } else if (kind == SplineKind::c2) {
+        // C2 interpolating spline with chordal knots (not-a-knot ends; the parabola through 3 nodes): the
+        // automatic spline's system with no node tensed (w = 0 everywhere, ends purely not-a-knot).
+        const double* const untensed = zeros(n);
+        start_tangents(ch, n, closed, untensed, untensed, untensed, b.pool, b.ts);
+        b.solved = true;
+    } else if (kind == SplineKind::automatic) {
+        if (concentrated_turns(ch, n, closed, b.g, b.gs, b.w)) {
+            start_tangents(ch, n, closed, b.g.data(), b.gs.data(), b.w.data(), b.pool, b.ts);
+        } else {
+            const double* const untensed = zeros(n);
+            start_tangents(ch, n, closed, untensed, untensed, untensed, b.pool, b.ts);
+        }
+        b.solved = true;
+    } else {
+        catmull_rom_tangents(nodes, settings, b);
+    }
+    return Status::success();
+}
+
+Status end_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out, CurveBuild& b) {
+    const Merged& m = b.m;
+    const Chords& ch = b.ch;
+    Tangents& tg = b.tg;
+    const dvec3* const P = b.P;
+    const std::size_t n = b.n, segs = b.segs;
+    const bool closed = settings.closed, physics = b.physics;
+    // The records are written from the node tangents (c2, and an automatic spline that no tension scales) or
+    // from segment tangents.
+    NodeTangents node_form{};
+    if (b.solved) node_form = finish_tangents(b.ts);
+    if (settings.kind == SplineKind::automatic) {
+        // Tension (wire, node, curvature-driven) scales both tangents at a node, as for catmull_rom (G1 kept;
+        // C2 only where it is 0). Nothing to scale with the wire's tension 0 and no per-node or physics input.
+        if (!nodes.kb_tension.empty() || physics || settings.tension != 0.0) {
+            segment_tangents(node_form, ch, tg);
+            node_form = {};
+            for (std::size_t j = 0; j < n; ++j) {
+                const uint32_t src = m.first[j];
+                const double t_user = nodes.kb_tension.empty() ? settings.tension : nodes.kb_tension[src];
+                const double t_curv = physics ? curvature_tension(nodes.theta_rad[src], nodes.iz_m4[src], nodes.length_m[src],
+                                                                  nodes.delta_length_m[src], nodes.area_m2[src])
+                                              : 0.0;
+                const double keep = (1.0 - t_user) * (1.0 - t_curv);
+                if (keep == 1.0) continue;
+                if (closed || j + 1 < n) tg.scale0(j == segs ? 0 : j, keep);
+                if (closed || j > 0) tg.scale1(j == 0 ? segs - 1 : j - 1, keep);
+            }
+        }
+    }
+
+
+    // The Bezier records (inner control points B1 = P0 + t0/3, B2 = P1 - t1/3) and the range check of the inner
+    // control points. Finite is not enough: a control point past the coordinate range (an extreme alpha)
+    // overflows the tube's float vertices downstream.
+    constexpr double kMaxControl_m = 10.0 * kMaxCoordinate_m;
+    // The node-tangent records test the offsets t/3 instead (in their structure-of-arrays form, before they are
+    // interleaved into records): the nodes are within +-kMaxCoordinate_m (check_nodes), so offsets within
+    // +-kMaxOffset_m give control points within +-9e12 (rounding is monotonic and 9e12 is a double). Sufficient,
+    // not necessary: when it fails, the exact test below decides (a control point just in range passes it).
+    constexpr double kMaxOffset_m = kMaxControl_m - 2.0 * kMaxCoordinate_m;
+    static_assert(sizeof(CubicBezier) == 12 * sizeof(double));
+    out.segments.resize(segs);
+    CubicBezier* const seg = out.segments.data();
+    const auto segments = [&](std::size_t k0, std::size_t count, const dvec3* p0, const dvec3* p1) {
+        if (node_form.x != nullptr) {
+            return node_segments(count, &p0->x, &p1->x, node_form.x + k0, node_form.y + k0, node_form.z + k0,
+                                 ch.len.data() + 1 + k0, &seg[k0].b0.x, kMaxOffset_m);
+        }
+        return segments_kernel(count, &p0->x, &p1->x, tg.t0x + k0, tg.t0y + k0, tg.t0z + k0, tg.t1x + k0,
+                               tg.t1y + k0, tg.t1z + k0, &seg[k0].b0.x, kMaxControl_m);
+    };
+    bool in_range = segments(0, n - 1, P, P + 1);
+    if (closed) in_range &= segments(n - 1, 1, P + (n - 1), P);
+    if (!in_range) {
+        for (std::size_t k = 0; k < segs; ++k) {
+            if (values_within(&seg[k].b1.x, 6, kMaxControl_m)) continue;
+            const uint32_t src = m.first[k];
+            clear_curve(out);
+            return Status::error(node_prefix(src) + "tangent overflowed (alpha " + describe(settings.alpha) +
+                                     " is too extreme for this node spacing)", static_cast<int>(src));
+        }
+    }
+    out.closed = closed;
+    out.source_node = m.first;
+    const float wire_radius = settings.radius_m > 0.0f ? settings.radius_m : kDefaultWireRadius_m;
+    if (nodes.radius_m.empty()) {
+        out.radius_m.assign(n, wire_radius);
+    } else {
+        out.radius_m.resize(n);
+        for (std::size_t j = 0; j < n; ++j) {
+            const float r = nodes.radius_m[m.first[j]];
+            out.radius_m[j] = r > 0.0f ? r : wire_radius;
+        }
+    }
+    return Status::success();
+}
+
+// A thread's build memory: build_curve uses the first, build_curves (and build_curve_pair) one per wire (nothing
+// calls build_curve between a group's begin_curve and end_curve), so a thread keeps at most two builds' worth for
+// its largest wires and two more for wires of up to 1,024 nodes (build_curves' kGroupNodes).
+CurveBuild& thread_build(std::size_t k) {
+    thread_local CurveBuild b[4];
+    return b[k];
+}
+
+}  // namespace
+
+Status build_curve(const WireNodes& nodes, const SplineSettings& settings, Curve& out) {
+    CurveBuild& b = thread_build(0);
+    Status st = begin_curve(nodes, settings, out, b);
+    if (st && b.ts.pending) solve(b.ts);
+    if (st) st = end_curve(nodes, settings, out, b);
+    if (!st) clear_curve(out);
+    return st;
+}
+
+void build_curves(std::span<CurveBuildJob> jobs) {
+    if (jobs.size() > 4) {  // four at a time, in order
+        for (std::size_t first = 0; first < jobs.size(); first += 4) {
+            build_curves(jobs.subspan(first, std::min<std::size_t>(4, jobs.size() - first)));
+        }
+        return;
+    }
+    const std::size_t count = jobs.size();
+    // Two jobs writing one curve cannot be built side by side: what build_curve calls in order leave (the later
+    // job's curve).
+    for (std::size_t k = 1; k < count; ++k) {
+        for (std::size_t l = 0; l < k; ++l) {
+            if (jobs[k].out != jobs[l].out) continue;
+            for (CurveBuildJob& job : jobs) job.status = build_curve(*job.nodes, *job.settings, *job.out);
+            return;
+        }
+    }
+    // Four builds in flight keep four builds' working memory per thread: only wires of up to kGroupNodes nodes
+    // take the third and fourth (a group with a larger wire is built as two pairs, in the first two builds).
+    constexpr std::size_t kGroupNodes = 1024;
+    const auto large = [](const CurveBuildJob& j) { return j.nodes->size() > kGroupNodes; };
+    if (count > 2 && std::any_of(jobs.begin(), jobs.begin() + count, large)) {
+        build_curves(jobs.first(2));
+        build_curves(jobs.subspan(2, count - 2));
+        return;
+    }
+    CurveBuild* b[4] = {};
+    for (std::size_t k = 0; k < count; ++k) {  // each build keeps its own memory until its end
+        b[k] = &thread_build(k);
+        jobs[k].status = begin_curve(*jobs[k].nodes, *jobs[k].settings, *jobs[k].out, *b[k]);
+    }
+    // The pending solves: four of one size side by side, else pairs of one size, else alone (the same results).
+    const auto pending = [&](std::size_t k) { return jobs[k].status.ok && b[k]->ts.pending; };
+    bool solved[4] = {};
+#if defined(__GNUC__)
+    if (count == 4 && pending(0) && pending(1) && pending(2) && pending(3) && b[0]->ts.m >= 4 &&
+        b[1]->ts.m == b[0]->ts.m && b[2]->ts.m == b[0]->ts.m && b[3]->ts.m == b[0]->ts.m) {
+        TangentSolve* const s[4] = {&b[0]->ts, &b[1]->ts, &b[2]->ts, &b[3]->ts};
+        thomas_quad(s);
+        solved[0] = solved[1] = solved[2] = solved[3] = true;
+    }
+#endif
+    for (std::size_t k = 0; k < count; ++k) {
+        if (!pending(k) || solved[k]) continue;
+        solved[k] = true;
+        std::size_t other = k + 1;
+        while (other < count && !(pending(other) && !solved[other] && b[other]->ts.m == b[k]->ts.m)) ++other;
+        if (other < count && b[k]->ts.m >= 4) {
+            thomas_pair(b[k]->ts, b[other]->ts);
+            solved[other] = true;
+        } else {
+            solve(b[k]->ts);
+        }
+    }
+    for (std::size_t k = 0; k < count; ++k) {
+        CurveBuildJob& job = jobs[k];
+        if (job.status) job.status = end_curve(*job.nodes, *job.settings, *job.out, *b[k]);
+        if (!job.status) clear_curve(*job.out);
+    }
+}
+
+std::pair<Status, Status> build_curve_pair(const WireNodes& nodes0, const SplineSettings& settings0, Curve& out0,
+                                           const WireNodes& nodes1, const SplineSettings& settings1, Curve& out1) {
+    CurveBuildJob jobs[2] = {{&nodes0, &settings0, &out0, {}}, {&nodes1, &settings1, &out1, {}}};
+    build_curves(jobs);
+    return {std::move(jobs[0].status), std::move(jobs[1].status)};
+}
+
+}  // namespace wire
