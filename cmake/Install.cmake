@@ -16,7 +16,7 @@ set(WIRES_INSTALL_CMAKEDIR "lib/cmake/wires" CACHE STRING "Where the wires CMake
 # target -> export name (wires::<name>). Also ALIASes in this build, so a parent project using
 # add_subdirectory() can link the same names.
 set(wires_exported
-  engine_ecs:ecs engine_scene:scene engine_platform:platform engine_gfx:gfx engine_assets:assets
+  engine_core:core engine_ecs:ecs engine_scene:scene engine_platform:platform engine_gfx:gfx engine_assets:assets
   wire_core:wire wire_io:wire_io wire_systems:wire_systems wire_render:wire_render curved_space:curved_space)
 
 set(wires_targets "")

@@ -99,7 +99,7 @@ wire::SplineSettings spline_of(const std::string& name) {
     wire::io::WireSpec spec;
     spec.spline_type = name;
     wire::PipelineSettings s;
-    if (wire::Status st = wire::io::resolve_settings(spec, {}, s); !st.ok)
+    if (engine::Status st = wire::io::resolve_settings(spec, {}, s); !st.ok())
         value_error("spline: " + st.message);
     return s.spline;
 }
@@ -438,10 +438,10 @@ py::dict mesh_rings(const DoubleArray& positions, const std::optional<IdArray>& 
     overrides.rings_per_segment = rings_per_segment;
     overrides.tolerance_m = tolerance_m;
     wire::PipelineSettings settings;
-    if (wire::Status st = wire::io::resolve_settings(spec, overrides, settings); !st.ok)
+    if (engine::Status st = wire::io::resolve_settings(spec, overrides, settings); !st.ok())
         value_error(st.message);
     wire::WirePipeline pipeline;
-    if (wire::Status st = pipeline.update(to_nodes(positions, ids, stretch, radii), settings); !st.ok) {
+    if (engine::Status st = pipeline.update(to_nodes(positions, ids, stretch, radii), settings); !st.ok()) {
         PyErr_SetString(g_wire_error, st.message.c_str());
         throw py::error_already_set();
     }
@@ -512,7 +512,7 @@ PYBIND11_MODULE(wires, m) {
                     .height = static_cast<int>(img.shape(0)),
                     .rgba = std::vector<uint8_t>(img.data(), img.data() + img.size())};
                 if (auto st = engine::platform::write_png(path, image); !st)
-                    throw std::runtime_error(path + ": " + st.error().message);
+                    throw std::runtime_error(path + ": " + st.message);
             },
             py::arg("path"), py::arg("image"))
         .def("project", &Runtime::project, py::arg("points"),

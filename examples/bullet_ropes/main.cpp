@@ -120,8 +120,8 @@ int main(int argc, char** argv) {
                              ctx.input().pressed(platform::Key::f12);
         if (capture) {
             const std::filesystem::path path = opt.out_dir / frame_name(frame);
-            if (platform::Status s = platform::capture_png(ctx, path); !s) {
-                std::fprintf(stderr, "bullet_ropes: %s\n", s.error().message.c_str());
+            if (engine::Status s = platform::capture_png(ctx, path); !s) {
+                std::fprintf(stderr, "bullet_ropes: %s\n", s.message.c_str());
                 return 1;
             }
             std::printf("%s\n", path.c_str());

@@ -199,7 +199,7 @@ void RopeScene::sync_wires() {
     for (const Rope& rope : ropes_) wire::systems::set_nodes(registry_, rope.wire, wire_nodes(*rope.body));
 }
 
-engine::platform::Expected<RopeView> RopeView::create(const RopeScene& scene) {
+engine::Expected<RopeView> RopeView::create(const RopeScene& scene) {
     RopeView view;
     auto lit = engine::gfx::LitRenderer::create();
     if (!lit) return lit.error();

@@ -11,7 +11,7 @@
 #include <engine/ecs/registry.hpp>
 #include <engine/gfx/lit_renderer.hpp>
 #include <engine/gfx/mesh.hpp>
-#include <engine/platform/expected.hpp>
+#include <engine/core/expected.hpp>
 #include <engine/scene/camera.hpp>
 #include <wire/draw.hpp>
 #include <wire/nodes.hpp>
@@ -81,7 +81,7 @@ private:
 /// material per rope colour. Needs a current GL 4.5 context.
 class RopeView {
 public:
-    static engine::platform::Expected<RopeView> create(const RopeScene& scene);
+    static engine::Expected<RopeView> create(const RopeScene& scene);
 
     /// Clears, draws the floor and the box, then the wires of `list`.
     void draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera);

@@ -168,8 +168,8 @@ int main(int argc, char** argv) {
             std::printf("demo: wrote %s\n", shot.string().c_str());
         }
         if (!shot.empty()) {
-            if (platform::Status s = platform::capture_png(ctx, shot); !s) {
-                std::fprintf(stderr, "demo: %s\n", s.error().message.c_str());
+            if (engine::Status s = platform::capture_png(ctx, shot); !s) {
+                std::fprintf(stderr, "demo: %s\n", s.message.c_str());
                 return 1;
             }
             written.push_back(shot.string());

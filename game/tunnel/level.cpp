@@ -46,7 +46,7 @@ LevelSettings with_defaults(const LevelSettings& settings_in) {
 }
 
 // The 8 cable anchors of a piece (unbent, piece space) from anchors.json.
-engine::platform::Status read_anchors(const std::string& path, std::vector<glm::dvec3>& anchors) {
+engine::Status read_anchors(const std::string& path, std::vector<glm::dvec3>& anchors) {
     std::ifstream in(path);
     if (!in) return Error{path + ": cannot open"};
     std::stringstream text;
@@ -71,12 +71,12 @@ Expected<std::unique_ptr<Level>> Level::create(const LevelSettings& settings) {
     std::unique_ptr<Level> level(new Level());
     State& s = *level->state_;
     s.settings = with_defaults(settings);
-    if (auto st = level->load_pieces(); !st) return st.error();
-    if (auto st = read_anchors(s.settings.asset_dir + "/anchors.json", s.anchors); !st) return st.error();
+    if (auto st = level->load_pieces(); !st) return st;
+    if (auto st = read_anchors(s.settings.asset_dir + "/anchors.json", s.anchors); !st) return st;
     level->build_chain();
     level->animate(0.0);
-    if (auto st = level->create_wire_renderer(); !st) return st.error();
-    if (auto st = level->spawn_fixed_cables(); !st) return st.error();
+    if (auto st = level->create_wire_renderer(); !st) return st;
+    if (auto st = level->spawn_fixed_cables(); !st) return st;
     level->spawn_ropes();
     level->settle();
     level->install_systems();

@@ -23,7 +23,7 @@
 #include <engine/assets/mesh_data.hpp>
 #include <engine/ecs/entity.hpp>
 #include <engine/ecs/schedule.hpp>
-#include <engine/platform/expected.hpp>
+#include <engine/core/expected.hpp>
 #include <engine/scene/camera.hpp>
 #include <wire/curve.hpp>
 #include <wire/draw.hpp>
@@ -39,9 +39,9 @@
 
 namespace tunnel {
 
-using engine::platform::Error;
-using engine::platform::Expected;
-using engine::platform::Status;
+using engine::Error;
+using engine::Expected;
+using engine::Status;
 
 /// Fixed at creation. Zero means default.
 struct LevelSettings {

@@ -162,7 +162,7 @@ int run_headless(platform::Context& ctx, tunnel::Level& level, const Args& args)
         if (capture.count(f) != 0) {
             const std::string path = frame_png(args.out, static_cast<uint64_t>(f));
             if (auto s = platform::capture_png(ctx, path); !s) {
-                std::fprintf(stderr, "tunnel: %s\n", s.error().message.c_str());
+                std::fprintf(stderr, "tunnel: %s\n", s.message.c_str());
                 return 1;
             }
             written.push_back(path);
@@ -268,7 +268,7 @@ int run_window(platform::Context& ctx, tunnel::Level& level, const Args& args) {
             std::snprintf(name, sizeof name, "screenshot_%03d.png", shots++);
             const std::string path = (std::filesystem::path(args.out) / name).string();
             if (auto s = platform::capture_png(ctx, path); !s) {
-                std::fprintf(stderr, "tunnel: %s\n", s.error().message.c_str());
+                std::fprintf(stderr, "tunnel: %s\n", s.message.c_str());
             } else {
                 std::printf("wrote %s\n", path.c_str());
             }

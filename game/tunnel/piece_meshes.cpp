@@ -48,7 +48,7 @@ std::vector<Group> make_groups() {
             {.name = "clips", .surface = Surface::steel, .albedo = {0.42f, 0.44f, 0.47f}}};
 }
 
-engine::platform::Status load_piece_meshes(const std::string& asset_dir, std::vector<Group>& groups) {
+engine::Status load_piece_meshes(const std::string& asset_dir, std::vector<Group>& groups) {
     std::vector<engine::assets::MeshData> meshes;
     for (const char* file : {"straight_section.glb", "wall_details.glb", "cable_hooks.glb"}) {
         const std::string path = asset_dir + "/" + file;
@@ -71,7 +71,7 @@ engine::platform::Status load_piece_meshes(const std::string& asset_dir, std::ve
     return {};
 }
 
-engine::assets::Status refine_group(Group& g, int max_level, PieceRenderer& pieces) {
+engine::Status refine_group(Group& g, int max_level, PieceRenderer& pieces) {
     for (int lvl = 0; lvl <= max_level; ++lvl) {
         engine::assets::MeshData combined;
         combined.name = g.name;
@@ -81,7 +81,7 @@ engine::assets::Status refine_group(Group& g, int max_level, PieceRenderer& piec
             append(combined, refined);
         }
         auto handle = pieces.add_mesh(combined, g.name + " level " + std::to_string(lvl));
-        if (!handle) return engine::assets::Status::failure(handle.error().message);
+        if (!handle) return engine::Status::error(handle.error().message);
         g.meshes.push_back(handle.value());
         g.vertices.push_back(combined.vertex_count());
         if (lvl == max_level) {

@@ -8,7 +8,7 @@
 
 #include <engine/assets/mesh_data.hpp>
 #include <engine/assets/subdivide.hpp>
-#include <engine/platform/expected.hpp>
+#include <engine/core/expected.hpp>
 
 #include <glm/vec3.hpp>
 
@@ -40,11 +40,11 @@ std::vector<Group> make_groups();
 /// Reads straight_section.glb, wall_details.glb and cable_hooks.glb from asset_dir and adds each mesh's
 /// control mesh to its group ("tunnel_wall": wall, "rib_*": ribs, "walkway", "anchor_*": hooks; others are
 /// ignored). Errors name the file or the mesh.
-engine::platform::Status load_piece_meshes(const std::string& asset_dir, std::vector<Group>& groups);
+engine::Status load_piece_meshes(const std::string& asset_dir, std::vector<Group>& groups);
 
 /// Refines every control mesh of `g` at levels 0..max_level, uploads each level's combined mesh to `pieces`,
 /// and keeps the vertex counts, the highest level (top) and its smallest distance from the axis.
-engine::assets::Status refine_group(Group& g, int max_level, PieceRenderer& pieces);
+engine::Status refine_group(Group& g, int max_level, PieceRenderer& pieces);
 
 /// What the ropes collide with, measured on the refined wall, ribs and walkway (within a fraction of a
 /// millimetre of the limit surfaces at level 4; the wall's and ribs' refined polygons lie inside their limit

@@ -6,7 +6,7 @@
 
 #include <curved_space/gpu.hpp>
 #include <engine/assets/mesh_data.hpp>
-#include <engine/platform/expected.hpp>
+#include <engine/core/expected.hpp>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
@@ -19,8 +19,8 @@
 
 namespace tunnel {
 
-using engine::platform::Error;
-using engine::platform::Expected;
+using engine::Error;
+using engine::Expected;
 
 /// How a surface is shaded (procedural detail in the fragment shader, from the unbent position).
 enum class Surface : int {

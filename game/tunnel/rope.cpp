@@ -277,7 +277,7 @@ AdaptResult Rope::adapt(const wire::SplineSettings& spline) {
             wire::WireNodes nodes;
             write_nodes(nodes);
             wire::Curve curve;
-            if (wire::build_curve(nodes, spline, curve).ok) {
+            if (wire::build_curve(nodes, spline, curve).ok()) {
                 for (std::size_t k = 0; k + 1 < curve.node_count(); ++k) {
                     if (curve.source_node[k] == e && curve.source_node[k + 1] == e + 1) {
                         p = wire::position(curve.segments[k], 0.5);

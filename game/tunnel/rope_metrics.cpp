@@ -27,7 +27,7 @@ void Level::measure_ropes() {
     wire::Curve curve;
     for (std::size_t r = 0; r < ropes_.size(); ++r) {
         ropes_[r].write_nodes(nodes);
-        if (!wire::build_curve(nodes, spline, curve).ok) continue;
+        if (!wire::build_curve(nodes, spline, curve).ok()) continue;
         for (const wire::CubicBezier& seg : curve.segments)
             for (int k = 0; k < 8; ++k) samples[r].push_back(wire::position(seg, k / 8.0));
         samples[r].push_back(nodes.positions.back());

@@ -86,8 +86,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     FuzzedDataProvider in(body + skip, size - 1 - skip);
     if (json) {
         const std::string text(reinterpret_cast<const char*>(body), text_size);
-        const curved_space::Status st = curved_space::parse_segments_json(text, "fuzz.json", segments);
-        if (!st.ok) {
+        const engine::Status st = curved_space::parse_segments_json(text, "fuzz.json", segments);
+        if (!st.ok()) {
             wire_fuzz::require(!st.message.empty(), "rejected SEGS.json without a message");
             wire_fuzz::require(st.message.rfind("fuzz.json", 0) == 0, "SEGS.json message does not name the file");
             wire_fuzz::require(segments.empty(), "rejected SEGS.json changed the output");
@@ -103,8 +103,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
             std::fprintf(stderr, "segment length %.17g angle %.17g direction %.17g\n", s.length_m, s.angle_rad,
                          s.direction_rad);
     curved_space::Chain chain;
-    const curved_space::Status st = curved_space::make_chain(segments, chain);
-    if (!st.ok) {
+    const engine::Status st = curved_space::make_chain(segments, chain);
+    if (!st.ok()) {
         wire_fuzz::require(!st.message.empty(), "make_chain error without a message");
         wire_fuzz::require(chain.segment_count() == 0, "rejected chain changed the output");
         return 0;

@@ -151,8 +151,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
         if (want_dump) dump(settings, nodes, k);
 
         wire::Curve curve;
-        const wire::Status cs = wire::build_curve(nodes, settings.spline, curve);
-        if (!cs.ok) {
+        const engine::Status cs = wire::build_curve(nodes, settings.spline, curve);
+        if (!cs.ok()) {
             wire_fuzz::require(!cs.message.empty(), "build_curve error without a message");
             wire_fuzz::require(curve.segments.empty(), "build_curve error left segments in the output");
         } else {
@@ -162,8 +162,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
                                    "build_curve control point not finite");
         }
 
-        const wire::Status ps = pipeline.update(nodes, settings);
-        if (!ps.ok) {
+        const engine::Status ps = pipeline.update(nodes, settings);
+        if (!ps.ok()) {
             wire_fuzz::require(!ps.message.empty(), "pipeline error without a message");
             continue;
         }

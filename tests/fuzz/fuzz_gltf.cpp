@@ -30,7 +30,7 @@ void check_mesh(const engine::assets::MeshData& m, const char* stage) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     std::vector<engine::assets::MeshData> meshes;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(data, size)), "fuzz.glb", meshes);
     if (!st.ok()) {
         wire_fuzz::require(st.message.rfind("fuzz.glb: ", 0) == 0, "glTF error does not name the input");
@@ -43,14 +43,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
         check_mesh(m, "read_gltf");
         if (m.triangle_count() > 20000) continue;  // keep one run fast
         engine::assets::ControlMesh control;
-        const engine::assets::Status cs = engine::assets::make_control_mesh(m, control);
+        const engine::Status cs = engine::assets::make_control_mesh(m, control);
         if (!cs.ok()) {
             wire_fuzz::require(!cs.message.empty(), "make_control_mesh error without a message");
             continue;
         }
         for (float f : control.positions) wire_fuzz::require(std::isfinite(f), "control position not finite");
         engine::assets::MeshData fine;
-        const engine::assets::Status ss = engine::assets::subdivide(control, 1, fine);
+        const engine::Status ss = engine::assets::subdivide(control, 1, fine);
         if (!ss.ok()) {
             wire_fuzz::require(!ss.message.empty(), "subdivide error without a message");
             continue;

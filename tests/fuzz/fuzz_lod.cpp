@@ -64,7 +64,7 @@ wire::Curve read_curve(FuzzedDataProvider& in) {
         s.kind = static_cast<wire::SplineKind>(in.ConsumeIntegralInRange<int>(0, 3));
         s.closed = c.closed;
         s.radius_m = static_cast<float>(scale * in.ConsumeFloatingPointInRange<double>(1e-3, 0.5));
-        if (wire::build_curve(nodes, s, c).ok) return c;
+        if (wire::build_curve(nodes, s, c).ok()) return c;
         c = wire::Curve{};
     }
     glm::dvec3 p = offset + scale * vec_in(in, -1.0, 1.0);

@@ -15,8 +15,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
     wire::io::SceneSpec scene;
-    const wire::Status st = wire::io::parse_wire_json(text, "fuzz.json", scene);
-    if (!st.ok) {
+    const engine::Status st = wire::io::parse_wire_json(text, "fuzz.json", scene);
+    if (!st.ok()) {
         wire_fuzz::require(!st.message.empty(), "rejected wire JSON without a message");
         wire_fuzz::require(st.message.rfind("fuzz.json", 0) == 0, "wire JSON message does not name the file");
         wire_fuzz::require(scene.frames.empty(), "rejected wire JSON left frames in the output");
@@ -33,13 +33,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
             small.rings_per_segment = 2;
             small.sides = static_cast<uint32_t>(std::min(spec.sides.value_or(6), 8));
             wire::PipelineSettings settings;
-            const wire::Status rs = wire::io::resolve_settings(spec, small, settings);
-            if (!rs.ok) {
+            const engine::Status rs = wire::io::resolve_settings(spec, small, settings);
+            if (!rs.ok()) {
                 wire_fuzz::require(!rs.message.empty(), "resolve_settings error without a message");
                 continue;
             }
-            const wire::Status ps = pipelines[w].update(wire::io::to_wire_nodes(spec), settings);
-            if (!ps.ok) {
+            const engine::Status ps = pipelines[w].update(wire::io::to_wire_nodes(spec), settings);
+            if (!ps.ok()) {
                 wire_fuzz::require(!ps.message.empty(), "pipeline error without a message");
                 continue;
             }

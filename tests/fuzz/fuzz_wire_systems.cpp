@@ -389,8 +389,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
             continue;
         }
         wire::Curve fresh;
-        const wire::Status st = wire::build_curve(h.registry.get<ws::Nodes>(w.entity), spline_of(h.registry.get<ws::Style>(w.entity)), fresh);
-        wire_fuzz::require(st.ok, "a wire without WireError has nodes build_curve rejects");
+        const engine::Status st = wire::build_curve(h.registry.get<ws::Nodes>(w.entity), spline_of(h.registry.get<ws::Style>(w.entity)), fresh);
+        wire_fuzz::require(st.ok(), "a wire without WireError has nodes build_curve rejects");
         wire_fuzz::require(fresh.segments.size() == c.curve.segments.size(), "settled curve has another segment count than a fresh one");
         double scale = 1.0;
         for (const wire::CubicBezier& b : fresh.segments)

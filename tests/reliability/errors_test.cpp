@@ -21,30 +21,30 @@ namespace {
 
 std::string wire_json_error(const std::string& text) {
     wire::io::SceneSpec scene;
-    const wire::Status st = wire::io::parse_wire_json(text, "cable.json", scene);
-    EXPECT_FALSE(st.ok);
+    const engine::Status st = wire::io::parse_wire_json(text, "cable.json", scene);
+    EXPECT_FALSE(st.ok());
     EXPECT_TRUE(scene.frames.empty());
     return st.message;
 }
 
 std::string pipeline_error(const wire::WireNodes& nodes, const wire::PipelineSettings& settings = {}) {
     wire::WirePipeline pipeline;
-    const wire::Status st = pipeline.update(nodes, settings);
-    EXPECT_FALSE(st.ok);
+    const engine::Status st = pipeline.update(nodes, settings);
+    EXPECT_FALSE(st.ok());
     return st.message;
 }
 
 std::string segments_error(const std::string& text) {
     std::vector<curved_space::Segment> segments;
-    const curved_space::Status st = curved_space::parse_segments_json(text, "segs.json", segments);
-    EXPECT_FALSE(st.ok);
+    const engine::Status st = curved_space::parse_segments_json(text, "segs.json", segments);
+    EXPECT_FALSE(st.ok());
     EXPECT_TRUE(segments.empty());
     return st.message;
 }
 
 std::string gltf_memory_error(const std::string& bytes) {
     std::vector<engine::assets::MeshData> meshes;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "piece.gltf", meshes);
     EXPECT_FALSE(st.ok());
     EXPECT_TRUE(meshes.empty());
@@ -153,7 +153,7 @@ TEST(WireJsonErrors, DuplicateIdNamesBothTheNodeAndTheId) {
 
 TEST(WireJsonErrors, MissingFileNamesThePath) {
     wire::io::SceneSpec scene;
-    const wire::Status st = wire::io::load_wire_json("/nonexistent/cable.json", scene);
+    const engine::Status st = wire::io::load_wire_json("/nonexistent/cable.json", scene);
     EXPECT_EQ(st.message, "/nonexistent/cable.json: cannot open: No such file or directory");
 }
 
@@ -163,9 +163,9 @@ TEST(CurveErrors, NanCoordinateNamesNodeAndAxis) {
     wire::WireNodes nodes;
     nodes.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, std::numeric_limits<double>::quiet_NaN(), 0}};
     wire::WirePipeline pipeline;
-    const wire::Status st = pipeline.update(nodes, {});
+    const engine::Status st = pipeline.update(nodes, {});
     EXPECT_EQ(st.message, "node 3: position.y is NaN");
-    EXPECT_EQ(st.node, 3);
+    EXPECT_EQ(st.index, 3);
 }
 
 TEST(CurveErrors, InfiniteCoordinate) {
@@ -225,7 +225,7 @@ TEST(CurveErrors, PipelineKeepsThePreviousStateOnError) {
     wire::WireNodes good;
     good.positions = {{0, 0, 0}, {1, 0, 0}, {2, 1, 0}};
     wire::WirePipeline pipeline;
-    ASSERT_TRUE(pipeline.update(good, {}).ok);
+    ASSERT_TRUE(pipeline.update(good, {}).ok());
     const std::size_t vertices = pipeline.mesh().vertices.size();
     wire::WireNodes bad = good;
     bad.positions[2].x = std::numeric_limits<double>::infinity();
@@ -275,8 +275,8 @@ TEST(CurveErrors, DenormalRadiusRegression) {
     nodes.radius_m[7] = 1e-6f;
     nodes.stretch.assign(nodes.positions.size(), 1e-6f);
     wire::WirePipeline pipeline;
-    const wire::Status st = pipeline.update(nodes, s);
-    ASSERT_TRUE(st.ok) << st.message;
+    const engine::Status st = pipeline.update(nodes, s);
+    ASSERT_TRUE(st.ok()) << st.message;
     ASSERT_FALSE(pipeline.mesh().vertices.empty());
     float max_u = 0.0f;
     for (const wire::TubeVertex& v : pipeline.mesh().vertices) {
@@ -341,7 +341,7 @@ TEST(GltfMemory, ReadsWhatWriteGlbWrote) {
     std::ifstream in(path, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::vector<engine::assets::MeshData> from_memory, from_file;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "quad.glb", from_memory);
     ASSERT_TRUE(st.ok()) << st.message;
     ASSERT_TRUE(engine::assets::read_gltf(path, from_file).ok());
@@ -358,7 +358,7 @@ TEST(GltfMemory, ReadsWhatWriteGlbWrote) {
 TEST(GltfMemory, JsonWithEmbeddedBuffer) {
     const std::string text = quad_gltf(3);
     std::vector<engine::assets::MeshData> meshes;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(text.data(), text.size())), "quad.gltf", meshes);
     ASSERT_TRUE(st.ok()) << st.message;
     ASSERT_EQ(meshes.size(), 1u);
@@ -413,7 +413,7 @@ std::string quad_bin() {
 
 std::string glb_error(const std::string& bytes) {
     std::vector<engine::assets::MeshData> meshes;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "piece.glb", meshes);
     EXPECT_FALSE(st.ok());
     EXPECT_TRUE(meshes.empty());
@@ -436,7 +436,7 @@ TEST(GlbErrors, BinChunkLongerThanTheFileRegression) {
 TEST(GlbErrors, ValidQuadLoads) {
     const std::string bytes = glb({{kJson, quad_glb_json(R"([{"byteLength":60}])")}, {kBin, quad_bin()}});
     std::vector<engine::assets::MeshData> meshes;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(bytes.data(), bytes.size())), "piece.glb", meshes);
     ASSERT_TRUE(st.ok()) << st.message;
     ASSERT_EQ(meshes.size(), 1u);
@@ -513,7 +513,7 @@ TEST(GlbErrors, ImagesAreNotDecodedButTheirByteRangeIsChecked) {
     };
     const std::string ok = with_offset(52);
     std::vector<engine::assets::MeshData> meshes;
-    const engine::assets::Status st =
+    const engine::Status st =
         engine::assets::read_gltf_memory(std::as_bytes(std::span(ok.data(), ok.size())), "piece.glb", meshes);
     EXPECT_TRUE(st.ok()) << st.message;
     EXPECT_EQ(glb_error(with_offset(4000)),
@@ -549,7 +549,7 @@ TEST(GltfErrors, ExternalBufferOutsideTheFilesDirectoryIsRefused) {
     std::vector<engine::assets::MeshData> meshes;
     // Beside the file: read.
     std::ofstream(dir / "level" / "inside.gltf") << quad_gltf(3, "quad.bin");
-    const engine::assets::Status st = engine::assets::read_gltf((dir / "level" / "inside.gltf").string(), meshes);
+    const engine::Status st = engine::assets::read_gltf((dir / "level" / "inside.gltf").string(), meshes);
     EXPECT_TRUE(st.ok()) << st.message;
     // '..' out of the directory: refused, naming the file and the reason.
     const std::string path = (dir / "level" / "outside.gltf").string();

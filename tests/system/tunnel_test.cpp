@@ -316,7 +316,7 @@ TEST(TunnelSystem, RopeInsertsNodesOnTheCurrentCurve) {
         wire::WireNodes before;
         rope.write_nodes(before);
         wire::Curve curve;
-        ASSERT_TRUE(wire::build_curve(before, wire::SplineSettings{}, curve).ok);
+        ASSERT_TRUE(wire::build_curve(before, wire::SplineSettings{}, curve).ok());
         const std::vector<uint32_t> old_ids = rope.ids();
         const tunnel::AdaptResult r = rope.adapt(wire::SplineSettings{});
         if (r.inserted == 0) continue;
@@ -398,7 +398,7 @@ RunFigures run_figures(platform::Context& ctx, tunnel::LevelSettings settings, i
     for (std::size_t c = 0; c < level.cables().size(); ++c) {
         if (!level.cables()[c].hanging) continue;
         wire::Curve fresh;
-        if (!wire::build_curve(level.cable_nodes(c), wire::SplineSettings{}, fresh).ok) continue;
+        if (!wire::build_curve(level.cable_nodes(c), wire::SplineSettings{}, fresh).ok()) continue;
         std::vector<glm::dvec3> q;
         for (const wire::CubicBezier& seg : fresh.segments)
             for (int i = 0; i < 32; ++i) q.push_back(wire::position(seg, i / 32.0));

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     const double angle_rad = kPi / 2;
     const curved_space::Segment segment{.length_m = spec.length_m, .angle_rad = angle_rad, .direction_rad = 0.0};
     curved_space::Chain chain;
-    if (auto s = curved_space::make_chain(std::span(&segment, 1), chain); !s.ok) {
+    if (auto s = curved_space::make_chain(std::span(&segment, 1), chain); !s.ok()) {
         std::fprintf(stderr, "tunnel_subdiv_shots: %s\n", s.message.c_str());
         return 1;
     }
@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
         }
         const std::string path = out_dir + (after ? "/after.png" : "/before.png");
         if (auto s = engine::platform::capture_png(*context.value(), path); !s) {
-            std::fprintf(stderr, "tunnel_subdiv_shots: %s\n", s.error().message.c_str());
+            std::fprintf(stderr, "tunnel_subdiv_shots: %s\n", s.message.c_str());
             return 1;
         }
         context.value()->end_frame();

@@ -32,18 +32,18 @@ bool finite(const std::vector<float>& values, std::size_t& bad) {
 
 int run_bend(const BendOptions& o) {
     std::vector<curved_space::Segment> segments;
-    if (curved_space::Status s = curved_space::read_segments_json(o.segments, segments); !s) {
+    if (engine::Status s = curved_space::read_segments_json(o.segments, segments); !s) {
         std::fprintf(stderr, "wiretool bend: %s\n", s.message.c_str());
         return exit_bad_input;
     }
     curved_space::Chain chain;
-    if (curved_space::Status s = curved_space::make_chain(segments, chain); !s) {  // validated already; kept for safety
+    if (engine::Status s = curved_space::make_chain(segments, chain); !s) {  // validated already; kept for safety
         std::fprintf(stderr, "wiretool bend: %s: %s\n", o.segments.c_str(), s.message.c_str());
         return exit_bad_input;
     }
 
     std::vector<engine::assets::MeshData> meshes;
-    if (engine::assets::Status s = engine::assets::read_gltf(o.input, meshes); !s.ok()) {
+    if (engine::Status s = engine::assets::read_gltf(o.input, meshes); !s.ok()) {
         std::fprintf(stderr, "wiretool bend: %s\n", s.message.c_str());
         return exit_bad_input;
     }
@@ -76,7 +76,7 @@ int run_bend(const BendOptions& o) {
                      "folds there: use a larger length or smaller angle)\n",
                      folded, vertices);
 
-    if (engine::assets::Status s = engine::assets::write_glb(o.output, meshes); !s.ok()) {
+    if (engine::Status s = engine::assets::write_glb(o.output, meshes); !s.ok()) {
         std::fprintf(stderr, "wiretool bend: %s\n", s.message.c_str());
         return exit_failure;
     }

@@ -58,7 +58,7 @@ engine::assets::MeshData to_mesh_data(const wire::TubeMesh& tube, std::size_t wi
 
 /// One generation: every frame in order, every wire, from parsed input to finished vertex and index arrays.
 /// Wires keep their pipeline state (pop-free remedy, carried-over first frame) across frames.
-wire::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::vector<wire::PipelineSettings>>& settings,
+engine::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::vector<wire::PipelineSettings>>& settings,
                       const MeshOptions& o, bool want_outputs, Output& out) {
     const std::size_t wires = scene.frames.front().wires.size();
     std::vector<wire::WirePipeline> pipelines(wires);
@@ -67,8 +67,8 @@ wire::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::v
         const bool last = f + 1 == scene.frames.size();
         for (std::size_t w = 0; w < wires; ++w) {
             const wire::io::WireSpec& spec = scene.frames[f].wires[w];
-            wire::Status st = pipelines[w].update(wire::io::to_wire_nodes(spec), settings[f][w]);
-            if (!st.ok) return wire::Status::error(where(o.input, f, scene.frames.size(), w) + ": " + st.message, st.node);
+            engine::Status st = pipelines[w].update(wire::io::to_wire_nodes(spec), settings[f][w]);
+            if (!st.ok()) return engine::Status::error(where(o.input, f, scene.frames.size(), w) + ": " + st.message, st.index);
             out.vertices += pipelines[w].mesh().vertices.size();
             if (want_outputs) {
                 if (!o.csv_out.empty()) append_ring_rows(out.csv, f, w, pipelines[w].rings());
@@ -76,7 +76,7 @@ wire::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::v
             }
         }
     }
-    return wire::Status::success();
+    return engine::Status::success();
 }
 
 bool write_atomically(const std::string& path, const std::string& bytes, std::string& error) {
@@ -99,7 +99,7 @@ bool write_atomically(const std::string& path, const std::string& bytes, std::st
 int run_mesh(MeshOptions o) {
     if (o.no_caps) o.overrides.caps = false;
     wire::io::SceneSpec scene;
-    if (wire::Status st = wire::io::load_wire_json(o.input, scene); !st.ok) {
+    if (engine::Status st = wire::io::load_wire_json(o.input, scene); !st.ok()) {
         std::cerr << "wiretool mesh: " << st.message << "\n";
         return exit_bad_input;
     }
@@ -107,7 +107,7 @@ int run_mesh(MeshOptions o) {
     for (std::size_t f = 0; f < scene.frames.size(); ++f)
         for (std::size_t w = 0; w < scene.frames[f].wires.size(); ++w) {
             wire::PipelineSettings s;
-            if (wire::Status st = wire::io::resolve_settings(scene.frames[f].wires[w], o.overrides, s); !st.ok) {
+            if (engine::Status st = wire::io::resolve_settings(scene.frames[f].wires[w], o.overrides, s); !st.ok()) {
                 std::cerr << "wiretool mesh: " << where(o.input, f, scene.frames.size(), w) << ": " << st.message
                           << "\n";
                 return exit_bad_input;
@@ -116,7 +116,7 @@ int run_mesh(MeshOptions o) {
         }
 
     Output out;
-    if (wire::Status st = generate(scene, settings, o, true, out); !st.ok) {
+    if (engine::Status st = generate(scene, settings, o, true, out); !st.ok()) {
         std::cerr << "wiretool mesh: " << st.message << "\n";
         return exit_bad_input;
     }

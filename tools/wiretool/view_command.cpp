@@ -158,7 +158,7 @@ wire::systems::Style style_of(const wire::io::WireSpec& spec, const std::optiona
     wire::io::SettingsOverrides overrides;
     overrides.spline_type = spline_override;
     wire::PipelineSettings resolved;
-    if (wire::Status st = wire::io::resolve_settings(spec, overrides, resolved); !st.ok)
+    if (engine::Status st = wire::io::resolve_settings(spec, overrides, resolved); !st.ok())
         throw BadInput{at + ": " + st.message};
     wire::systems::Style style;
     style.spline = resolved.spline;
@@ -267,7 +267,7 @@ int run_view(const ViewOptions& o) try {
     if (o.path == "gpu") path = wire::UploadPath::gpu_rings;
 
     wire::io::SceneSpec scene;
-    if (wire::Status st = wire::io::load_wire_json(o.input, scene); !st.ok) throw BadInput{st.message};
+    if (engine::Status st = wire::io::load_wire_json(o.input, scene); !st.ok()) throw BadInput{st.message};
     const std::size_t frames = scene.frames.size();
     const std::size_t wires = scene.frames.front().wires.size();
     std::vector<std::vector<wire::systems::Style>> styles(frames);
@@ -283,7 +283,7 @@ int run_view(const ViewOptions& o) try {
             spline.closed = style.closed;
             spline.radius_m = style.radius_m;
             wire::Curve curve;
-            if (wire::Status st = wire::build_curve(wire::io::to_wire_nodes(spec), spline, curve); !st.ok)
+            if (engine::Status st = wire::build_curve(wire::io::to_wire_nodes(spec), spline, curve); !st.ok())
                 throw BadInput{at + ": " + st.message};
             styles[f].push_back(style);
         }
@@ -431,7 +431,7 @@ int run_view(const ViewOptions& o) try {
             const std::string final_path = png_every_frame ? per_frame_path(o.png_out, f) : o.png_out;
             const std::string tmp = outputs.stage(final_path);
             if (auto st = engine::platform::write_png(tmp, engine::platform::read_pixels(*gl)); !st)
-                throw Failure{exit_failure, final_path + ": cannot write (" + st.error().message + ")"};
+                throw Failure{exit_failure, final_path + ": cannot write (" + st.message + ")"};
         }
         gl->end_frame();
     }

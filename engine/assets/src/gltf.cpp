@@ -59,16 +59,16 @@ int add_view_and_accessor(tinygltf::Model& model, std::vector<unsigned char>& bu
 
 Status check_mesh(const MeshData& m, std::size_t index) {
     const std::string who = "mesh " + std::to_string(index) + (m.name.empty() ? "" : " '" + m.name + "'");
-    if (m.positions.size() % 3 != 0) return Status::failure(who + ": positions are not xyz triples");
+    if (m.positions.size() % 3 != 0) return Status::error(who + ": positions are not xyz triples");
     if (!m.normals.empty() && m.normals.size() != m.positions.size())
-        return Status::failure(who + ": normals count differs from positions");
+        return Status::error(who + ": normals count differs from positions");
     if (!m.uvs.empty() && m.uvs.size() / 2 != m.positions.size() / 3)
-        return Status::failure(who + ": uv count differs from vertex count");
-    if (m.indices.size() % 3 != 0) return Status::failure(who + ": indices are not triangles");
+        return Status::error(who + ": uv count differs from vertex count");
+    if (m.indices.size() % 3 != 0) return Status::error(who + ": indices are not triangles");
     const std::size_t n = m.vertex_count();
     for (std::size_t i = 0; i < m.indices.size(); ++i)
         if (m.indices[i] >= n)
-            return Status::failure(who + ": index " + std::to_string(i) + " = " + std::to_string(m.indices[i]) +
+            return Status::error(who + ": index " + std::to_string(i) + " = " + std::to_string(m.indices[i]) +
                                    " out of range (" + std::to_string(n) + " vertices)");
     return {};
 }
@@ -77,7 +77,7 @@ Status check_mesh(const MeshData& m, std::size_t index) {
 
 Status write_glb(const std::string& path, std::span<const MeshData> meshes) {
     for (std::size_t i = 0; i < meshes.size(); ++i)
-        if (Status s = check_mesh(meshes[i], i); !s.ok()) return Status::failure(path + ": " + s.message);
+        if (Status s = check_mesh(meshes[i], i); !s.ok()) return Status::error(path + ": " + s.message);
 
     tinygltf::Model model;
     model.asset.version = "2.0";
@@ -137,25 +137,25 @@ Status write_glb(const std::string& path, std::span<const MeshData> meshes) {
     std::ostringstream stream;
     tinygltf::TinyGLTF writer;
     if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
-        return Status::failure(path + ": tinygltf could not serialize the model");
+        return Status::error(path + ": tinygltf could not serialize the model");
 
     const std::string tmp = path + ".tmp";
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) return Status::failure(path + ": cannot open '" + tmp + "' for writing: " + std::strerror(errno));
+        if (!out) return Status::error(path + ": cannot open '" + tmp + "' for writing: " + std::strerror(errno));
         const std::string bytes = stream.str();
         out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         out.flush();
         if (!out) {
             out.close();
             std::remove(tmp.c_str());
-            return Status::failure(path + ": write failed: " + std::strerror(errno));
+            return Status::error(path + ": write failed: " + std::strerror(errno));
         }
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         const std::string why = std::strerror(errno);
         std::remove(tmp.c_str());
-        return Status::failure(path + ": cannot rename temporary file: " + why);
+        return Status::error(path + ": cannot rename temporary file: " + why);
     }
     return {};
 }
@@ -166,20 +166,20 @@ namespace {
 Status read_float_accessor(const tinygltf::Model& model, int index, int components, std::vector<float>& out,
                            const std::string& who) {
     if (index < 0 || index >= static_cast<int>(model.accessors.size()))
-        return Status::failure(who + ": accessor " + std::to_string(index) + " does not exist");
+        return Status::error(who + ": accessor " + std::to_string(index) + " does not exist");
     const tinygltf::Accessor& a = model.accessors[index];
     if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
-        return Status::failure(who + ": accessor " + std::to_string(index) + " is not float");
+        return Status::error(who + ": accessor " + std::to_string(index) + " is not float");
     if (tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type)) != components)
-        return Status::failure(who + ": accessor " + std::to_string(index) + " has " +
+        return Status::error(who + ": accessor " + std::to_string(index) + " has " +
                                std::to_string(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type))) +
                                " components, expected " + std::to_string(components));
     if (a.bufferView < 0 || a.bufferView >= static_cast<int>(model.bufferViews.size()))
-        return Status::failure(who + ": accessor " + std::to_string(index) + " has no buffer view (sparse or "
+        return Status::error(who + ": accessor " + std::to_string(index) + " has no buffer view (sparse or "
                                "empty accessors are not supported)");
     const tinygltf::BufferView& v = model.bufferViews[a.bufferView];
     if (v.buffer < 0 || v.buffer >= static_cast<int>(model.buffers.size()))
-        return Status::failure(who + ": buffer view " + std::to_string(a.bufferView) + " names no buffer");
+        return Status::error(who + ": buffer view " + std::to_string(a.bufferView) + " names no buffer");
     const std::vector<unsigned char>& data = model.buffers[v.buffer].data;
     const std::size_t elem = std::size_t(components) * 4;
     const std::size_t stride = v.byteStride ? v.byteStride : elem;
@@ -190,7 +190,7 @@ Status read_float_accessor(const tinygltf::Model& model, int index, int componen
     const std::size_t room = view_end - view_begin;
     if (a.count > 0 && (stride < elem || a.byteOffset > room || room - a.byteOffset < elem ||
                         a.count - 1 > (room - a.byteOffset - elem) / stride))
-        return Status::failure(who + ": accessor " + std::to_string(index) + " reads past its buffer");
+        return Status::error(who + ": accessor " + std::to_string(index) + " reads past its buffer");
     const std::size_t start = view_begin + a.byteOffset;
     out.resize(a.count * components);
     for (std::size_t i = 0; i < a.count; ++i) std::memcpy(&out[i * components], &data[start + i * stride], elem);
@@ -199,22 +199,22 @@ Status read_float_accessor(const tinygltf::Model& model, int index, int componen
 
 Status read_indices(const tinygltf::Model& model, int index, std::vector<uint32_t>& out, const std::string& who) {
     if (index < 0 || index >= static_cast<int>(model.accessors.size()))
-        return Status::failure(who + ": index accessor " + std::to_string(index) + " does not exist");
+        return Status::error(who + ": index accessor " + std::to_string(index) + " does not exist");
     const tinygltf::Accessor& a = model.accessors[index];
-    if (a.type != TINYGLTF_TYPE_SCALAR) return Status::failure(who + ": index accessor is not scalar");
+    if (a.type != TINYGLTF_TYPE_SCALAR) return Status::error(who + ": index accessor is not scalar");
     std::size_t size = 0;
     switch (a.componentType) {
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: size = 1; break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: size = 2; break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: size = 4; break;
-        default: return Status::failure(who + ": index component type " + std::to_string(a.componentType) +
+        default: return Status::error(who + ": index component type " + std::to_string(a.componentType) +
                                         " is not an unsigned integer type");
     }
     if (a.bufferView < 0 || a.bufferView >= static_cast<int>(model.bufferViews.size()))
-        return Status::failure(who + ": index accessor has no buffer view");
+        return Status::error(who + ": index accessor has no buffer view");
     const tinygltf::BufferView& v = model.bufferViews[a.bufferView];
     if (v.buffer < 0 || v.buffer >= static_cast<int>(model.buffers.size()))
-        return Status::failure(who + ": index buffer view names no buffer");
+        return Status::error(who + ": index buffer view names no buffer");
     const std::vector<unsigned char>& data = model.buffers[v.buffer].data;
     const std::size_t stride = v.byteStride ? v.byteStride : size;
     // Overflow-safe, as in read_float_accessor.
@@ -222,7 +222,7 @@ Status read_indices(const tinygltf::Model& model, int index, std::vector<uint32_
     const std::size_t room = data.size() - begin;
     if (a.count > 0 && (stride < size || a.byteOffset > room || room - a.byteOffset < size ||
                         a.count - 1 > (room - a.byteOffset - size) / stride))
-        return Status::failure(who + ": index accessor reads past its buffer");
+        return Status::error(who + ": index accessor reads past its buffer");
     const std::size_t start = begin + a.byteOffset;
     out.resize(a.count);
     for (std::size_t i = 0; i < a.count; ++i) {
@@ -257,7 +257,7 @@ Status convert_mesh(const tinygltf::Model& model, int mesh_index, const glm::dma
                                 (mesh.name.empty() ? "" : " '" + mesh.name + "'") + " primitive " + std::to_string(p);
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) continue;  // points/lines: not meshes
         auto it = prim.attributes.find("POSITION");
-        if (it == prim.attributes.end()) return Status::failure(who + ": no POSITION attribute");
+        if (it == prim.attributes.end()) return Status::error(who + ": no POSITION attribute");
         MeshData m;
         m.name = mesh.name;
         if (Status s = read_float_accessor(model, it->second, 3, m.positions, who); !s.ok()) return s;
@@ -267,27 +267,27 @@ Status convert_mesh(const tinygltf::Model& model, int mesh_index, const glm::dma
             if (Status s = read_float_accessor(model, t->second, 2, m.uvs, who); !s.ok()) return s;
         const std::size_t n = m.vertex_count();
         if (!m.normals.empty() && m.normals.size() != m.positions.size())
-            return Status::failure(who + ": NORMAL count differs from POSITION count");
+            return Status::error(who + ": NORMAL count differs from POSITION count");
         if (!m.uvs.empty() && m.uvs.size() / 2 != n)
-            return Status::failure(who + ": TEXCOORD_0 count differs from POSITION count");
+            return Status::error(who + ": TEXCOORD_0 count differs from POSITION count");
         if (prim.indices >= 0) {
             if (Status s = read_indices(model, prim.indices, m.indices, who); !s.ok()) return s;
         } else {
             m.indices.resize(n);
             for (std::size_t i = 0; i < n; ++i) m.indices[i] = static_cast<uint32_t>(i);
         }
-        if (m.indices.size() % 3 != 0) return Status::failure(who + ": index count is not a multiple of 3");
+        if (m.indices.size() % 3 != 0) return Status::error(who + ": index count is not a multiple of 3");
         for (std::size_t i = 0; i < m.indices.size(); ++i)
             if (m.indices[i] >= n)
-                return Status::failure(who + ": index " + std::to_string(i) + " = " +
+                return Status::error(who + ": index " + std::to_string(i) + " = " +
                                        std::to_string(m.indices[i]) + " is out of range (" + std::to_string(n) +
                                        " vertices)");
         for (float f : m.positions)
-            if (!std::isfinite(f)) return Status::failure(who + ": POSITION holds a NaN or infinite value");
+            if (!std::isfinite(f)) return Status::error(who + ": POSITION holds a NaN or infinite value");
         for (float f : m.normals)
-            if (!std::isfinite(f)) return Status::failure(who + ": NORMAL holds a NaN or infinite value");
+            if (!std::isfinite(f)) return Status::error(who + ": NORMAL holds a NaN or infinite value");
         for (float f : m.uvs)
-            if (!std::isfinite(f)) return Status::failure(who + ": TEXCOORD_0 holds a NaN or infinite value");
+            if (!std::isfinite(f)) return Status::error(who + ": TEXCOORD_0 holds a NaN or infinite value");
         if (m.normals.empty()) {  // area-weighted face normals
             std::vector<glm::dvec3> acc(n, glm::dvec3(0.0));
             auto P = [&](uint32_t i) { return glm::dvec3(m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]); };
@@ -318,7 +318,7 @@ Status convert_mesh(const tinygltf::Model& model, int mesh_index, const glm::dma
         // Huge (finite) positions or node scales overflow the float results or the computed normals.
         for (std::size_t i = 0; i < m.positions.size(); ++i)
             if (!std::isfinite(m.positions[i]) || !std::isfinite(m.normals[i]))
-                return Status::failure(who + ": a position or normal is not finite after the node transforms "
+                return Status::error(who + ": a position or normal is not finite after the node transforms "
                                              "(values too large)");
         out.push_back(std::move(m));
     }
@@ -328,13 +328,13 @@ Status convert_mesh(const tinygltf::Model& model, int mesh_index, const glm::dma
 Status visit_node(const tinygltf::Model& model, int node_index, const glm::dmat4& parent, const std::string& file,
                   std::vector<MeshData>& out, int depth) {
     if (node_index < 0 || node_index >= static_cast<int>(model.nodes.size()))
-        return Status::failure(file + ": node " + std::to_string(node_index) + " does not exist");
-    if (depth > 64) return Status::failure(file + ": node hierarchy deeper than 64 (a cycle?)");
+        return Status::error(file + ": node " + std::to_string(node_index) + " does not exist");
+    if (depth > 64) return Status::error(file + ": node hierarchy deeper than 64 (a cycle?)");
     const tinygltf::Node& node = model.nodes[node_index];
     const glm::dmat4 world = parent * local_matrix(node);
     if (node.mesh >= 0) {
         if (node.mesh >= static_cast<int>(model.meshes.size()))
-            return Status::failure(file + ": node " + std::to_string(node_index) + " names mesh " +
+            return Status::error(file + ": node " + std::to_string(node_index) + " names mesh " +
                                    std::to_string(node.mesh) + " which does not exist");
         if (Status s = convert_mesh(model, node.mesh, world, file, out); !s.ok()) return s;
     }
@@ -365,7 +365,7 @@ Status convert_model(const tinygltf::Model& model, const std::string& file, std:
         out.clear();
         return s;
     }
-    if (out.empty()) return Status::failure(file + ": contains no triangle mesh");
+    if (out.empty()) return Status::error(file + ": contains no triangle mesh");
     return {};
 }
 
@@ -568,7 +568,7 @@ bool no_write(std::string* err, const std::string&, const std::vector<unsigned c
 Status load(const unsigned char* data, std::size_t size, const std::string& name, FileScope* scope,
             std::vector<MeshData>& out) {
     out.clear();
-    if (size > kMaxBytes) return Status::failure(name + ": larger than 4 GiB");
+    if (size > kMaxBytes) return Status::error(name + ": larger than 4 GiB");
     const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
     Glb glb;
     if (size == 0) data = reinterpret_cast<const unsigned char*>("");
@@ -576,7 +576,7 @@ Status load(const unsigned char* data, std::size_t size, const std::string& name
     std::size_t json_size = size;
     if (binary) {
         if (const auto bad = check_glb(data, size, glb))
-            return Status::failure(name + ": not a valid GLB file: " + *bad);
+            return Status::error(name + ": not a valid GLB file: " + *bad);
         json_text += glb.json_offset;
         json_size = glb.json_size;
     }
@@ -592,14 +592,14 @@ Status load(const unsigned char* data, std::size_t size, const std::string& name
                                          return true;
                                      });
     } catch (const TooDeep&) {
-        return Status::failure(name + ": not a readable glTF file: JSON nested deeper than " +
+        return Status::error(name + ": not a readable glTF file: JSON nested deeper than " +
                                std::to_string(kMaxDepth) + " levels");
     } catch (const std::exception& e) {
-        return Status::failure(name + ": not a readable glTF file: " + e.what());
+        return Status::error(name + ": not a readable glTF file: " + e.what());
     }
     if (root.is_object())  // otherwise tinygltf says what is wrong
         if (const auto bad = check_json(root, binary ? &glb : nullptr))
-            return Status::failure(name + ": not a readable glTF file: " + *bad);
+            return Status::error(name + ": not a readable glTF file: " + *bad);
 
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
@@ -616,9 +616,9 @@ Status load(const unsigned char* data, std::size_t size, const std::string& name
                     : loader.LoadASCIIFromString(&model, &err, &warn, json_text, static_cast<unsigned int>(size),
                                                  base_dir);
     } catch (const std::exception& e) {
-        return Status::failure(name + ": not a readable glTF file: " + e.what());
+        return Status::error(name + ": not a readable glTF file: " + e.what());
     }
-    if (!ok) return Status::failure(name + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
+    if (!ok) return Status::error(name + ": not a readable glTF file: " + (err.empty() ? "unknown error" : err));
     return convert_model(model, name, out);
 }
 
@@ -627,14 +627,14 @@ Status load(const unsigned char* data, std::size_t size, const std::string& name
 Status read_gltf(const std::string& path, std::vector<MeshData>& out) {
     out.clear();
     std::ifstream in(path, std::ios::binary);
-    if (!in) return Status::failure(path + ": cannot open: " + std::strerror(errno));
+    if (!in) return Status::error(path + ": cannot open: " + std::strerror(errno));
     std::vector<unsigned char> bytes;
     char block[1 << 16];
     while (in.read(block, sizeof block) || in.gcount() > 0) {
         bytes.insert(bytes.end(), block, block + in.gcount());
-        if (bytes.size() > kMaxBytes) return Status::failure(path + ": larger than 4 GiB");
+        if (bytes.size() > kMaxBytes) return Status::error(path + ": larger than 4 GiB");
     }
-    if (in.bad()) return Status::failure(path + ": read error: " + std::strerror(errno));
+    if (in.bad()) return Status::error(path + ": read error: " + std::strerror(errno));
     FileScope scope;
     std::error_code ec;
     scope.dir = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec).parent_path(), ec);

@@ -86,10 +86,10 @@ Status check_manifold(const ControlMesh& m) {
             const int a = m.face_vertices[static_cast<std::size_t>(offsets[f] + i)];
             const int b = m.face_vertices[static_cast<std::size_t>(offsets[f] + (i + 1) % n)];
             if (a == b)
-                return Status::failure(who(m.name) + ": degenerate face " + std::to_string(f) + " (vertex " +
+                return Status::error(who(m.name) + ": degenerate face " + std::to_string(f) + " (vertex " +
                                        std::to_string(a) + " repeated)");
             if (++directed[edge_key(a, b)] > 1)
-                return Status::failure(who(m.name) + ": non-manifold edge between vertices " + std::to_string(a) +
+                return Status::error(who(m.name) + ": non-manifold edge between vertices " + std::to_string(a) +
                                        " and " + std::to_string(b) +
                                        " (used twice in the same direction: 3+ faces or a flipped face)");
         }
@@ -108,12 +108,12 @@ Status make_control_mesh(const MeshData& tri, ControlMesh& out) {
     m.name = tri.name;
     m.origin = tri.origin;
     const std::size_t n = tri.vertex_count();
-    if (tri.triangle_count() == 0) return Status::failure(who(tri.name) + ": no triangles to subdivide");
+    if (tri.triangle_count() == 0) return Status::error(who(tri.name) + ": no triangles to subdivide");
     if (tri.positions.size() != 3 * n || (!tri.uvs.empty() && tri.uvs.size() != 2 * n) ||
         (!tri.normals.empty() && tri.normals.size() != 3 * n) || tri.indices.size() % 3 != 0)
-        return Status::failure(who(tri.name) + ": attribute arrays do not match the vertex count");
+        return Status::error(who(tri.name) + ": attribute arrays do not match the vertex count");
     for (std::uint32_t i : tri.indices)
-        if (i >= n) return Status::failure(who(tri.name) + ": index " + std::to_string(i) + " out of range");
+        if (i >= n) return Status::error(who(tri.name) + ": index " + std::to_string(i) + " out of range");
 
     // Weld equal positions into control vertices.
     std::map<std::array<std::uint32_t, 3>, int> weld;
@@ -121,7 +121,7 @@ Status make_control_mesh(const MeshData& tri, ControlMesh& out) {
     for (std::size_t v = 0; v < n; ++v) {
         const float* p = &tri.positions[3 * v];
         if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-            return Status::failure(who(tri.name) + ": vertex " + std::to_string(v) + " has a non-finite position");
+            return Status::error(who(tri.name) + ": vertex " + std::to_string(v) + " has a non-finite position");
         const std::array<std::uint32_t, 3> key{float_bits(p[0]), float_bits(p[1]), float_bits(p[2])};
         auto [it, inserted] = weld.try_emplace(key, static_cast<int>(m.positions.size() / 3));
         if (inserted) m.positions.insert(m.positions.end(), p, p + 3);
@@ -219,19 +219,19 @@ Status make_control_mesh(const MeshData& tri, ControlMesh& out) {
 
 Status subdivide(const ControlMesh& coarse, int level, MeshData& out) {
     if (level < 0 || level > kMaxSubdivisionLevel)
-        return Status::failure(who(coarse.name) + ": subdivision level " + std::to_string(level) +
+        return Status::error(who(coarse.name) + ": subdivision level " + std::to_string(level) +
                                " out of range [0, " + std::to_string(kMaxSubdivisionLevel) + "]");
-    if (coarse.face_sizes.empty()) return Status::failure(who(coarse.name) + ": no faces to subdivide");
+    if (coarse.face_sizes.empty()) return Status::error(who(coarse.name) + ": no faces to subdivide");
     const int num_vertices = static_cast<int>(coarse.positions.size() / 3);
     const int corner_total = std::accumulate(coarse.face_sizes.begin(), coarse.face_sizes.end(), 0);
     if (static_cast<int>(coarse.face_vertices.size()) != corner_total ||
         (!coarse.face_uvs.empty() && static_cast<int>(coarse.face_uvs.size()) != corner_total))
-        return Status::failure(who(coarse.name) + ": face arrays do not match the face sizes");
+        return Status::error(who(coarse.name) + ": face arrays do not match the face sizes");
     for (int v : coarse.face_vertices)
         if (v < 0 || v >= num_vertices)
-            return Status::failure(who(coarse.name) + ": face vertex " + std::to_string(v) + " out of range");
+            return Status::error(who(coarse.name) + ": face vertex " + std::to_string(v) + " out of range");
     for (int s : coarse.face_sizes)
-        if (s < 3) return Status::failure(who(coarse.name) + ": face with " + std::to_string(s) + " vertices");
+        if (s < 3) return Status::error(who(coarse.name) + ": face with " + std::to_string(s) + " vertices");
     if (Status s = check_manifold(coarse); !s.ok()) return s;
 
     Far::TopologyDescriptor desc;
@@ -260,7 +260,7 @@ Status subdivide(const ControlMesh& coarse, int level, MeshData& out) {
     std::unique_ptr<Far::TopologyRefiner> refiner(Far::TopologyRefinerFactory<Far::TopologyDescriptor>::Create(
         desc, Far::TopologyRefinerFactory<Far::TopologyDescriptor>::Options(Sdc::SCHEME_CATMARK, sdc)));
     if (!refiner)
-        return Status::failure(who(coarse.name) + ": OpenSubdiv could not build the topology" +
+        return Status::error(who(coarse.name) + ": OpenSubdiv could not build the topology" +
                                (g_osd_error.empty() ? std::string() : ": " + g_osd_error));
     Far::TopologyRefiner::UniformOptions uniform(level);
     uniform.fullTopologyInLastLevel = true;
@@ -387,7 +387,7 @@ Status subdivide(const ControlMesh& coarse, int level, MeshData& out) {
             result.indices.insert(result.indices.end(), {face_out[0], face_out[i], face_out[i + 1]});
     }
     for (float x : result.positions)
-        if (!std::isfinite(x)) return Status::failure(who(coarse.name) + ": refinement produced a non-finite position");
+        if (!std::isfinite(x)) return Status::error(who(coarse.name) + ": refinement produced a non-finite position");
     out = std::move(result);
     return {};
 }

@@ -53,7 +53,7 @@ struct RetainedBuffer::State {
         if (buffer) glUnmapNamedBuffer(buffer.id());
     }
 
-    Expected<void> reallocate(std::size_t bytes) {
+    Status reallocate(std::size_t bytes) {
         Expected<Buffer> made =
             make_buffer({.size_bytes = bytes, .storage_flags = kMapFlags, .label = desc.label});
         if (!made) return made.error();
@@ -100,7 +100,7 @@ Expected<RetainedBuffer> RetainedBuffer::create(const RetainedBufferDesc& desc) 
     if (s.desc.label.empty()) s.desc.label = "retained buffer";
     s.allocator = RangeAllocator(0, s.desc.alignment);
     const std::size_t initial = s.allocator.rounded(s.desc.initial_bytes);
-    if (Expected<void> st = s.reallocate(initial); !st) return st.error();
+    if (Status st = s.reallocate(initial); !st) return st;
     return rb;
 }
 
@@ -131,7 +131,7 @@ Expected<RetainedRange> RetainedBuffer::allocate(std::size_t bytes) {
         const auto grown = static_cast<std::size_t>(std::ceil(static_cast<double>(cap) * s.desc.growth));
         // Enough for the request even if the free space at the end is not usable.
         const std::size_t size = s.allocator.rounded(std::max(grown, cap + s.allocator.rounded(bytes)));
-        if (Expected<void> st = s.reallocate(size); !st) return st.error();
+        if (Status st = s.reallocate(size); !st) return st;
         offset = s.allocator.allocate(bytes);
         assert(offset && "grown buffer must hold the request");
         range.grew = true;

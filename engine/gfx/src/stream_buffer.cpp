@@ -64,7 +64,7 @@ struct StreamBuffer::State {
         if (buffer) glUnmapNamedBuffer(buffer.id());
     }
 
-    Expected<void> allocate(std::size_t new_region_bytes) {
+    Status allocate(std::size_t new_region_bytes) {
         const std::size_t total = new_region_bytes * desc.regions;
         Expected<Buffer> made =
             make_buffer({.size_bytes = total, .storage_flags = kMapFlags, .label = desc.label});
@@ -116,8 +116,8 @@ Expected<StreamBuffer> StreamBuffer::create(const StreamBufferDesc& desc) {
     if (s.desc.alignment == 0) s.desc.alignment = 256;
     if (s.desc.label.empty()) s.desc.label = "stream buffer";
     s.fences.assign(s.desc.regions, nullptr);
-    if (Expected<void> st = s.allocate(round_up(s.desc.region_bytes, s.desc.alignment)); !st)
-        return st.error();
+    if (Status st = s.allocate(round_up(s.desc.region_bytes, s.desc.alignment)); !st)
+        return st;
     return sb;
 }
 
@@ -131,7 +131,7 @@ Expected<StreamRegion> StreamBuffer::begin(std::size_t bytes) {
         const auto grown =
             static_cast<std::size_t>(std::ceil(static_cast<double>(s.region_bytes) * s.desc.growth));
         const std::size_t size = round_up(std::max(bytes, grown), s.desc.alignment);
-        if (Expected<void> st = s.allocate(size); !st) return st.error();
+        if (Status st = s.allocate(size); !st) return st;
         region.grew = true;
     }
     const uint32_t r = s.next;

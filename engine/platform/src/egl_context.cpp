@@ -252,7 +252,7 @@ public:
         assert(width_px > 0 && height_px > 0 && "resize to an empty framebuffer");
         if (width_px == width_ && height_px == height_) return;
         if (Status s = create_targets(width_px, height_px); !s) {
-            std::fprintf(stderr, "%s\n", s.error().message.c_str());
+            std::fprintf(stderr, "%s\n", s.message.c_str());
             return;
         }
         if (on_resize_) on_resize_(width_, height_);
@@ -333,7 +333,7 @@ Expected<std::unique_ptr<Context>> create_headless_context(const ContextDesc& de
         return egl_failure("eglMakeCurrent without a surface failed");
     }
     auto context = std::make_unique<EglContext>(dpy, ctx);  // owns dpy reference and ctx from here on
-    if (Status s = context->create_targets(desc.width, desc.height); !s) return s.error();
+    if (Status s = context->create_targets(desc.width, desc.height); !s) return s;
     context->begin_frame();
     return std::unique_ptr<Context>(std::move(context));
 }

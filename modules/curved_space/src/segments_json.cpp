@@ -54,7 +54,7 @@ Status parse_segments_json(std::string_view text, const std::string& name, std::
         s.direction_rad = item.contains("direction") ? item.at("direction").get<double>() : 0.0;
         segments.push_back(s);
     }
-    if (Status status = validate(segments); !status) return Status::error(prefix + status.message, status.segment);
+    if (Status status = validate(segments); !status) return Status::error(prefix + status.message, status.index);
     out = std::move(segments);
     return Status::success();
 }

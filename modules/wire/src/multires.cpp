@@ -181,8 +181,8 @@ void MultiresCurve::reset() {
 Status MultiresCurve::update(const WireNodes& nodes, Curve& rendered) {
     Curve T;
     Status st = build_curve(nodes, settings_.spline, T);
-    if (st.ok) st = check_unique_ids(nodes);
-    if (!st.ok) {
+    if (st.ok()) st = check_unique_ids(nodes);
+    if (!st.ok()) {
         rendered = rendered_;
         return st;
     }

@@ -24,7 +24,7 @@ Status WirePipeline::update(const WireNodes& nodes, const PipelineSettings& sett
         pop_free_ = settings.pop_free;
     }
     Curve next;
-    if (Status st = multires_.update(nodes, next); !st.ok) return st;
+    if (Status st = multires_.update(nodes, next); !st.ok()) return st;
     rendered_ = std::move(next);
 
     segment_ring_counts(rendered_, settings.tessellate, counts_);

@@ -415,7 +415,7 @@ TEST(SubdivisionLevel, MeasuredErrorOfTheChosenLevelIsWithinTolerance) {
     const double kappa = (kPi / 3) / 4.0;  // 60 degrees over the 4 m piece
     curved_space::Chain chain;
     const curved_space::Segment segment{.length_m = 4.0, .angle_rad = kPi / 3, .direction_rad = 0.0};
-    ASSERT_TRUE(curved_space::make_chain(std::span(&segment, 1), chain).ok);
+    ASSERT_TRUE(curved_space::make_chain(std::span(&segment, 1), chain).ok());
     const MeshData reference = refined_and_bent(control, 5, chain);
     const TriangleGrid reference_grid(reference, 0.05);
 

@@ -279,8 +279,8 @@ TEST_F(GfxTest, PngCaptureRoundTrip) {
 
     const std::filesystem::path path =
         std::filesystem::temp_directory_path() / ("gfx_test_" + std::to_string(::getpid())) / "capture.png";
-    const platform::Status written = platform::capture_png(*context, path);
-    ASSERT_TRUE(written.ok()) << written.error().message;
+    const engine::Status written = platform::capture_png(*context, path);
+    ASSERT_TRUE(written.ok()) << written.message;
     auto read = platform::read_png(path);
     ASSERT_TRUE(read.ok()) << read.error().message;
     EXPECT_EQ(read->width, image.width);

@@ -25,8 +25,8 @@ constexpr double pi = std::numbers::pi;
 
 Chain build(const std::vector<Segment>& segments) {
     Chain chain;
-    const curved_space::Status status = curved_space::make_chain(segments, chain);
-    EXPECT_TRUE(status.ok) << status.message;
+    const engine::Status status = curved_space::make_chain(segments, chain);
+    EXPECT_TRUE(status.ok()) << status.message;
     return chain;
 }
 
@@ -237,7 +237,7 @@ TEST(CurvedSpaceChain, StraightBeforeAndAfterTheChain) {
     world_from_chain[1] = glm::dvec4(-1, 0, 0, 0);
     world_from_chain[3] = glm::dvec4(1e6, -2e6, 3.0, 1);
     Chain chain;
-    ASSERT_TRUE(curved_space::make_chain(mixed_segments(), chain, world_from_chain).ok);
+    ASSERT_TRUE(curved_space::make_chain(mixed_segments(), chain, world_from_chain).ok());
     const double total = chain.total_length_m();
     const glm::dmat4& end = chain.world_from_segment(chain.segment_count());
     std::mt19937_64 rng(4);
@@ -281,17 +281,17 @@ TEST(CurvedSpaceChain, InvalidSegmentsAreRejectedWithTheirIndexAndField) {
     };
     for (const Case& c : cases) {
         Chain chain = build({{2.0, 1.0, 0.0}});
-        const curved_space::Status status = curved_space::make_chain(c.segments, chain);
-        EXPECT_FALSE(status.ok);
+        const engine::Status status = curved_space::make_chain(c.segments, chain);
+        EXPECT_FALSE(status.ok());
         EXPECT_EQ(status.message, c.message);
-        EXPECT_EQ(status.segment, c.index);
+        EXPECT_EQ(status.index, c.index);
         // The chain given is left as it was.
         EXPECT_EQ(chain.segment_count(), 1u);
         EXPECT_EQ(chain.total_length_m(), 2.0);
     }
     // An empty chain is valid: the identity.
     Chain empty;
-    ASSERT_TRUE(curved_space::make_chain({}, empty).ok);
+    ASSERT_TRUE(curved_space::make_chain({}, empty).ok());
     EXPECT_EQ(empty.transform_point({1, 2, 3}), dvec3(1, 2, 3));
 }
 
@@ -409,7 +409,7 @@ TEST(CurvedSpaceGpuRecords, CameraRelativeInDouble) {
     glm::dmat4 world_from_chain(1.0);
     world_from_chain[3] = glm::dvec4(1e6, 2e6, -1e6, 1.0);
     Chain chain;
-    ASSERT_TRUE(curved_space::make_chain(mixed_segments(), chain, world_from_chain).ok);
+    ASSERT_TRUE(curved_space::make_chain(mixed_segments(), chain, world_from_chain).ok());
     const dvec3 camera{1e6 + 1.0, 2e6 - 2.0, -1e6 + 0.5};
     const std::vector<curved_space::GpuSegment> records = curved_space::gpu_segments(chain, camera);
     ASSERT_EQ(records.size(), chain.segment_count() + 1);

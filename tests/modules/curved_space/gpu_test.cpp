@@ -90,8 +90,8 @@ Scene make_scene(std::size_t count) {
     world_from_chain[3] = glm::dvec4(1e6, -2e6, 5e5, 1.0);
     const std::vector<Segment> segments{{4.0, 0.5, 0.0},  {2.0, -1.2, 0.3}, {3.0, 0.0, 1.0},
                                         {1.5, 2.0, 1.57}, {5.0, 0.8, -2.0}, {2.5, 1.0, 2.5}};
-    const curved_space::Status status = curved_space::make_chain(segments, scene.chain, world_from_chain);
-    EXPECT_TRUE(status.ok) << status.message;
+    const engine::Status status = curved_space::make_chain(segments, scene.chain, world_from_chain);
+    EXPECT_TRUE(status.ok()) << status.message;
     scene.camera = scene.chain.transform_point({0.3, 0.0, 6.0}) + dvec3(2.0, 1.0, -1.5);
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -44,7 +44,7 @@ constexpr std::size_t kChordal = 0, kAuto = 3;
 Curve build(const Case& c, const SplineSettings& s) {
     Curve curve;
     const Status st = build_curve(c.nodes, s, curve);
-    EXPECT_TRUE(st.ok) << c.label << ": " << st.message;
+    EXPECT_TRUE(st.ok()) << c.label << ": " << st.message;
     EXPECT_EQ(curve.node_count(), c.nodes.size()) << c.label;
     return curve;
 }
@@ -174,7 +174,7 @@ TEST(WireCurveFamilies, AutoIsG1AndMovesContinuouslyWithItsNodesOnEveryFamily) {
         const double z = 2.0 * next() - 1.0, t = 6.283185307179586 * next(), r = std::sqrt(1.0 - z * z);
         moved.positions[i] += delta * glm::dvec3(r * std::cos(t), r * std::sin(t), z);
         Curve b;
-        ASSERT_TRUE(build_curve(moved, kMethods[kAuto].settings, b).ok);
+        ASSERT_TRUE(build_curve(moved, kMethods[kAuto].settings, b).ok());
         const double gain = curve_jump_m(a, b, 32) / delta;
         worst_gain = std::max(worst_gain, gain);
         EXPECT_LT(gain, 20.0) << c.family << " #" << ci << " " << c.label;
@@ -251,14 +251,14 @@ TEST(WireCurveFamilies, PairBuildsEqualSingleBuildsBitForBit) {
                     const Status single0 = build_curve(na, sa, s0), single1 = build_curve(nb, sb, s1);
                     const auto [pair0, pair1] = build_curve_pair(na, sa, p0, nb, sb, p1);
                     ++pairs;
-                    interleaved += single0.ok && single1.ok && sa.kind == sb.kind && !sa.closed && !sb.closed &&
+                    interleaved += single0.ok() && single1.ok() && sa.kind == sb.kind && !sa.closed && !sb.closed &&
                                    sa.kind != SplineKind::catmull_rom && na.size() == nb.size();
-                    EXPECT_EQ(pair0.ok, single0.ok) << all[ci].label;
+                    EXPECT_EQ(pair0.ok(), single0.ok()) << all[ci].label;
                     EXPECT_EQ(pair0.message, single0.message) << all[ci].label;
-                    EXPECT_EQ(pair0.node, single0.node) << all[ci].label;
-                    EXPECT_EQ(pair1.ok, single1.ok) << all[ci].label;
+                    EXPECT_EQ(pair0.index, single0.index) << all[ci].label;
+                    EXPECT_EQ(pair1.ok(), single1.ok()) << all[ci].label;
                     EXPECT_EQ(pair1.message, single1.message) << all[ci].label;
-                    EXPECT_EQ(pair1.node, single1.node) << all[ci].label;
+                    EXPECT_EQ(pair1.index, single1.index) << all[ci].label;
                     EXPECT_TRUE(same_curve(p0, s0)) << all[ci].family << " #" << ci << " " << all[ci].label;
                     EXPECT_TRUE(same_curve(p1, s1)) << all[ci].family << " #" << ci << " " << all[ci].label;
                 }
@@ -304,11 +304,11 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
                 bool quad = count == 4;
                 for (std::size_t k = 0; k < count; ++k) {
                     const Status alone = build_curve(*nodes[k], *set[k], single);
-                    quad = quad && alone.ok && !set[k]->closed && set[k]->kind != SplineKind::catmull_rom &&
+                    quad = quad && alone.ok() && !set[k]->closed && set[k]->kind != SplineKind::catmull_rom &&
                            set[k]->kind == set[0]->kind && nodes[k]->size() == nodes[0]->size();
-                    EXPECT_EQ(jobs[k].status.ok, alone.ok) << all[ci].label << " slot " << k;
+                    EXPECT_EQ(jobs[k].status.ok(), alone.ok()) << all[ci].label << " slot " << k;
                     EXPECT_EQ(jobs[k].status.message, alone.message) << all[ci].label << " slot " << k;
-                    EXPECT_EQ(jobs[k].status.node, alone.node) << all[ci].label << " slot " << k;
+                    EXPECT_EQ(jobs[k].status.index, alone.index) << all[ci].label << " slot " << k;
                     EXPECT_TRUE(same_curve(grouped[k], single)) << all[ci].family << " #" << ci << " " << all[ci].label << " slot " << k;
                 }
                 four_lane += quad;
@@ -327,7 +327,7 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
         build_curves(jobs);
         for (std::size_t k = 0; k < 4; ++k) {
             const Status alone = build_curve(*jobs[k].nodes, settings[0], single);
-            EXPECT_TRUE(alone.ok && jobs[k].status.ok) << "large wire in slot " << slot << ", slot " << k;
+            EXPECT_TRUE(alone.ok() && jobs[k].status.ok()) << "large wire in slot " << slot << ", slot " << k;
             EXPECT_TRUE(same_curve(grouped[k], single)) << "large wire in slot " << slot << ", slot " << k;
         }
     }
@@ -341,7 +341,7 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
         build_curves(jobs);
         for (std::size_t k = 0; k < 6; ++k) {
             const Status alone = build_curve(all[k].nodes, settings[0], single);
-            EXPECT_EQ(jobs[k].status.ok, alone.ok) << "six jobs, slot " << k;
+            EXPECT_EQ(jobs[k].status.ok(), alone.ok()) << "six jobs, slot " << k;
             EXPECT_TRUE(same_curve(outs[k], single)) << "six jobs, slot " << k;
         }
         for (std::size_t k = 0; k < 6; ++k) jobs[k] = {&all[k + 6].nodes, &settings[0], &outs[k], {}};
@@ -349,16 +349,16 @@ TEST(WireCurveFamilies, GroupBuildsEqualSingleBuildsBitForBit) {
         build_curves(std::span(jobs, 5));
         for (std::size_t k = 0; k < 5; ++k) {
             const Status alone = build_curve(all[k + 6].nodes, settings[0], single);
-            EXPECT_EQ(jobs[k].status.ok, alone.ok) << "shared curve, slot " << k;
+            EXPECT_EQ(jobs[k].status.ok(), alone.ok()) << "shared curve, slot " << k;
             if (k != 1) {
                 EXPECT_TRUE(same_curve(*jobs[k].out, single)) << "shared curve, slot " << k;
             }
         }
-        ASSERT_TRUE(build_curve(all[10].nodes, settings[0], single).ok);
+        ASSERT_TRUE(build_curve(all[10].nodes, settings[0], single).ok());
         EXPECT_TRUE(same_curve(shared, single)) << "the shared curve holds the later job's";
         const auto [first, second] = build_curve_pair(all[12].nodes, settings[0], shared, all[13].nodes, settings[0], shared);
-        EXPECT_TRUE(first.ok && second.ok);
-        ASSERT_TRUE(build_curve(all[13].nodes, settings[0], single).ok);
+        EXPECT_TRUE(first.ok() && second.ok());
+        ASSERT_TRUE(build_curve(all[13].nodes, settings[0], single).ok());
         EXPECT_TRUE(same_curve(shared, single)) << "a pair given one curve: the second wire's";
     }
     EXPECT_GT(four_lane, 100);  // the four-lane solve did run

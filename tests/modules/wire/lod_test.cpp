@@ -207,7 +207,7 @@ void run_proof(double tolerance_px, int wires_per_shape, ProofStats& st, bool ke
             const WireNodes nodes = make_wire(shape, rng);
             Curve curve;
             const bool closed = shape != Shape::hanging && w % 4 == 3;
-            ASSERT_TRUE(build_curve(nodes, SplineSettings{.closed = closed, .radius_m = 0.01f}, curve).ok);
+            ASSERT_TRUE(build_curve(nodes, SplineSettings{.closed = closed, .radius_m = 0.01f}, curve).ok());
             LodBounds bounds;
             compute_lod_bounds(curve, bounds);
             for (CameraKind kind : {CameraKind::near_fill, CameraKind::far_few_px, CameraKind::grazing,
@@ -282,7 +282,7 @@ TEST(LodProof, MeasurementAgreesWithBruteForceAndDetectsUnderTessellation) {
     for (int w = 0; w < 24; ++w) {
         const WireNodes nodes = make_wire(static_cast<Shape>(w % 3), rng);
         Curve curve;
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{}, curve).ok());
         const LodView view = make_camera(static_cast<CameraKind>(w % 4), curve, rng);
         WireLod lod;
         update_lod(curve, view, LodSettings{.max_rings_per_segment = 1u << 16}, lod);
@@ -311,7 +311,7 @@ TEST(LodProof, SidesPolygonErrorWithinTolerance) {
         WireNodes nodes = make_wire(static_cast<Shape>(w % 3), rng);
         Curve curve;
         const float radius = static_cast<float>(std::pow(10.0, uniform(rng, -3.0, -0.5)));
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok());
         const LodView view = make_camera(static_cast<CameraKind>(w % 4), curve, rng);
         const LodSettings settings{.tolerance_px = 0.5, .max_sides = 1024};
         WireLod lod;
@@ -393,7 +393,7 @@ Curve hanging_curve(int n) {
         nodes.positions.emplace_back(x, 1.5 * (std::cosh(x / 1.5) - std::cosh(2.0 / 1.5)), 0.0);
     }
     Curve c;
-    EXPECT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.02f}, c).ok);
+    EXPECT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.02f}, c).ok());
     return c;
 }
 
@@ -594,7 +594,7 @@ TEST(LodCulling, BoundingSphereCullGivesTheSameLodAsTheHullTest) {
         const glm::dvec3 shift = random_unit(rng) * uniform(rng, 0.0, 30.0);
         for (glm::dvec3& p : nodes.positions) p += shift;
         Curve curve;
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = static_cast<float>(uniform(rng, 0.001, 0.3))}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = static_cast<float>(uniform(rng, 0.001, 0.3))}, curve).ok());
         const BoundingSphere sphere = curve_bounding_sphere(curve);
         for (const CubicBezier& c : curve.segments)
             for (const glm::dvec3& p : {c.b0, c.b1, c.b2, c.b3})
@@ -708,7 +708,7 @@ bool family_curve(int i, Rng& rng, Curve& curve) {
     return build_curve(nodes,
                        SplineSettings{.closed = closed, .radius_m = static_cast<float>(uniform(rng, 0.001, 0.05))},
                        curve)
-        .ok;
+        .ok();
 }
 
 // Level 0's deviation of one segment as span_level0() computed it before its hull certificate: min(hull, 3M/4),
@@ -741,7 +741,7 @@ TEST(LodPerSegment, WangCountsEqualTheScalarFormula) {
     for (int w = 0; w < 240; ++w) {
         const WireNodes nodes = make_wire(static_cast<Shape>(w % 3), rng);
         Curve curve;
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.01f}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.01f}, curve).ok());
         LodBounds bounds;
         compute_lod_bounds(curve, bounds);
         const LodView view = make_camera(static_cast<CameraKind>(w % 4), curve, rng);
@@ -1019,10 +1019,10 @@ TEST(LodCheapPass, CoherenceReuseEqualsAFullUpdate) {
     for (int i = 0; i < 60; ++i) {
         const WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
         Curve curve;
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.005f}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = 0.005f}, curve).ok());
         if (i % 2 == 1) {  // thick: a few pixels of radius, so the side count comes from the segments' depths
             const float radius = static_cast<float>(0.08 * curve_bounding_sphere(curve).radius_m);
-            ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok);
+            ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok());
         }
         LodBounds bounds;
         compute_lod_bounds(curve, bounds);
@@ -1070,7 +1070,7 @@ TEST(LodSpans, DeviationBoundsTheChordDistance) {
     for (int i = 0; i < 90; ++i) {
         const WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
         Curve curve;
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{.closed = i % 6 == 5}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.closed = i % 6 == 5}, curve).ok());
         LodBounds b;
         compute_lod_bounds(curve, b);
         const std::size_t n = curve.segment_count();
@@ -1122,7 +1122,7 @@ TEST(LodSpans, RingsKeepFramesAndTextureContinuous) {
     for (int i = 0; i < 30; ++i) {
         const WireNodes nodes = make_wire(static_cast<Shape>(i % 3), rng);
         Curve curve;
-        ASSERT_TRUE(build_curve(nodes, SplineSettings{.closed = i % 3 != 1 && i % 4 == 3}, curve).ok);
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.closed = i % 3 != 1 && i % 4 == 3}, curve).ok());
         const LodView view = make_camera(CameraKind::far_few_px, curve, rng);
         WireLod lod;
         update_lod(curve, view, LodSettings{}, lod);
@@ -1168,7 +1168,7 @@ TEST(LodCulling, BoundingSphereAgreesWithTheHullTestFarFromTheOrigin) {
         for (glm::dvec3& p : nodes.positions) p = shift + scale * p;
         Curve curve;
         const float radius = std::max(1e-6f, static_cast<float>(scale * uniform(rng, 0.001, 0.3)));
-        if (!build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok) {
+        if (!build_curve(nodes, SplineSettings{.radius_m = radius}, curve).ok()) {
             ++collapsed;  // nodes that collapse in double at this distance
             continue;
         }
@@ -1225,7 +1225,7 @@ TEST(LodCulling, OffscreenSegmentsAreCoarse) {
     WireNodes nodes;
     for (int i = 0; i < 40; ++i) nodes.positions.emplace_back(0.3 * std::sin(i * 0.7), 0.0, -20.0 + i);
     Curve curve;
-    ASSERT_TRUE(build_curve(nodes, SplineSettings{}, curve).ok);
+    ASSERT_TRUE(build_curve(nodes, SplineSettings{}, curve).ok());
     const LodView view = LodView::perspective(glm::dvec3(1, 0.5, 0), glm::dvec3(1, 0.5, -1), glm::dvec3(0, 1, 0),
                                               kFov, kWidth, kHeight, 0.05, 1e4);
     WireLod lod;

@@ -16,7 +16,7 @@ TEST(WireCatenary, SolvesEndsArcLengthAndDistanceForAnySag) {
         const dvec3 p1(1e6, 2.0, -3.0), p2 = p1 + dvec3(12.0, -2.0, 5.0);
         const double L = glm::length(p2 - p1) * ratio;
         Catenary c;
-        ASSERT_TRUE(c.solve(p1, p2, L).ok) << ratio;
+        ASSERT_TRUE(c.solve(p1, p2, L).ok()) << ratio;
         EXPECT_LT(glm::length(c.point_at_arc_length(L) - p2), 1e-9 * L) << ratio;
         EXPECT_NEAR(c.arc_length_at(c.span_m()), L, 1e-12 * L) << ratio;
         // Arc length of a dense polyline through the reference agrees with s(x).
@@ -34,8 +34,8 @@ TEST(WireCatenary, SolvesEndsArcLengthAndDistanceForAnySag) {
         EXPECT_LE(c.distance(mid + dvec3(0.0, 0.0, 1e-3)), 1e-3 + 1e-12) << ratio;  // at most the offset
     }
     Catenary c;
-    EXPECT_FALSE(c.solve(dvec3(0.0), dvec3(1.0, 0.0, 0.0), 0.5).ok);
-    EXPECT_FALSE(c.solve(dvec3(0.0), dvec3(0.0, 1.0, 0.0), 5.0).ok);
+    EXPECT_FALSE(c.solve(dvec3(0.0), dvec3(1.0, 0.0, 0.0), 0.5).ok());
+    EXPECT_FALSE(c.solve(dvec3(0.0), dvec3(0.0, 1.0, 0.0), 5.0).ok());
 }
 
 TEST(WireCatenary, DistanceOfAnOffsetPointIsTheOffset) {

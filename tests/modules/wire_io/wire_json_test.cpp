@@ -8,14 +8,14 @@ using wire::io::SceneSpec;
 namespace {
 SceneSpec parse_ok(const std::string& text) {
     SceneSpec s;
-    const wire::Status st = wire::io::parse_wire_json(text, "in.json", s);
-    EXPECT_TRUE(st.ok) << st.message;
+    const engine::Status st = wire::io::parse_wire_json(text, "in.json", s);
+    EXPECT_TRUE(st.ok()) << st.message;
     return s;
 }
 std::string parse_error(const std::string& text) {
     SceneSpec s;
-    const wire::Status st = wire::io::parse_wire_json(text, "in.json", s);
-    EXPECT_FALSE(st.ok) << "accepted: " << text;
+    const engine::Status st = wire::io::parse_wire_json(text, "in.json", s);
+    EXPECT_FALSE(st.ok()) << "accepted: " << text;
     EXPECT_TRUE(s.frames.empty());
     return st.message;
 }
@@ -83,8 +83,8 @@ TEST(WireJson, ErrorsNameWhereAndWhat) {
 
 TEST(WireJson, MissingFileIsNamed) {
     SceneSpec s;
-    const wire::Status st = wire::io::load_wire_json("/no/such/cable.json", s);
-    EXPECT_FALSE(st.ok);
+    const engine::Status st = wire::io::load_wire_json("/no/such/cable.json", s);
+    EXPECT_FALSE(st.ok());
     EXPECT_NE(st.message.find("/no/such/cable.json: cannot open"), std::string::npos) << st.message;
 }
 
@@ -130,16 +130,16 @@ TEST(WireJson, DefaultSplineIsAutomaticAndAnAlphaAloneMeansCatmullRom) {
     // alpha still gets Catmull-Rom with that alpha, as before.
     wire::PipelineSettings p;
     SceneSpec s = parse_ok(R"({"nodes": [[0,0,0],[1,0,0],[2,1,0]]})");
-    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], {}, p).ok);
+    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], {}, p).ok());
     EXPECT_EQ(p.spline.kind, wire::SplineKind::automatic);
     s = parse_ok(R"({"spline": {"alpha": 0.7}, "nodes": [[0,0,0],[1,0,0],[2,1,0]]})");
-    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], {}, p).ok);
+    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], {}, p).ok());
     EXPECT_EQ(p.spline.kind, wire::SplineKind::catmull_rom);
     EXPECT_EQ(p.spline.alpha, 0.7);
     s = parse_ok(R"({"nodes": [[0,0,0],[1,0,0],[2,1,0]]})");
     wire::io::SettingsOverrides o;
     o.alpha = 0.25;
-    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], o, p).ok);
+    ASSERT_TRUE(wire::io::resolve_settings(s.frames[0].wires[0], o, p).ok());
     EXPECT_EQ(p.spline.kind, wire::SplineKind::catmull_rom);
     EXPECT_EQ(p.spline.alpha, 0.25);
 }

@@ -97,7 +97,7 @@ TEST(PackedRingTest, RealisticWiresKeepFrameAndTexturePrecision) {
         settings.spline.radius_m = static_cast<float>(radius);
         settings.tessellate.rings_per_segment = 8;
         wire::WirePipeline p;
-        ASSERT_TRUE(p.update(nodes, settings).ok);
+        ASSERT_TRUE(p.update(nodes, settings).ok());
         const wire::RingSet& rs = p.rings();
         for (std::size_t i = 0; i < rs.rings.size(); ++i) {
             const wire::Ring& ring = rs.rings[i];

@@ -80,8 +80,8 @@ struct Scene {
 
     void add(const wire::WireNodes& nodes, wire::PipelineSettings s, uint32_t material = 0) {
         wire::WirePipeline p;
-        const wire::Status st = p.update(nodes, s);
-        EXPECT_TRUE(st.ok) << st.message;
+        const engine::Status st = p.update(nodes, s);
+        EXPECT_TRUE(st.ok()) << st.message;
         pipelines.push_back(std::move(p));
         settings.push_back(s);
         materials.push_back(material);
@@ -182,8 +182,8 @@ platform::Image render(platform::Context& ctx, WireRenderer& renderer, const Dra
 }
 
 void save(const platform::Image& image, const std::string& name) {
-    const platform::Status st = platform::write_png(name, image);
-    EXPECT_TRUE(st.ok()) << st.error().message;
+    const engine::Status st = platform::write_png(name, image);
+    EXPECT_TRUE(st.ok()) << st.message;
 }
 
 bool same_pixel(const uint8_t* a, const uint8_t* b) {
@@ -295,8 +295,8 @@ struct ThinWire {
 
 ThinWire make_thin_wire(const wire::WireNodes& nodes, float radius_m, uint32_t tube_sides) {
     ThinWire w;
-    const wire::Status st = w.pipeline.update(nodes, wire_settings(radius_m, tube_sides));
-    EXPECT_TRUE(st.ok) << st.message;
+    const engine::Status st = w.pipeline.update(nodes, wire_settings(radius_m, tube_sides));
+    EXPECT_TRUE(st.ok()) << st.message;
     wire::build_strip(w.pipeline.rings(), w.strip);
     return w;
 }
@@ -812,8 +812,8 @@ TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
         }
         w.settings = wire_settings(0.02f + 0.04f * static_cast<float>(uni(rng)), 6 + static_cast<uint32_t>(uni(rng) * 8),
                                    loop);
-        const wire::Status st = w.pipeline.update(nodes, w.settings);
-        ASSERT_TRUE(st.ok) << st.message;
+        const engine::Status st = w.pipeline.update(nodes, w.settings);
+        ASSERT_TRUE(st.ok()) << st.message;
         ++w.generation;
     };
     auto list = [&](UploadPath path) {

@@ -262,7 +262,7 @@ TEST(WireMemory, ReleasedWireWithInvalidNodesComesBackWithItsLastValidCurve) {
             const WireCurve& c = w.registry.get<WireCurve>(e);
             EXPECT_FALSE(c.released) << "variant " << variant;
             Curve expected;
-            ASSERT_TRUE(build_curve(last_valid, c.spline, expected).ok);
+            ASSERT_TRUE(build_curve(last_valid, c.spline, expected).ok());
             EXPECT_TRUE(same_curve(c.curve, expected)) << "variant " << variant;
         }
         w.look(0.0);

@@ -117,9 +117,9 @@ TEST_F(BendCommand, BakesTheCpuReferenceIntoEveryMesh) {
     std::vector<MeshData> expected;
     ASSERT_TRUE(engine::assets::read_gltf(path("in.glb"), expected).ok());
     std::vector<curved_space::Segment> segments;
-    ASSERT_TRUE(curved_space::read_segments_json(path("segs.json"), segments).ok);
+    ASSERT_TRUE(curved_space::read_segments_json(path("segs.json"), segments).ok());
     curved_space::Chain chain;
-    ASSERT_TRUE(curved_space::make_chain(segments, chain).ok);
+    ASSERT_TRUE(curved_space::make_chain(segments, chain).ok());
     ASSERT_EQ(segments.size(), 3u);
     EXPECT_EQ(segments[2].direction_rad, 0.0);  // optional key, default 0
 
@@ -209,17 +209,17 @@ TEST(SegmentsJson, ParsesAndRejectsWithoutTouchingTheOutput) {
     std::vector<curved_space::Segment> out{{9.0, 9.0, 9.0}};
     ASSERT_TRUE(curved_space::parse_segments_json(R"({"segments": [{"length": 2, "angle": 0.25, "direction": -1}]})",
                                                   "s.json", out)
-                    .ok);
+                    .ok());
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0].length_m, 2.0);
     EXPECT_EQ(out[0].angle_rad, 0.25);
     EXPECT_EQ(out[0].direction_rad, -1.0);
-    const curved_space::Status bad =
+    const engine::Status bad =
         curved_space::parse_segments_json(R"({"segments": [{"length": 2, "angle": 0.25}, {"length": -3, "angle": 0}]})",
                                           "s.json", out);
-    EXPECT_FALSE(bad.ok);
+    EXPECT_FALSE(bad.ok());
     EXPECT_EQ(bad.message, "s.json: segment 1: length must be positive, got -3");
-    EXPECT_EQ(bad.segment, 1);
+    EXPECT_EQ(bad.index, 1);
     EXPECT_EQ(out.size(), 1u);
     EXPECT_EQ(curved_space::parse_segments_json("[1, 2]", "s.json", out).message,
               "s.json: expected an object {\"segments\": [...]}, got array");

@@ -109,7 +109,7 @@ TEST_F(WiretoolMesh, ToleranceBoundsTheDistanceFromCurveToRingPolyline) {
     // Round the nodes as the file does (std::to_string keeps 6 decimals).
     for (auto& p : nodes.positions) p = glm::dvec3(std::stod(std::to_string(p.x)), std::stod(std::to_string(p.y)), 0.0);
     wire::Curve curve;
-    ASSERT_TRUE(build_curve(nodes, wire::SplineSettings{.alpha = 1.0}, curve).ok);
+    ASSERT_TRUE(build_curve(nodes, wire::SplineSettings{.alpha = 1.0}, curve).ok());
     double worst = 0.0;
     for (const glm::dvec3& p : wire::sample_curve(curve, 400)) worst = std::max(worst, wire::distance_to_polyline(p, polyline));
     EXPECT_LE(worst, tol) << "rings: " << rows.size();

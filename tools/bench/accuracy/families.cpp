@@ -57,7 +57,7 @@ FamilyResults run_family_accuracy(const Options& o) {
             std::vector<double> dev;
             for (const Case& c : f.cases) {
                 wire::Curve curve;
-                if (!wire::build_curve(c.nodes, m.settings, curve).ok) {
+                if (!wire::build_curve(c.nodes, m.settings, curve).ok()) {
                     dev.push_back(NAN);
                     continue;
                 }

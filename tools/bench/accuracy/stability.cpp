@@ -75,7 +75,7 @@ Case run_pipeline(const std::string& name, const wire::WireNodes& nodes, wire::P
                   bool weld = true) {
     Case c{name, "", "", ""};
     wire::WirePipeline p;
-    const wire::Status st = p.update(nodes, settings);
+    const engine::Status st = p.update(nodes, settings);
     if (!st) {
         c.result = "error: " + st.message;
         c.error = "-";
@@ -221,7 +221,7 @@ std::string stability_report() {
         curved_space::Chain chain;
         const std::vector<curved_space::Segment> segs{
             {.length_m = 4.0, .angle_rad = alpha, .direction_rad = 0.3}};
-        const curved_space::Status st = curved_space::make_chain(segs, chain);
+        const engine::Status st = curved_space::make_chain(segs, chain);
         if (!st) {
             c.result = "error: " + st.message;
         } else {
@@ -242,7 +242,7 @@ std::string stability_report() {
         Case c{"1,000 chained bend segments closing a full circle", "", "", ""};
         std::vector<curved_space::Segment> segs(1000, {.length_m = 0.01, .angle_rad = 2.0 * kPi / 1000.0});
         curved_space::Chain chain;
-        const curved_space::Status st = curved_space::make_chain(segs, chain);
+        const engine::Status st = curved_space::make_chain(segs, chain);
         if (!st) {
             c.result = "error: " + st.message;
         } else {

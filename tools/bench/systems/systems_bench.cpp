@@ -36,7 +36,7 @@ bool resolve_spline(const Options& o, wire::SplineSettings& spline) {
     wire::PipelineSettings resolved;
     wire::io::SettingsOverrides overrides;
     overrides.spline_type = o.spline;
-    if (wire::Status st = wire::io::resolve_settings(wire::io::WireSpec{}, overrides, resolved); !st.ok) {
+    if (engine::Status st = wire::io::resolve_settings(wire::io::WireSpec{}, overrides, resolved); !st.ok()) {
         std::fprintf(stderr, "wiretool bench: --spline: %s\n", st.message.c_str());
         return false;
     }

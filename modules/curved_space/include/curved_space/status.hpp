@@ -1,23 +1,10 @@
-// Result of a curved_space operation that can fail on bad input: ok, or a message naming what is wrong.
+// The curved-space module's result type is the runtime's one: engine::Status (engine/core/status.hpp). A
+// failure's `index` is the offending input segment (-1 when no single segment is to blame), its message e.g.
+// "segment 3: length must be positive, got -1".
 #pragma once
 
-#include <string>
-#include <utility>
+#include "engine/core/status.hpp"
 
 namespace curved_space {
-
-/// Success, or a specific error such as "segment 3: length must be positive, got -1".
-/// `segment` is the index of the offending input segment (-1 when no single segment is to blame).
-struct Status {
-    bool ok = true;
-    std::string message;
-    int segment = -1;
-
-    [[nodiscard]] explicit operator bool() const { return ok; }
-    [[nodiscard]] static Status success() { return {}; }
-    [[nodiscard]] static Status error(std::string msg, int segment_index = -1) {
-        return Status{false, std::move(msg), segment_index};
-    }
-};
-
+using engine::Status;
 }  // namespace curved_space

@@ -94,7 +94,7 @@ struct WireRenderer::State {
     std::vector<uint32_t> ring_word;      ///< per order position: first word of its rings (retained)
     std::vector<PackedRing> packed;
 
-    Expected<void> ensure_patterns(uint32_t max_sides) {
+    Status ensure_patterns(uint32_t max_sides) {
         if (max_sides <= pattern_max_sides) return {};
         const uint32_t top = std::max(max_sides, std::max(kPatternMinSides, 2 * pattern_max_sides));
         std::vector<uint32_t> indices;
@@ -169,7 +169,7 @@ struct WireRenderer::State {
         }
     }
 
-    Expected<void> ensure_draw_index_capacity(std::size_t n) {
+    Status ensure_draw_index_capacity(std::size_t n) {
         if (draw_parameters || n <= draw_index_capacity) return {};
         const std::size_t capacity =
             std::max<std::size_t>(n, std::max<std::size_t>(1024, 2 * draw_index_capacity));
@@ -235,7 +235,7 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
             glVertexArrayAttribBinding(vao->id(), kDrawIndexLocation, 1);
             glVertexArrayBindingDivisor(vao->id(), 1, 1);
         }
-        if (Expected<void> st = s.ensure_draw_index_capacity(1); !st) return st.error();
+        if (Status st = s.ensure_draw_index_capacity(1); !st) return st;
     }
 
     // The built-in weave: mipmapped, repeating, anisotropic where available.
@@ -274,7 +274,7 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     if (!storage) return storage.error();
     s.ring_storage = std::move(storage).value();
     s.residency = RingResidency(desc.retain_frames != 0 ? desc.retain_frames : 180);
-    if (Expected<void> st = s.ensure_patterns(kPatternMinSides); !st) return st.error();
+    if (Status st = s.ensure_patterns(kPatternMinSides); !st) return st;
     return r;
 }
 
@@ -357,9 +357,9 @@ FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera&
         return stats;
     }
     const std::size_t n = s.order.size();
-    if (Expected<void> st = s.ensure_draw_index_capacity(n); !st) return stats;
+    if (Status st = s.ensure_draw_index_capacity(n); !st) return stats;
     if (!cpu) {
-        if (Expected<void> st = s.ensure_patterns(max_sides); !st) return stats;
+        if (Status st = s.ensure_patterns(max_sides); !st) return stats;
     }
 
     // (2) Prepare: commands per item, then the region layout: per-draw records | indirect commands |

@@ -427,7 +427,7 @@ void build_curves(std::span<CurveBuildJob> jobs) {
         jobs[k].status = begin_curve(*jobs[k].nodes, *jobs[k].settings, *jobs[k].out, *b[k]);
     }
     // The pending solves: four of one size side by side, else pairs of one size, else alone (the same results).
-    const auto pending = [&](std::size_t k) { return jobs[k].status.ok && b[k]->ts.pending; };
+    const auto pending = [&](std::size_t k) { return jobs[k].status.ok() && b[k]->ts.pending; };
     bool solved[4] = {};
 #if defined(__GNUC__)
     if (count == 4 && pending(0) && pending(1) && pending(2) && pending(3) && b[0]->ts.m >= 4 &&

@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
             for (dvec3& p : nodes.positions) p += offset * dir;
             const wire::SplineSettings settings{.kind = wire::SplineKind::automatic};
             wire::Curve curve;
-            if (!wire::build_curve(nodes, settings, curve).ok) continue;
+            if (!wire::build_curve(nodes, settings, curve).ok()) continue;
             std::vector<uint32_t> counts(curve.segment_count(), 4);
             std::vector<wire::RingParam> params;
             wire::place_rings(curve, counts, params);
@@ -155,11 +155,11 @@ int main(int argc, char** argv) {
             for (dvec3& p : wf.positions) p = dvec3(vec3(p));
             for (dvec3& p : rf.positions) p = first + dvec3(vec3(p - first));
             wire::Curve cw, cr;
-            if (wire::build_curve(wf, settings, cw).ok && cw.segment_count() == curve.segment_count()) {
+            if (wire::build_curve(wf, settings, cw).ok() && cw.segment_count() == curve.segment_count()) {
                 world.push_back(std::max(0.0, wire::families::max_deviation_m(shifted, cw) - exact_dev));
                 world_case.push_back(&base);
             }
-            if (wire::build_curve(rf, settings, cr).ok && cr.segment_count() == curve.segment_count()) {
+            if (wire::build_curve(rf, settings, cr).ok() && cr.segment_count() == curve.segment_count()) {
                 relative.push_back(std::max(0.0, wire::families::max_deviation_m(shifted, cr) - exact_dev));
                 relative_case.push_back(&base);
             }

@@ -169,7 +169,7 @@ void copy_nodes(WireNodes& to, const WireNodes& from) {
 /// build_curve from the same nodes and settings (the fast path), which is deterministic: the same curve, bit for
 /// bit. False (still released) if that fails, which cannot happen for nodes that built once.
 bool restore_curve(WireCurve& c, const SplineSettings& spline) {
-    if (!build_curve(c.previous_nodes, spline, c.curve).ok) return false;
+    if (!build_curve(c.previous_nodes, spline, c.curve).ok()) return false;
     c.released = false;
     ++c.builds;
     return true;
@@ -267,8 +267,8 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         bool stays_released = false;
         BoundingSphere sphere{};  // of the new curve, once computed (radius >= 0)
         if (step.exact) {
-            if (job.status.ok && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
-            if (job.status.ok) {
+            if (job.status.ok() && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
+            if (job.status.ok()) {
                 if (c.curve.segments.capacity() == 0) {
                     // Released (culled while moving) or new. A released wire still outside the view stays
                     // released: the LOD stage culls it by its sphere, so the curve is never copied out of the
@@ -296,7 +296,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             job.status = c.multires.update(nodes, c.curve);
         }
         ++c.builds;
-        if (job.status.ok) {
+        if (job.status.ok()) {
             ++c.generation;
             // The LOD's O(1) cull test; its LodBounds are the LOD stage's (WireCurve::lod_bounds).
             c.bounds = sphere.radius_m >= 0.0 ? sphere : curve_bounding_sphere(c.curve);
@@ -310,7 +310,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             // it): `bounds` is not known to be its sphere.
             c.bounds_generation = 0;
         }
-        if (!job.status.ok && c.released) {
+        if (!job.status.ok() && c.released) {
             // Invalid nodes: the wire keeps its last valid curve, which was released. The multires path has
             // already put it back (it shows its last state on failure); the fast path leaves it empty.
             if (!c.curve.segments.empty()) {
@@ -319,7 +319,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 job.restored = true;
             }
         }
-        c.blending = job.status.ok && !c.multires_stale && c.multires.blending();
+        c.blending = job.status.ok() && !c.multires_stale && c.multires.blending();
     };
     parallel_over((jobs.size() + 3) / 4, [&](std::size_t group) {
         thread_local Curve scratch[4];
@@ -357,11 +357,11 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     // Serial, in entity order: errors (reported once per distinct message), work lists.
     ctx.blending.clear();
     for (CurveJob& job : jobs) {
-        if (!job.status.ok) {
+        if (!job.status.ok()) {
             std::string message = describe_entity(job.entity) + ": " + job.status.message;
             const WireError* old = registry.try_get<WireError>(job.entity);
             if (old == nullptr || old->message != message) {
-                registry.emplace_or_replace<WireError>(job.entity, message, job.status.node);
+                registry.emplace_or_replace<WireError>(job.entity, message, job.status.index);
                 ErrorReport report{job.entity, std::move(message)};
                 if (ctx.on_error) ctx.on_error(report);
                 ctx.new_errors.push_back(std::move(report));

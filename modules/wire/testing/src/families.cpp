@@ -93,7 +93,7 @@ std::vector<Case> catenaries(uint64_t seed, int count) {
         const dvec3 p1 = 10.0 * r.unit(), p2 = p1 + span * horiz + span * std::tan(rise) * up;
         const double L = glm::length(p2 - p1) * (1.0 + slack);
         Catenary cat;
-        if (!cat.solve(p1, p2, L, up).ok) continue;  // cannot happen for these ranges (not vertical, L > chord)
+        if (!cat.solve(p1, p2, L, up).ok()) continue;  // cannot happen for these ranges (not vertical, L > chord)
         Case c;
         c.family = "catenary";
         c.label = fmt("span %.1f m, rise %.0f deg, slack %.1f%%, ", span, rise * 180.0 / kPi, 100.0 * slack) +

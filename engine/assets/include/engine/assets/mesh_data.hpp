@@ -1,6 +1,8 @@
 // Plain triangle-mesh arrays exchanged with asset files (glTF) and the tools: no GL, no ECS.
 #pragma once
 
+#include "engine/core/status.hpp"
+
 #include <glm/vec3.hpp>
 
 #include <cstdint>
@@ -22,14 +24,6 @@ struct MeshData {
 
     [[nodiscard]] std::size_t vertex_count() const { return positions.size() / 3; }
     [[nodiscard]] std::size_t triangle_count() const { return indices.size() / 3; }
-};
-
-/// Result of a load or write: empty message means success; otherwise the message names the file and
-/// the problem.
-struct Status {
-    std::string message;
-    [[nodiscard]] bool ok() const { return message.empty(); }
-    static Status failure(std::string m) { return Status{std::move(m)}; }
 };
 
 }  // namespace engine::assets

@@ -18,13 +18,13 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "engine/platform/expected.hpp"
+#include "engine/core/expected.hpp"
 
 namespace engine::gfx {
 
-using platform::Error;
-using platform::Expected;
-using platform::Status;
+using engine::Error;
+using engine::Expected;
+using engine::Status;
 
 namespace detail {
 void delete_buffer(unsigned id);

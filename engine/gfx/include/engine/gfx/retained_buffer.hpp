@@ -15,7 +15,7 @@
 
 #include "engine/gfx/range_allocator.hpp"
 #include "engine/gfx/resources.hpp"
-#include "engine/platform/expected.hpp"
+#include "engine/core/expected.hpp"
 
 #include <cstddef>
 #include <cstdint>

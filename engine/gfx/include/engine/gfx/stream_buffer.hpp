@@ -4,7 +4,7 @@
 #pragma once
 
 #include "engine/gfx/resources.hpp"
-#include "engine/platform/expected.hpp"
+#include "engine/core/expected.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -14,8 +14,8 @@
 
 namespace engine::gfx {
 
-using engine::platform::Error;
-using engine::platform::Expected;
+using engine::Error;
+using engine::Expected;
 
 /// Zero means default.
 struct StreamBufferDesc {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "engine/platform/context.hpp"
-#include "engine/platform/expected.hpp"
+#include "engine/core/expected.hpp"
 
 namespace engine::platform {
 

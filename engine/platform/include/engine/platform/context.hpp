@@ -7,7 +7,7 @@
 #include <memory>
 #include <string>
 
-#include "engine/platform/expected.hpp"
+#include "engine/core/expected.hpp"
 #include "engine/platform/input.hpp"
 
 /// GL 4.5 context (GLFW window or headless EGL), input, frame capture and PNG files, Expected/Error.

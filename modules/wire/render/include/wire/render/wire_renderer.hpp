@@ -23,7 +23,7 @@
 #include "wire/draw.hpp"
 
 #include "engine/gfx/resources.hpp"
-#include "engine/platform/expected.hpp"
+#include "engine/core/expected.hpp"
 #include "engine/scene/camera.hpp"
 
 #include <glm/vec3.hpp>
@@ -38,8 +38,9 @@
 /// The wire renderer: the one part of the wire module that makes GL calls.
 namespace wire::render {
 
-using engine::platform::Error;
-using engine::platform::Expected;
+using engine::Error;
+using engine::Status;
+using engine::Expected;
 
 /// A row of the material table (DrawItem::material indexes it).
 struct Material {
