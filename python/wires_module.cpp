@@ -304,7 +304,7 @@ public:
         gl_->begin_frame();
         engine::gfx::clear({clear[0], clear[1], clear[2], clear[3]});
         const auto t0 = std::chrono::steady_clock::now();
-        wire::render::FrameSettings settings;
+        wire::render::DrawSettings settings;
         settings.light = light_;
         settings.eye_m = eye_m_;
         drawn_ = renderer_.draw(ctx_.draw_list, ctx_.camera, settings);
@@ -349,7 +349,7 @@ public:
     }
 
     py::dict stats() const {
-        const wire::systems::FrameStats& s = ctx_.stats;
+        const wire::systems::RunStats& s = ctx_.stats;
         py::dict d;
         d["wires"] = s.wires;
         d["visible_wires"] = s.visible_wires;
@@ -420,7 +420,7 @@ private:
     wire::RingSet ring_set_;
     wire::render::Light light_{.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
     std::optional<glm::dvec3> eye_m_;
-    wire::render::FrameStats drawn_{};
+    wire::render::DrawStats drawn_{};
     double render_ms_ = 0.0;
 };
 

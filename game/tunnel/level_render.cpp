@@ -82,7 +82,7 @@ void Level::draw_wires() {
         const GpuPass gpu_pass(s.wires_timer);
         s.wire_stats = {};
         if (options_.draw_wires) {
-            wire::render::FrameSettings settings;
+            wire::render::DrawSettings settings;
             settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
             settings.wireframe = options_.wireframe;
             s.wire_stats = s.wires.draw(s.context.draw_list, camera_, settings);
@@ -102,7 +102,7 @@ void Level::draw_wires() {
         break;
     }
     while (s.gpu_results.size() > 16) s.gpu_results.erase(s.gpu_results.begin());  // rejected results
-    const wire::systems::FrameStats& ws = s.context.stats;
+    const wire::systems::RunStats& ws = s.context.stats;
     stats_.wires = ws.wires;
     stats_.curves_built = ws.curves_built;
     stats_.rings = ws.rings;

@@ -94,7 +94,7 @@ struct Level::State {
     double fly_distance_m = 0.0;
     double rope_time_s = 0.0;  // simulated rope time since frame 0 (drives the gusts)
     double flight_z_m = 0.0;   // unbent z of the fly camera
-    wire::render::FrameStats wire_stats{};
+    wire::render::DrawStats wire_stats{};
     std::vector<float> bucket;
     engine::gfx::GpuTimer pieces_timer, wires_timer;  // GPU ms per pass, read back a few frames later
     std::map<uint64_t, std::pair<double, double>> gpu_results;  // frame -> (pieces, wires) ms, -1 = not yet

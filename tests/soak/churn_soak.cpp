@@ -211,7 +211,7 @@ private:
     void move_camera();
     void check_frame();
     void check_errors();
-    Sample sample(const wire::render::FrameStats& fs);
+    Sample sample(const wire::render::DrawStats& fs);
     void check_curve(const std::vector<Sample>& curve);
 
     Options opt_;
@@ -467,7 +467,7 @@ void Soak::check_errors() {
             fail("good wire has an error: %s", ws::wire_error(registry_, w.entity)->message.c_str());
 }
 
-Sample Soak::sample(const wire::render::FrameStats& fs) {
+Sample Soak::sample(const wire::render::DrawStats& fs) {
     const GlObjects gl = count_gl_objects();
     if (gl.textures != baseline_.textures || gl.vertex_arrays != baseline_.vertex_arrays ||
         gl.programs != baseline_.programs || gl.shaders != baseline_.shaders ||
@@ -578,7 +578,7 @@ int Soak::run() {
 
         context->begin_frame();
         engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
-        const wire::render::FrameStats fs = renderer_->draw(context_.draw_list, context_.camera);
+        const wire::render::DrawStats fs = renderer_->draw(context_.draw_list, context_.camera);
         context->end_frame();
         render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
         if (const GLenum err = glGetError(); err != GL_NO_ERROR) fail("GL error 0x%x after draw", err);

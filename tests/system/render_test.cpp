@@ -94,7 +94,7 @@ Hit cast_sphere(const glm::dvec3& o, const glm::dvec3& d, double r) {
 struct Scene {
     scene::Camera camera;
     gfx::DirectionalLight light;
-    gfx::MeshData mesh;
+    gfx::PrimitiveMesh mesh;
     glm::mat4 world_from_model{1.0f};
     LocalRayCast cast;
 };

@@ -25,8 +25,8 @@ struct Piece {
     glm::vec3 albedo;
 };
 
-engine::gfx::MeshData to_gfx(const engine::assets::MeshData& m) {
-    engine::gfx::MeshData g;
+engine::gfx::PrimitiveMesh to_gfx(const engine::assets::MeshData& m) {
+    engine::gfx::PrimitiveMesh g;
     for (std::size_t v = 0; v < m.vertex_count(); ++v) {
         engine::gfx::Vertex vertex;
         vertex.position = glm::vec3(glm::dvec3(m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]) + m.origin);

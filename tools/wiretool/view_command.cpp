@@ -328,9 +328,9 @@ int run_view(const ViewOptions& o) try {
     std::vector<wire::systems::ErrorReport> runtime_errors;
     ctx.on_error = [&](const wire::systems::ErrorReport& e) { runtime_errors.push_back(e); };
     wire::systems::install(schedule, ctx);
-    wire::render::FrameStats drawn;
+    wire::render::DrawStats drawn;
     schedule.add("wire.render", [&](engine::ecs::Registry&, const engine::ecs::FrameContext&) {
-        wire::render::FrameSettings settings;
+        wire::render::DrawSettings settings;
         settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
         drawn = renderer.draw(ctx.draw_list, ctx.camera, settings);
     });

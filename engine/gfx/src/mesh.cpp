@@ -11,7 +11,7 @@
 namespace engine::gfx {
 namespace {
 
-void add_quad(MeshData& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 n) {
+void add_quad(PrimitiveMesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 n) {
     const auto base = static_cast<std::uint32_t>(m.vertices.size());
     m.vertices.insert(m.vertices.end(), {{a, n}, {b, n}, {c, n}, {d, n}});
     m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
@@ -19,9 +19,9 @@ void add_quad(MeshData& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, g
 
 }  // namespace
 
-MeshData make_cylinder_mesh(const CylinderDesc& desc) {
+PrimitiveMesh make_cylinder_mesh(const CylinderDesc& desc) {
     assert(desc.sides >= 3 && "cylinder needs at least 3 sides");
-    MeshData m;
+    PrimitiveMesh m;
     const int n = desc.sides;
     const float r = desc.radius_m;
     const float h = desc.half_height_m;
@@ -67,8 +67,8 @@ MeshData make_cylinder_mesh(const CylinderDesc& desc) {
     return m;
 }
 
-MeshData make_box_mesh(glm::vec3 e) {
-    MeshData m;
+PrimitiveMesh make_box_mesh(glm::vec3 e) {
+    PrimitiveMesh m;
     using glm::vec3;
     add_quad(m, {-e.x, -e.y, e.z}, {e.x, -e.y, e.z}, {e.x, e.y, e.z}, {-e.x, e.y, e.z}, {0, 0, 1});
     add_quad(m, {e.x, -e.y, -e.z}, {-e.x, -e.y, -e.z}, {-e.x, e.y, -e.z}, {e.x, e.y, -e.z}, {0, 0, -1});
@@ -79,15 +79,15 @@ MeshData make_box_mesh(glm::vec3 e) {
     return m;
 }
 
-MeshData make_plane_mesh(float s) {
-    MeshData m;
+PrimitiveMesh make_plane_mesh(float s) {
+    PrimitiveMesh m;
     add_quad(m, {-s, 0, s}, {s, 0, s}, {s, 0, -s}, {-s, 0, -s}, {0, 1, 0});
     return m;
 }
 
-MeshData make_sphere_mesh(float radius_m, int slices, int stacks) {
+PrimitiveMesh make_sphere_mesh(float radius_m, int slices, int stacks) {
     assert(slices >= 3 && stacks >= 2);
-    MeshData m;
+    PrimitiveMesh m;
     const float pi = std::numbers::pi_v<float>;
     for (int j = 0; j <= stacks; ++j) {
         const float theta = pi * static_cast<float>(j) / static_cast<float>(stacks);  // 0 at +y
@@ -109,7 +109,7 @@ MeshData make_sphere_mesh(float radius_m, int slices, int stacks) {
     return m;
 }
 
-Expected<GpuMesh> upload_mesh(const MeshData& mesh, std::string_view label) {
+Expected<GpuMesh> upload_mesh(const PrimitiveMesh& mesh, std::string_view label) {
     if (mesh.vertices.empty() || mesh.indices.empty())
         return Error{"upload_mesh: mesh '" + std::string(label) + "' is empty"};
     GpuMesh gpu;

@@ -210,7 +210,7 @@ TEST_F(GfxTest, DebugOutputReachesSink) {
 }
 
 TEST(MeshTest, CylinderCountsAndNormals) {
-    const gfx::MeshData m = gfx::make_cylinder_mesh({.radius_m = 2.0f, .half_height_m = 1.0f, .sides = 8});
+    const gfx::PrimitiveMesh m = gfx::make_cylinder_mesh({.radius_m = 2.0f, .half_height_m = 1.0f, .sides = 8});
     EXPECT_EQ(m.vertices.size(), 2u * 9u + 2u * 9u);
     EXPECT_EQ(m.indices.size(), 8u * 6u + 2u * 8u * 3u);
     for (const gfx::Vertex& v : m.vertices) {
@@ -229,7 +229,7 @@ TEST(MeshTest, CylinderCountsAndNormals) {
 }
 
 TEST(MeshTest, BoxAndSphereFaceOutward) {
-    for (const gfx::MeshData& m : {gfx::make_box_mesh(glm::vec3(1, 2, 3)), gfx::make_sphere_mesh(1.0f, 12, 6),
+    for (const gfx::PrimitiveMesh& m : {gfx::make_box_mesh(glm::vec3(1, 2, 3)), gfx::make_sphere_mesh(1.0f, 12, 6),
                                    gfx::make_plane_mesh(2.0f)}) {
         for (std::size_t t = 0; t < m.indices.size(); t += 3) {
             const gfx::Vertex& a = m.vertices[m.indices[t]];

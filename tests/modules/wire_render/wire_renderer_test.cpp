@@ -39,8 +39,8 @@ namespace platform = engine::platform;
 using wire::DrawItem;
 using wire::DrawList;
 using wire::UploadPath;
-using wire::render::FrameSettings;
-using wire::render::FrameStats;
+using wire::render::DrawSettings;
+using wire::render::DrawStats;
 using wire::render::RendererDesc;
 using wire::render::WireRenderer;
 
@@ -170,11 +170,11 @@ Scene test_scene() {
 }
 
 platform::Image render(platform::Context& ctx, WireRenderer& renderer, const DrawList& list,
-                       const engine::scene::Camera& camera, const FrameSettings& settings = {},
-                       FrameStats* stats = nullptr) {
+                       const engine::scene::Camera& camera, const DrawSettings& settings = {},
+                       DrawStats* stats = nullptr) {
     ctx.begin_frame();
     engine::gfx::clear(kBackground);
-    const FrameStats s = renderer.draw(list, camera, settings);
+    const DrawStats s = renderer.draw(list, camera, settings);
     if (stats != nullptr) *stats = s;
     platform::Image image = platform::read_pixels(ctx);
     ctx.end_frame();
@@ -358,7 +358,7 @@ TEST(WireRendererTest, CpuMeshRendersLitTexturedWires) {
     WireRenderer renderer = make_renderer();
     const Scene scene = test_scene();
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
-    FrameStats stats;
+    DrawStats stats;
     const platform::Image image =
         render(*ctx, renderer, scene.list(UploadPath::cpu_mesh), scene_camera(), {}, &stats);
     save(image, "wire_render_cpu_mesh.png");
@@ -398,7 +398,7 @@ TEST(WireRendererTest, GpuRingsMatchCpuMesh) {
         engine::scene::Camera camera;
     } views[] = {{"scene", scene_camera()}, {"cap", cap_view}, {"radius", radius_view}};
     for (const auto& view : views) {
-        FrameStats cpu_stats, gpu_stats;
+        DrawStats cpu_stats, gpu_stats;
         const platform::Image cpu =
             render(*ctx, renderer, scene.list(UploadPath::cpu_mesh), view.camera, {}, &cpu_stats);
         const platform::Image gpu =
@@ -525,7 +525,7 @@ TEST(WireRendererTest, EmptyListDrawsNothing) {
     const Scene scene = test_scene();
     GLuint query = 0;
     glGenQueries(1, &query);
-    auto primitives = [&](const DrawList& list, FrameStats& stats, platform::Image& image) {
+    auto primitives = [&](const DrawList& list, DrawStats& stats, platform::Image& image) {
         ctx->begin_frame();
         engine::gfx::clear(kBackground);
         glBeginQuery(GL_PRIMITIVES_GENERATED, query);
@@ -537,7 +537,7 @@ TEST(WireRendererTest, EmptyListDrawsNothing) {
         ctx->end_frame();
         return n;
     };
-    FrameStats stats;
+    DrawStats stats;
     platform::Image image;
     for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
         EXPECT_EQ(primitives(DrawList{.path = path, .items = {}}, stats, image), 0u);
@@ -596,7 +596,7 @@ TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
         for (std::size_t count = 1; count <= all.items.size(); count += 3) {
             DrawList list{.path = path,
                           .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)}};
-            FrameStats stats;
+            DrawStats stats;
             const platform::Image got = render(*ctx, growing, list, scene_camera(), {}, &stats);
             const platform::Image want = render(*ctx, roomy, list, scene_camera());
             ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
@@ -663,7 +663,7 @@ TEST(WireRendererTest, MaterialsAndWireframe) {
     Scene scene = test_scene();
     for (std::size_t i = 0; i < scene.materials.size(); i += 2) scene.materials[i] = blue;
     for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
-        FrameStats stats;
+        DrawStats stats;
         const platform::Image filled = render(*ctx, renderer, scene.list(path), scene_camera(), {}, &stats);
         EXPECT_EQ(stats.multi_draw_calls, 2u);
         // cpu-mesh: one command a wire; gpu-rings: one per started chunk of kChunkBands bands.
@@ -733,10 +733,10 @@ TEST(WireRendererTest, HundredWiresBytesAndFrameTime) {
         scene.add(hanging_cable({x, 1.5, z}, {x + 0.5, 1.0 - 0.02 * (i % 7), z - 0.8}, 0.4 + 0.005 * i, 8),
                   wire_settings(0.015f, 8));
     }
-    FrameStats cpu_stats, gpu_stats;
+    DrawStats cpu_stats, gpu_stats;
     const DrawList cpu_list = scene.list(UploadPath::cpu_mesh);
     const DrawList gpu_list = scene.list(UploadPath::gpu_rings);
-    auto time_frames = [&](const DrawList& list, FrameStats& stats) {
+    auto time_frames = [&](const DrawList& list, DrawStats& stats) {
         render(*ctx, renderer, list, scene_camera(), {}, &stats);  // warm up
         glFinish();
         const int frames = 10;
@@ -857,7 +857,7 @@ TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
             }
         }
         const DrawList gpu = list(UploadPath::gpu_rings);
-        FrameStats rs, ss;
+        DrawStats rs, ss;
         const platform::Image a = render(*ctx, retained, gpu, scene_camera(), {}, &rs);
         const platform::Image b = render(*ctx, streamed, gpu, scene_camera(), {}, &ss);
         const platform::Image c = render(*ctx, streamed, list(UploadPath::cpu_mesh), scene_camera());
@@ -908,7 +908,7 @@ TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {
     const Scene scene = test_scene();
     const DrawList all = scene.list(UploadPath::gpu_rings);
     const DrawList none{.path = UploadPath::gpu_rings, .items = {}};
-    FrameStats stats;
+    DrawStats stats;
     render(*ctx, renderer, all, scene_camera(), {}, &stats);
     EXPECT_EQ(stats.wires_uploaded, all.items.size());
     render(*ctx, renderer, all, scene_camera(), {}, &stats);
@@ -943,7 +943,7 @@ TEST(WireRendererTest, RetainedRingStorageGrowsWithoutLeaks) {
     for (std::size_t count = 1; count <= all.items.size(); count += 2) {
         DrawList list{.path = UploadPath::gpu_rings,
                       .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)}};
-        FrameStats stats;
+        DrawStats stats;
         const platform::Image got = render(*ctx, growing, list, scene_camera(), {}, &stats);
         const platform::Image want = render(*ctx, roomy, list, scene_camera());
         ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
@@ -1095,7 +1095,7 @@ TEST(WireRendererTest, GpuRingsStripsMatchCpuMesh) {
             cpu.items.push_back(w.list(UploadPath::cpu_mesh, sides).items[0]);
             gpu.items.push_back(w.list(UploadPath::gpu_rings, sides).items[0]);
         }
-        FrameStats cs, gs;
+        DrawStats cs, gs;
         const platform::Image a = render(*ctx, renderer, cpu, camera, {}, &cs);
         const platform::Image b = render(*ctx, renderer, gpu, camera, {}, &gs);
         save(a, sides == 2 ? "wire_render_strips_cpu_mesh.png" : "wire_render_lines_cpu_mesh.png");

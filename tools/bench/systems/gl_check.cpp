@@ -43,7 +43,7 @@ void GlCheck::draw_one(GlPath& path, wire::render::WireRenderer& renderer,
     engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
     const double t0 = wall_ms();
     path.timer.begin();
-    const wire::render::FrameStats st = renderer.draw(ctx.draw_list, ctx.camera);
+    const wire::render::DrawStats st = renderer.draw(ctx.draw_list, ctx.camera);
     path.timer.end();
     const double t1 = wall_ms();
     engine::gfx::finish_gpu();  // llvmpipe's threads finish the frame before the next path is timed

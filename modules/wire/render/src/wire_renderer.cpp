@@ -132,7 +132,7 @@ struct WireRenderer::State {
     /// Retained path: makes every drawn item's rings resident (uploading new or changed ones) and records the
     /// first word of each; evicts wires not drawn for a while. Items whose rings could not be stored are
     /// dropped from `order` (the rest of the frame draws).
-    void retain(const DrawList& list, FrameStats& stats) {
+    void retain(const DrawList& list, DrawStats& stats) {
         ring_storage.begin_frame();
         residency.begin_frame();
         ring_word.clear();
@@ -325,10 +325,10 @@ const std::vector<unsigned>& WireRenderer::allocated_ring_buffers() const {
     return state_->ring_storage.allocated_buffers();
 }
 
-FrameStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
-                              const FrameSettings& settings) {
+DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
+                              const DrawSettings& settings) {
     State& s = *state_;
-    FrameStats stats;
+    DrawStats stats;
     const bool cpu = list.path == UploadPath::cpu_mesh;
     const bool retained = !cpu && s.desc.retain_rings;
 

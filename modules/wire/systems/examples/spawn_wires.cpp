@@ -49,7 +49,7 @@ int main() {
         if (frame == 5) registry.destroy(b);
         schedule.run(registry, 1.0 / 60.0);
 
-        const wire::systems::FrameStats& s = context.stats;
+        const wire::systems::RunStats& s = context.stats;
         std::printf("frame %d: %zu wires, %zu visible; built %zu curves, %zu lods, %zu rings, %zu meshes; "
                     "draw %zu items, %zu rings, %zu vertices\n",
                     frame, s.wires, s.visible_wires, s.curves_built, s.lod_updates, s.rings_built, s.meshes_built,

@@ -201,7 +201,7 @@ std::size_t bytes_of(const RingSet& r) {
 }  // namespace
 
 void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
-    ctx.stats = FrameStats{};
+    ctx.stats = RunStats{};
     ctx.new_errors.clear();
     ctx.curve_changed.clear();
 

@@ -1,6 +1,5 @@
-/// \file
-/// Entity handles: 32-bit generational ids, 20 bits of slot index and 12 bits of version.
-/// A destroyed entity's slot is reused with a higher version, so an old handle to it is detected as stale.
+// Entity handles: 32-bit generational ids, 20 bits of slot index and 12 bits of version.
+// A destroyed entity's slot is reused with a higher version, so an old handle to it is detected as stale.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,5 @@
-/// \file
-/// The registry: creates and destroys entities and owns one storage per component type. Most calls forward
-/// to Storage<T>; the registry adds handle checks and one shared change clock for all storages.
+// The registry: creates and destroys entities and owns one storage per component type. Most calls forward
+// to Storage<T>; the registry adds handle checks and one shared change clock for all storages.
 #pragma once
 
 #include <engine/ecs/config.hpp>

@@ -1,6 +1,5 @@
-/// \file
-/// The schedule: named systems run in the order they were added, each timed per frame (last and mean wall
-/// time) for a stats panel, and each given the registry tick of its own previous run for change tracking.
+// The schedule: named systems run in the order they were added, each timed per frame (last and mean wall
+// time) for a stats panel, and each given the registry tick of its own previous run for change tracking.
 #pragma once
 
 #include <engine/ecs/config.hpp>

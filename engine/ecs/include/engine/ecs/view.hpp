@@ -1,6 +1,5 @@
-/// \file
-/// Views: entities that have all of several component types. A view walks the smallest of its storages
-/// (back to front) and checks membership in the others; components come back as references.
+// Views: entities that have all of several component types. A view walks the smallest of its storages
+// (back to front) and checks membership in the others; components come back as references.
 #pragma once
 
 #include <engine/ecs/storage.hpp>

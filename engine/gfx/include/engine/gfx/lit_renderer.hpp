@@ -1,7 +1,6 @@
-/// \file
-/// A minimal forward renderer for opaque meshes: Lambert diffuse from one directional light plus ambient.
-/// Used by the demo and the headless system test; the shading is documented so tests can predict it:
-///   color = albedo * (ambient + (1 - ambient) * max(0, dot(n, to_light))) * light_color
+// A minimal forward renderer for opaque meshes: Lambert diffuse from one directional light plus ambient.
+// Used by the demo and the headless system test; the shading is documented so tests can predict it:
+//   color = albedo * (ambient + (1 - ambient) * max(0, dot(n, to_light))) * light_color
 #pragma once
 
 #include <glm/mat4x4.hpp>

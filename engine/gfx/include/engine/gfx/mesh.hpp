@@ -1,6 +1,5 @@
-/// \file
-/// Simple indexed triangle meshes (position + normal): CPU generators for primitives and their GPU upload.
-/// The generators are plain math (no GL); upload_mesh needs a current context.
+// Simple indexed triangle meshes (position + normal): CPU generators for primitives and their GPU upload.
+// The generators are plain math (no GL); upload_mesh needs a current context.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +19,7 @@ struct Vertex {
 };
 
 /// Counter-clockwise front faces, outward normals.
-struct MeshData {
+struct PrimitiveMesh {
     std::vector<Vertex> vertices{};        ///< the vertices
     std::vector<std::uint32_t> indices{};  ///< three per triangle, into vertices
 };
@@ -34,16 +33,16 @@ struct CylinderDesc {
     bool caps = true;            ///< close both ends
 };
 /// The cylinder described by `desc`.
-MeshData make_cylinder_mesh(const CylinderDesc& desc = {});
+PrimitiveMesh make_cylinder_mesh(const CylinderDesc& desc = {});
 
 /// Axis-aligned box centered on the origin, flat normals.
-MeshData make_box_mesh(glm::vec3 half_extents_m = glm::vec3(0.5f));
+PrimitiveMesh make_box_mesh(glm::vec3 half_extents_m = glm::vec3(0.5f));
 
 /// Square in the y = 0 plane facing +y, centered on the origin.
-MeshData make_plane_mesh(float half_size_m = 1.0f);
+PrimitiveMesh make_plane_mesh(float half_size_m = 1.0f);
 
 /// UV sphere centered on the origin.
-MeshData make_sphere_mesh(float radius_m = 0.5f, int slices = 32, int stacks = 16);
+PrimitiveMesh make_sphere_mesh(float radius_m = 0.5f, int slices = 32, int stacks = 16);
 
 /// A mesh on the GPU: vertex buffer (Vertex layout: location 0 position, 1 normal), index buffer and VAO.
 struct GpuMesh {
@@ -54,7 +53,7 @@ struct GpuMesh {
 };
 
 /// Errors: empty mesh, or buffer allocation failed.
-Expected<GpuMesh> upload_mesh(const MeshData& mesh, std::string_view label = {});
+Expected<GpuMesh> upload_mesh(const PrimitiveMesh& mesh, std::string_view label = {});
 
 /// Draws all triangles with whatever program is in use.
 void draw(const GpuMesh& mesh);

@@ -1,5 +1,4 @@
-/// \file
-/// Frame capture: read back the framebuffer a Context renders into, write and read PNG files.
+// Frame capture: read back the framebuffer a Context renders into, write and read PNG files.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,5 @@
-/// \file
-/// An OpenGL 4.5 core context with a frame loop: a GLFW window, or headless EGL (Mesa surfaceless) rendering
-/// into an off-screen framebuffer. GL calls go through libepoxy in both cases.
+// An OpenGL 4.5 core context with a frame loop: a GLFW window, or headless EGL (Mesa surfaceless) rendering
+// into an off-screen framebuffer. GL calls go through libepoxy in both cases.
 #pragma once
 
 #include <functional>

@@ -1,5 +1,4 @@
-/// \file
-/// Keyboard and mouse state of a window, sampled by Context::poll_events(). Headless contexts keep it empty.
+// Keyboard and mouse state of a window, sampled by Context::poll_events(). Headless contexts keep it empty.
 #pragma once
 
 #include <array>

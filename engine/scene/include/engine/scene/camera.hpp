@@ -1,6 +1,5 @@
-/// \file
-/// Perspective camera: position, look-at target, vertical field of view; GL clip conventions (z in [-1, 1],
-/// right-handed view space looking down -z), as glm::perspective and glm::lookAt produce them.
+// Perspective camera: position, look-at target, vertical field of view; GL clip conventions (z in [-1, 1],
+// right-handed view space looking down -z), as glm::perspective and glm::lookAt produce them.
 #pragma once
 
 #include <cmath>

@@ -1,6 +1,5 @@
-/// \file
-/// View frustum as six normalized planes extracted from a view-projection matrix (Gribb & Hartmann), with
-/// conservative visibility tests: a test returns false only when the shape is certainly outside.
+// View frustum as six normalized planes extracted from a view-projection matrix (Gribb & Hartmann), with
+// conservative visibility tests: a test returns false only when the shape is certainly outside.
 #pragma once
 
 #include <array>

@@ -1,23 +1,22 @@
-/// \file
-/// The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
-/// persistently mapped buffers and one multi-draw per material. The only wire code that touches GL.
-///
-/// Upload paths: cpu-mesh streams every visible wire's vertices and indices each frame; gpu-rings keeps each
-/// wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
-/// a frame sends the rings of changed wires plus one draw record and command per visible wire, and expands the
-/// tube in the vertex shader over a static index pattern per side count (each vertex shaded once per ring).
-///
-/// Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
-/// by material, (2) a per-mode "prepare" step that writes each item's draw record and indirect commands (and
-/// streams or retains its geometry), (3) one shared submission loop issuing glMultiDrawElementsIndirect per run
-/// of equal materials with the mode's program, vertex array and element buffer. A new mode adds a program, a
-/// prepare step and its element pattern.
-///
-/// \code
-///   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
-///   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
-///   wire::render::FrameStats stats = renderer->draw(list, camera);  // list.path picks cpu_mesh or gpu_rings
-/// \endcode
+// The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
+// persistently mapped buffers and one multi-draw per material. The only wire code that touches GL.
+//
+// Upload paths: cpu-mesh streams every visible wire's vertices and indices each frame; gpu-rings keeps each
+// wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
+// a frame sends the rings of changed wires plus one draw record and command per visible wire, and expands the
+// tube in the vertex shader over a static index pattern per side count (each vertex shaded once per ring).
+//
+// Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
+// by material, (2) a per-mode "prepare" step that writes each item's draw record and indirect commands (and
+// streams or retains its geometry), (3) one shared submission loop issuing glMultiDrawElementsIndirect per run
+// of equal materials with the mode's program, vertex array and element buffer. A new mode adds a program, a
+// prepare step and its element pattern.
+//
+// \code
+//   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
+//   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
+//   wire::render::DrawStats stats = renderer->draw(list, camera);  // list.path picks cpu_mesh or gpu_rings
+// \endcode
 #pragma once
 
 #include "wire/draw.hpp"
@@ -81,7 +80,7 @@ struct RendererDesc {
 };
 
 /// Per-frame options.
-struct FrameSettings {
+struct DrawSettings {
     Light light{};           ///< the frame's directional light
     bool wireframe = false;  ///< glPolygonMode(GL_LINE) for this frame's wires
     /// Camera position in double (world metres); unset: camera.position. Offsets origin_m - eye are computed
@@ -90,7 +89,7 @@ struct FrameSettings {
 };
 
 /// What one draw() did.
-struct FrameStats {
+struct DrawStats {
     std::size_t bytes_uploaded = 0;  ///< bytes memcpy'd into mapped buffers (geometry, per-draw, commands)
     std::size_t ring_bytes_uploaded = 0;  ///< gpu-rings: the packed ring records among them
     std::size_t wires_uploaded = 0;       ///< gpu-rings: wires whose rings were written this frame
@@ -133,8 +132,8 @@ public:
     /// clear). All items go into one region of the stream buffer; one glMultiDraw*Indirect per material; the
     /// region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material <
     /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
-    FrameStats draw(const DrawList& list, const engine::scene::Camera& camera,
-                    const FrameSettings& settings = {});
+    DrawStats draw(const DrawList& list, const engine::scene::Camera& camera,
+                    const DrawSettings& settings = {});
 
     /// True when the draw index comes from gl_BaseInstanceARB (ARB_shader_draw_parameters), false when from
     /// the instanced attribute.

@@ -1,13 +1,12 @@
-/// \file
-/// Game-side API of wire entities: spawn, update, inspect. Destroy with registry.destroy(entity): every wire
-/// component lives on the entity, so nothing else holds on to it.
-///
-/// \code
-///   engine::ecs::Entity w = wire::systems::spawn_wire(registry, nodes, {.radius_m = 0.02f});
-///   wire::systems::set_nodes(registry, w, moved_nodes);    // or edit_nodes(registry, w).positions[3] = p;
-///   wire::systems::insert_node(registry, w, 4, midpoint);  // a new node with a fresh stable id
-///   registry.destroy(w);
-/// \endcode
+// Game-side API of wire entities: spawn, update, inspect. Destroy with registry.destroy(entity): every wire
+// component lives on the entity, so nothing else holds on to it.
+//
+// \code
+//   engine::ecs::Entity w = wire::systems::spawn_wire(registry, nodes, {.radius_m = 0.02f});
+//   wire::systems::set_nodes(registry, w, moved_nodes);    // or edit_nodes(registry, w).positions[3] = p;
+//   wire::systems::insert_node(registry, w, 4, midpoint);  // a new node with a fresh stable id
+//   registry.destroy(w);
+// \endcode
 #pragma once
 
 #include "wire/systems/components.hpp"

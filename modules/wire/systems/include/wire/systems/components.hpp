@@ -1,6 +1,5 @@
-/// \file
-/// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them
-/// as changed); the wire systems own everything else and keep it between frames.
+// Components of a wire entity. The game writes Nodes and Style (through the api.hpp calls, which stamp them
+// as changed); the wire systems own everything else and keep it between frames.
 #pragma once
 
 #include "wire/curve.hpp"

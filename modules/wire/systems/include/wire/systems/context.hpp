@@ -1,6 +1,5 @@
-/// \file
-/// What the wire systems share for one scene: the camera and settings the game sets each frame, the frame's
-/// DrawList and statistics they produce, and their work lists. One WireContext per registry and schedule.
+// What the wire systems share for one scene: the camera and settings the game sets each frame, the frame's
+// DrawList and statistics they produce, and their work lists. One WireContext per registry and schedule.
 #pragma once
 
 #include "wire/draw.hpp"
@@ -18,7 +17,7 @@
 namespace wire::systems {
 
 /// Counts of one frame (reset by the curve system, filled by each system). "Rebuilt" counts are the work done.
-struct FrameStats {
+struct RunStats {
     std::size_t wires = 0;             ///< wire entities (with Nodes and Style)
     std::size_t curves_built = 0;      ///< curve stage runs (changed nodes/style, or an ongoing geomorph)
     std::size_t lod_updates = 0;       ///< update_lod runs (hull tests); 0 when nothing moved
@@ -60,7 +59,7 @@ struct WireContext {
 
     // ---- produced by the systems each frame ----
     DrawList draw_list;                          ///< valid until the systems run again
-    FrameStats stats;                            ///< counts of the last Schedule::run
+    RunStats stats;                            ///< counts of the last Schedule::run
     std::vector<ErrorReport> new_errors;         ///< errors that appeared this frame
 
     // ---- the systems' own bookkeeping ----

@@ -1,22 +1,21 @@
-/// \file
-/// The wire systems and their order. install() registers, in this order, on a schedule:
-/// \verbatim
-///   wire.curve      wires whose Nodes or Style changed since it last ran (change tracking), plus wires in
-///                   a geomorph: pop-free curve (multires.hpp); bad nodes -> WireError, reported once,
-///                   wire skipped
-///   wire.lod        if the camera (or LOD settings) changed: every wire; otherwise only wires whose curve
-///                   changed: hull culling, per-segment ring counts, sides, hysteresis (lod.hpp); releases
-///                   the curve of a wire culled while moving and rebuilds it when the view turns to it
-///                   (WireCurve)
-///   wire.rings      visible wires whose curve or counts changed: ring records, first normal carried over
-///   wire.mesh       cpu_mesh path: visible wires whose rings or sides changed: TubeVertex + indices;
-///                   gpu_rings path: nothing
-///   wire.draw_list  the frame's DrawList: visible wires in entity order, spans into the per-wire arrays
-/// \endverbatim
-/// The renderer adds its upload/render systems after these, reading WireContext::draw_list.
-/// Per-wire work runs with tbb::parallel_for over a dense array of the wires to process; each wire writes
-/// only its own components, and lists are ordered by entity, so the output does not depend on the thread
-/// count.
+// The wire systems and their order. install() registers, in this order, on a schedule:
+// \verbatim
+//   wire.curve      wires whose Nodes or Style changed since it last ran (change tracking), plus wires in
+//                   a geomorph: pop-free curve (multires.hpp); bad nodes -> WireError, reported once,
+//                   wire skipped
+//   wire.lod        if the camera (or LOD settings) changed: every wire; otherwise only wires whose curve
+//                   changed: hull culling, per-segment ring counts, sides, hysteresis (lod.hpp); releases
+//                   the curve of a wire culled while moving and rebuilds it when the view turns to it
+//                   (WireCurve)
+//   wire.rings      visible wires whose curve or counts changed: ring records, first normal carried over
+//   wire.mesh       cpu_mesh path: visible wires whose rings or sides changed: TubeVertex + indices;
+//                   gpu_rings path: nothing
+//   wire.draw_list  the frame's DrawList: visible wires in entity order, spans into the per-wire arrays
+// \endverbatim
+// The renderer adds its upload/render systems after these, reading WireContext::draw_list.
+// Per-wire work runs with tbb::parallel_for over a dense array of the wires to process; each wire writes
+// only its own components, and lists are ordered by entity, so the output does not depend on the thread
+// count.
 #pragma once
 
 #include "wire/systems/context.hpp"

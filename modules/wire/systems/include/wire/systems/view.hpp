@@ -1,6 +1,5 @@
-/// \file
-/// The camera as the wire LOD sees it: engine::scene::Camera plus the viewport size -> wire::LodView
-/// (double).
+// The camera as the wire LOD sees it: engine::scene::Camera plus the viewport size -> wire::LodView
+// (double).
 #pragma once
 
 #include "wire/lod.hpp"
