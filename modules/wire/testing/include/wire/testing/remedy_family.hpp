@@ -21,6 +21,11 @@ struct RemedyFamilySettings {
     uint64_t seed = 1;
     int samples_per_segment = 8;   ///< sample points per segment of the distance metric (exact foot points)
     double jump_bound_m = 2e-3;    ///< the per-frame jump aim (issue 17: 2 mm on a 20-40 m cable)
+    /// Which cables: 0 both (even open, odd closed), 1 open only, 2 closed only.
+    int shapes = 0;
+    /// Node spacing of the open cables: -1 drawn per cable (uniform, end-dense or jittered), 0 uniform,
+    /// 1 end-dense (1 - cos: elements 10-40x shorter at the ends than in the middle), 2 jittered.
+    int open_spacing = -1;
 };
 
 /// One event (a state whose ids differ from the previous one's) and what the remedy did with it.
