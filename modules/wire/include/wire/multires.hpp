@@ -38,7 +38,10 @@
 // geomorph restart it; the curve then settles at most max_blend_s after the last event.
 // Known limit: between junctions D pairs points by parameter; where the two curves' parameter speeds differ
 // strongly (uniform Catmull-Rom across very unequal elements) D slides along the curve, max|D| can exceed the
-// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md).
+// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md). It is
+// not only uniform: on end-dense cables max|D| reaches 120x the pop for centripetal and 220x for auto, so their
+// events are lengthened for a slide that barely shows (centripetal end-dense: settles 2 s median, 4 s p90;
+// docs/issue31_popfree.md has the figures and the refinement that was tried).
 // Not remedied (the new curve is shown at once, counted in unremedied()): a node count change when
 // WireNodes::ids is empty (nodes are then named by index), or a change between open and closed.
 // A duplicate id in one state is an error (Status naming the node and the id); the previous curve stays.
