@@ -54,7 +54,8 @@ struct RemedyFamilyResult {
     /// events still keep the 1/5 ratio, the lag and the settling; their frames move by up to 1.5 max|D| / N_max.
     double large_offset_m = 0.0;
     std::size_t large_events = 0;
-    double max_jump_over_design = 0.0;  ///< largest jump / (sum over running events of 1.5 max|D| / N), large or not
+    double max_jump_over_design = 0.0;  ///< largest jump / (sum over running events of 1.5 max|D| / N; an event folded
+                                        ///< into a later one counts up to that one's switch frame), large or not
     double max_jump_large_m = 0.0;      ///< largest jump in frames where a large event runs
     double max_jump_ratio = 0.0;        ///< per frame: jump / sum of the running events' pops (jump > 1e-9 m)
     double max_lag_ratio = 0.0;         ///< per frame: lag / the same sum (lag > 1e-9 m)
