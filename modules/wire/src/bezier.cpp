@@ -146,13 +146,29 @@ double closest_parameter(const CubicBezier& c, const glm::dvec3& p) {
     // Newton on f(t) = (B(t)-p).B'(t) = 0, kept inside the scan cell.
     const double lo = std::max(0.0, best_t - 1.0 / kScan), hi = std::min(1.0, best_t + 1.0 / kScan);
     double t = best_t;
-    for (int it = 0; it < 8; ++it) {
+    bool converged = false;
+    for (int it = 0; it < 8 && !converged; ++it) {
         const glm::dvec3 d = position(c, t) - p, d1 = derivative(c, t), d2 = second_derivative(c, t);
         const double f = glm::dot(d, d1), fp = glm::dot(d1, d1) + glm::dot(d, d2);
         if (!(fp > 0.0)) break;
         const double next = std::clamp(t - f / fp, lo, hi);
-        if (std::abs(next - t) < 1e-15) break;
+        converged = std::abs(next - t) < 1e-15;
         t = next;
+    }
+    if (!converged) {
+        // Newton crawls where the derivative vanishes (a segment with a zero end tangent: tension 1, a merged
+        // node): bisect f on the scan cell instead, where it changes sign.
+        auto f = [&](double x) { return glm::dot(position(c, x) - p, derivative(c, x)); };
+        double a = lo, b = hi;
+        if (f(a) <= 0.0 && f(b) >= 0.0) {
+            for (int it = 0; it < 60 && b - a > 1e-16; ++it) {
+                const double m = 0.5 * (a + b);
+                (f(m) <= 0.0 ? a : b) = m;
+            }
+            const double bt = 0.5 * (a + b);
+            const glm::dvec3 db = position(c, bt) - p, dt = position(c, t) - p;
+            if (glm::dot(db, db) < glm::dot(dt, dt)) t = bt;
+        }
     }
     const glm::dvec3 dn = position(c, t) - p;
     return glm::dot(dn, dn) <= best_d2 ? t : best_t;

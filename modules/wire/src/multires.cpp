@@ -335,11 +335,27 @@ void MultiresCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
     });
     pieces_ = std::move(out);
 
-    // The new event, unless nothing moved. Its length: see multires.hpp.
+    // The new event, unless nothing moved. The running events are folded into it: its offset is what the
+    // curve drawn this frame holds off T (their offsets at this frame's weights, plus P - T), so the switch
+    // shows what they would have shown, and from here one geomorph carries the whole remaining change. Events
+    // that kept their own clocks would add their speeds (three of them at 1 mm a frame: 3 mm); one event keeps
+    // the per-frame bound. Its length: see multires.hpp.
     if (max_d > 0.0) {
+        std::vector<double> keep(layers);
+        for (std::size_t e = 0; e < layers; ++e) keep[e] = 1.0 - smoothstep(static_cast<double>(events_[e].elapsed) / events_[e].frames);
+        max_d = 0.0;
+        for (Piece& p : pieces_) {
+            CubicBezier c = p.offset.back();
+            for (std::size_t e = 0; e < layers; ++e) {
+                const CubicBezier& d = p.offset[e];
+                c.b0 += keep[e] * d.b0, c.b1 += keep[e] * d.b1, c.b2 += keep[e] * d.b2, c.b3 += keep[e] * d.b3;
+            }
+            p.offset.assign(1, c);
+            max_d = std::max(max_d, max_displacement(c));
+        }
         const double need = 1.5 * max_d / settings_.max_step_m;
         const int frames = need >= static_cast<double>(max_frames_) ? max_frames_ : std::max(min_frames_, static_cast<int>(std::ceil(need)));
-        events_.push_back({0, frames, max_d});
+        events_.assign(1, Event{0, frames, max_d});
         last_frames_ = frames;
         ++started_;
     } else {

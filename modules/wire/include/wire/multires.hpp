@@ -11,9 +11,12 @@
 // offset D = P - T is one cubic per sub-piece, continuous along the wire, and zero wherever P and T agree.
 // The curve drawn is
 //     rendered = T + sum over running events e of (1 - w(k_e / N_e)) * D_e,     w(s) = 3s^2 - 2s^3,
-// k_e the frames since event e, N_e its length in frames. Each event decays on its own clock; a later event
-// carries the earlier offsets over onto the new parameterisation (exactly, by sub-division), so overlapping
-// events compose and none of them restarts or stalls another. Properties, for the target at rest:
+// k_e the frames since event e, N_e its length in frames. A later event carries the earlier offsets over onto
+// the new parameterisation (exactly, by sub-division) and folds them into its own: its D is what the curve
+// drawn at its switch frame holds off T (the running offsets at that frame's weights, plus P - T), so at most
+// one event runs and its length is set by everything still to be blended. (Issue 31: events on their own
+// clocks added their speeds; three running at their 1 mm bound moved an end-dense cable 2.0-2.4 mm a frame.)
+// Properties, for the target at rest:
 //   * no step: at an event's frame w = 0, so the switch shows the previous curve exactly; w is C1 with w' = 0
 //     at both ends, and when an event ends its offset is exactly 0, so the end and the dropping of the ghost
 //     junctions (sub-pieces of T that rejoin) change nothing;
@@ -29,10 +32,16 @@
 // bounded time" meet only up to a size; with the defaults, 1 mm a frame holds up to max|D| = 16 cm, 2 mm up
 // to 32 cm (events in flight add up, hence 1 mm for one event), and a larger change takes 4 s at max|D|/160
 // a frame. A wire held more than 4 s away from its physics is no longer a smoothing.
-// Events overlap: each keeps its own bound, so the frame's jump is at most the sum over running events.
+// Events overlap: the running one is folded into the new one, so the per-frame bound holds for the frame, not
+// per event: the switch frame moves as the folded event would have (<= its bound), later frames by at most
+// 1.5 max|D| / N of the folded event (<= max_step_m up to max|D| = 16 cm). Events arriving faster than one
+// geomorph restart it; the curve then settles at most max_blend_s after the last event.
 // Known limit: between junctions D pairs points by parameter; where the two curves' parameter speeds differ
 // strongly (uniform Catmull-Rom across very unequal elements) D slides along the curve, max|D| can exceed the
-// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md).
+// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md). It is
+// not only uniform: on end-dense cables max|D| reaches 120x the pop for centripetal and 220x for auto, so their
+// events are lengthened for a slide that barely shows (centripetal end-dense: settles 2 s median, 4 s p90;
+// docs/issue31_popfree.md has the figures and the refinement that was tried).
 // Not remedied (the new curve is shown at once, counted in unremedied()): a node count change when
 // WireNodes::ids is empty (nodes are then named by index), or a change between open and closed.
 // A duplicate id in one state is an error (Status naming the node and the id); the previous curve stays.

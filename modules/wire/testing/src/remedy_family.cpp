@@ -117,7 +117,7 @@ double directed_m(const Curve& from, const Curve& to, int per_segment) {
         const double g = 0.5 * (std::sqrt(5.0) - 1.0);
         double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
         double f1 = foot.local(position(s, x1)), f2 = foot.local(position(s, x2));
-        for (int it = 0; it < 16; ++it) {
+        for (int it = 0; it < 40; ++it) {
             if (f1 >= f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = foot.local(position(s, x1));
             else lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = foot.local(position(s, x2));
         }
@@ -126,7 +126,7 @@ double directed_m(const Curve& from, const Curve& to, int per_segment) {
     return worst;
 }
 
-WireNodes open_cable(Rng& rng, double& length_m) {
+WireNodes open_cable(Rng& rng, double& length_m, int forced_spacing) {
     length_m = rng.uniform(20.0, 40.0);
     const double slack = rng.uniform(0.01, 0.25);
     const double chord = length_m / (1.0 + slack), dy = chord * rng.uniform(-0.3, 0.3), dx = std::sqrt(chord * chord - dy * dy);
@@ -135,7 +135,7 @@ WireNodes open_cable(Rng& rng, double& length_m) {
     const dvec3 p2 = p1 + dvec3(dx * std::cos(heading), dy, dx * std::sin(heading));
     Catenary cat;
     (void)cat.solve(p1, p2, length_m);
-    const int n = rng.integer(16, 40), spacing = rng.integer(0, 2);
+    const int n = rng.integer(16, 40), drawn = rng.integer(0, 2), spacing = forced_spacing >= 0 ? forced_spacing : drawn;
     std::vector<double> s(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
         const double f = static_cast<double>(i) / (n - 1);
@@ -178,9 +178,9 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
     Rng rng{settings.seed * 0x2545F4914F6CDD1Dull + 12345u};
     const int per_seg = std::max(1, settings.samples_per_segment);
     for (int cable = 0; cable < settings.cables && out.error.empty(); ++cable) {
-        const bool closed = cable % 2 == 1;
+        const bool closed = settings.shapes == 1 ? false : settings.shapes == 2 ? true : cable % 2 == 1;
         double length = 0.0;
-        WireNodes nodes = closed ? closed_loop(rng, length) : open_cable(rng, length);
+        WireNodes nodes = closed ? closed_loop(rng, length) : open_cable(rng, length, settings.open_spacing);
         const std::size_t n0 = nodes.size();
         const double spacing = length / static_cast<double>(closed ? n0 : n0 - 1);
         uint32_t next_id = static_cast<uint32_t>(rng.integer(1, 1000)) * 1000u;
@@ -199,6 +199,7 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
             std::size_t event;
             std::size_t end_frame;
             double pop, speed;  // speed: the design's per-frame bound 1.5 max|D| / N
+            std::size_t folded_after = std::numeric_limits<std::size_t>::max();  // folded into a later event
         };
         std::vector<Running> running;
         std::size_t frame = 0;
@@ -224,7 +225,12 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
                 e.offset_m = e.frames > 0 ? m.last_max_offset_m() : 0.0;
                 out.large_events += e.offset_m > out.large_offset_m;
                 out.events.push_back(e);
-                if (e.frames > 0) running.push_back({out.events.size() - 1, frame + static_cast<std::size_t>(e.frames), e.pop_m, 1.5 * e.offset_m / e.frames});
+                if (e.frames > 0) {
+                    // The remedy folds the running events into the new one (multires.hpp): what is left of them
+                    // ends with it, and from the next frame on the new event's speed is the design's bound.
+                    for (Running& r : running) r.end_frame = frame + static_cast<std::size_t>(e.frames), r.folded_after = std::min(r.folded_after, frame);
+                    running.push_back({out.events.size() - 1, frame + static_cast<std::size_t>(e.frames), e.pop_m, 1.5 * e.offset_m / e.frames});
+                }
                 if (running.size() > 1) for (const Running& r : running) out.events[r.event].overlapped = true;
             }
             const double jump = curve_distance_m(prev, cur, per_seg), lag = curve_distance_m(cur, m.target(), per_seg);
@@ -232,7 +238,7 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
             double speed = 0.0;
             bool any_off = false, large = false;
             for (const Running& r : running) {
-                pops += r.pop, speed += r.speed, large = large || out.events[r.event].offset_m > out.large_offset_m;
+                pops += r.pop, speed += frame <= r.folded_after ? r.speed : 0.0, large = large || out.events[r.event].offset_m > out.large_offset_m;
                 if (r.end_frame > frame) lag_pops += r.pop, any_off = true;
             }
             if (m.blending() != any_off) ++out.state_mismatch;

@@ -21,6 +21,11 @@ struct RemedyFamilySettings {
     uint64_t seed = 1;
     int samples_per_segment = 8;   ///< sample points per segment of the distance metric (exact foot points)
     double jump_bound_m = 2e-3;    ///< the per-frame jump aim (issue 17: 2 mm on a 20-40 m cable)
+    /// Which cables: 0 both (even open, odd closed), 1 open only, 2 closed only.
+    int shapes = 0;
+    /// Node spacing of the open cables: -1 drawn per cable (uniform, end-dense or jittered), 0 uniform,
+    /// 1 end-dense (1 - cos: elements 10-40x shorter at the ends than in the middle), 2 jittered.
+    int open_spacing = -1;
 };
 
 /// One event (a state whose ids differ from the previous one's) and what the remedy did with it.
@@ -49,7 +54,8 @@ struct RemedyFamilyResult {
     /// events still keep the 1/5 ratio, the lag and the settling; their frames move by up to 1.5 max|D| / N_max.
     double large_offset_m = 0.0;
     std::size_t large_events = 0;
-    double max_jump_over_design = 0.0;  ///< largest jump / (sum over running events of 1.5 max|D| / N), large or not
+    double max_jump_over_design = 0.0;  ///< largest jump / (sum over running events of 1.5 max|D| / N; an event folded
+                                        ///< into a later one counts up to that one's switch frame), large or not
     double max_jump_large_m = 0.0;      ///< largest jump in frames where a large event runs
     double max_jump_ratio = 0.0;        ///< per frame: jump / sum of the running events' pops (jump > 1e-9 m)
     double max_lag_ratio = 0.0;         ///< per frame: lag / the same sum (lag > 1e-9 m)
