@@ -33,11 +33,12 @@ Status WirePipeline::update(const WireNodes& nodes, const PipelineSettings& sett
     RingSettings ring_settings;
     ring_settings.frames.method = settings.frame_method;
     if (states_ > 0 && !rings_.frames.empty()) {
-        // Temporal coherence: carry the first normal over instead of re-seeding from a world axis.
+        // Temporal coherence: the first normal moves with the wire (motion.hpp) instead of being re-seeded.
         ring_settings.frames.has_previous_normal = true;
-        ring_settings.frames.previous_normal = rings_.frames.front().r;
+        ring_settings.frames.previous_normal = carry_normal(fit_motion(motion_, nodes), rings_.frames.front().r);
     }
     build_rings(rendered_, params_, ring_settings, rings_);
+    motion_ = motion_reference(nodes);
     build_tube(rings_, settings.tube, mesh_);
     ++states_;
     return Status::success();

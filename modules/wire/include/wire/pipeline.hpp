@@ -3,6 +3,7 @@
 #pragma once
 
 #include "wire/curve.hpp"
+#include "wire/motion.hpp"
 #include "wire/multires.hpp"
 #include "wire/nodes.hpp"
 #include "wire/rings.hpp"
@@ -45,6 +46,7 @@ private:
     std::vector<uint32_t> counts_;
     std::vector<RingParam> params_;
     RingSet rings_;
+    MotionReference motion_{};  ///< the nodes rings_'s first frame was built from (its motion carries the frame)
     TubeMesh mesh_;
     std::size_t states_ = 0;
 };

@@ -506,10 +506,11 @@ void rings_system(Registry& registry, WireContext& ctx) {
         WireRings& r = *job.rings;
         place_rings(job.curve->curve, job.lod->lod.counts, r.params);
         RingSettings settings;
+        const WireNodes& nodes = job.curve->previous_nodes;  // the last valid nodes: what the curve shows
         if (!r.rings.frames.empty()) {
-            // Temporal coherence: carry the first normal over instead of re-seeding it from a world axis.
+            // Temporal coherence: the first normal moves with the wire (motion.hpp) instead of being re-seeded.
             settings.frames.has_previous_normal = true;
-            settings.frames.previous_normal = r.rings.frames.front().r;
+            settings.frames.previous_normal = carry_normal(fit_motion(r.motion, nodes), r.rings.frames.front().r);
         }
         thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
         // The float records are built straight into the wire's own buffer (lent to the scratch set for the build,
@@ -519,6 +520,7 @@ void rings_system(Registry& registry, WireContext& ctx) {
         std::swap(scratch.rings, r.rings.rings);
         build_rings(job.curve->curve, r.params, settings, scratch);
         r.frame_settings = settings.frames;
+        r.motion = motion_reference(nodes);
         keep_rings(scratch, r);
         ++r.generation;
         r.seen_curve = job.curve->generation;

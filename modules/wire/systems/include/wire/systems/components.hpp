@@ -4,6 +4,7 @@
 
 #include "wire/curve.hpp"
 #include "wire/lod.hpp"
+#include "wire/motion.hpp"
 #include "wire/multires.hpp"
 #include "wire/nodes.hpp"
 #include "wire/rings.hpp"
@@ -97,6 +98,7 @@ struct WireRings {
     RingSet rings;                     ///< float ring records, ring 0's frame and the scalars (see above)
     float u_close = 0.0f;              ///< closed wires: texture u where the loop closes (0 for open wires)
     FrameSettings frame_settings{};    ///< what the last build seeded its first normal with (wire_ring_set redoes it)
+    MotionReference motion{};          ///< the nodes ring 0's frame was built from: their motion carries it on
     uint64_t generation = 0;           ///< +1 each time the rings are rebuilt
     uint64_t seen_curve = 0;           ///< WireCurve::generation the rings were built from
     uint64_t seen_lod = 0;             ///< WireLodState::generation the rings were built from

@@ -1,0 +1,62 @@
+// How a wire moved between two states of its nodes: the best-fit rotation of its nodes matched by id, weighted
+// toward the start, so the first frame (and with it the texture) moves with the wire instead of lagging it.
+//
+// Why: projecting last state's first normal onto the new normal plane is the smallest rotation that takes the old
+// first tangent to the new one. Under a rigid motion that is not the motion: a rotation about any axis not
+// perpendicular to the first tangent also turns the wire about that tangent, which the projection leaves out, so
+// the texture slides around a swinging cable (2-3 degrees a frame) and a pose that returns shows another angle.
+// The rotation that carries the nodes onto their new positions (weighted least squares, Horn 1987: the top
+// eigenvector of a symmetric 4x4 matrix) is exact for a rigid motion whatever the path, and for a non-rigid one it
+// is the mean rotation of the wire near its start: the weights exp(-s / l) fall with the distance s along the wire
+// from node 0, and the reach l starts at two elements and doubles until the nodes within it fix the rotation (a
+// straight start borrows the bend further along), so the first frame follows the wire where it sits.
+//
+// Where that reason stops holding: the nodes of a wire determine its rotation about the line through them only
+// through their spread off that line. When the fit cannot tell rotations about that line apart (the gap between
+// the two largest eigenvalues is below 1e-3 of the largest: a wire within a few percent of straight, where 1e-7
+// relative noise of float physics would turn into up to 1e-4 rad of twist jitter), the carried normal blends
+// smoothly into the projection (fully projection below 1e-4): a straight wire's twist about itself is not in its
+// nodes, and the projection is the twist-free choice. Fewer than three nodes matched by id (ids replaced wholesale,
+// a wire without ids whose node count changed) also falls back to the projection.
+#pragma once
+
+#include "wire/nodes.hpp"
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include <array>
+#include <cstdint>
+
+namespace wire {
+
+/// A state's nodes to fit the next state's motion against: the first nodes, then ever sparser ones to the end
+/// (at most kCapacity), with their ids and their distance along the wire. Fixed size, no allocation (kept per wire).
+struct MotionReference {
+    static constexpr uint32_t kCapacity = 10;  // 64 nodes: 0, 1, 2, 3, 5, 8, 12, 18, 27 and 63
+    std::array<glm::dvec3, kCapacity> position{};  ///< world metres
+    std::array<uint32_t, kCapacity> id{};           ///< node ids (the node index when the wire has no ids)
+    std::array<float, kCapacity> arc{};             ///< polyline length from node 0 (metres)
+    uint32_t count = 0;                             ///< 0: no reference (nothing to carry from)
+    uint32_t node_count = 0;                        ///< nodes in the state (matching by index needs the same count)
+    bool by_index = false;                          ///< the state had no ids: nodes are matched by index
+};
+
+/// The reference of `nodes` (positions finite; any count, 0 gives an empty reference).
+[[nodiscard]] MotionReference motion_reference(const WireNodes& nodes);
+
+/// The rotation fitted from `from` to the matching nodes of `to`, and how well the nodes determine it.
+struct MotionFit {
+    glm::dquat rotation{1.0, 0.0, 0.0, 0.0};  ///< unit: world directions of the old state -> the new state
+    uint32_t matched = 0;      ///< reference nodes found in `to`
+    /// 1: the nodes pin the rotation down (use it); 0: they do not (use the projection); between: blend.
+    double confidence = 0.0;
+};
+[[nodiscard]] MotionFit fit_motion(const MotionReference& from, const WireNodes& to);
+
+/// Last state's first normal carried into the new state: turned by `confidence` times the fitted rotation's angle
+/// about its axis (all of it when the fit is sure, none when it is not: the frame stage then projects the plain
+/// previous normal). Not yet orthogonal to the new first tangent: pass it as FrameSettings::previous_normal.
+[[nodiscard]] glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal);
+
+}  // namespace wire
