@@ -2,7 +2,7 @@
 // constraints, a bending constraint per interior node, contacts with friction, pinned ends) that refines and
 // coarsens itself: nodes are inserted where the cable bends and
 // removed where it runs straight, each new node with a fresh stable id and placed ON the cable's current
-// rendered curve, so the wire systems' pop-free geomorph (wire/multires.hpp) makes the change invisible.
+// rendered curve, so the wire systems' pop-free blend (wire/pop_free.hpp) makes the change invisible.
 // Plain math on plain arrays: no GL, no ECS.
 #pragma once
 

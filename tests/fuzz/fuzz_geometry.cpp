@@ -52,9 +52,9 @@ wire::PipelineSettings read_settings(FuzzedDataProvider& in) {
     s.frame_method = static_cast<wire::FrameMethod>(in.ConsumeIntegralInRange<int>(0, 2));
     s.pop_free = in.ConsumeBool();
     if (in.ConsumeBool()) {
-        s.multires.blend_s = special_or_raw(in);
-        s.multires.max_step_m = special_or_raw(in);
-        s.multires.max_blend_s = special_or_raw(in);
+        s.blend.blend_s = special_or_raw(in);
+        s.blend.max_step_m = special_or_raw(in);
+        s.blend.max_blend_s = special_or_raw(in);
     }
     return s;
 }
@@ -121,8 +121,8 @@ void dump(const wire::PipelineSettings& s, const wire::WireNodes& n, int state) 
                  int(s.spline.curvature_tension), int(s.spline.closed), double(s.spline.radius_m),
                  s.spline.merge_epsilon_rel, s.tessellate.rings_per_segment, s.tessellate.tolerance_m,
                  s.tessellate.max_rings_per_segment, s.tube.sides, int(s.tube.caps), int(s.tube.tilt_normals),
-                 int(s.frame_method), int(s.pop_free), s.multires.blend_s, s.multires.max_step_m,
-                 s.multires.max_blend_s);
+                 int(s.frame_method), int(s.pop_free), s.blend.blend_s, s.blend.max_step_m,
+                 s.blend.max_blend_s);
     for (std::size_t i = 0; i < n.size(); ++i) {
         std::fprintf(stderr, "  node %zu: %.17g %.17g %.17g", i, n.positions[i].x, n.positions[i].y, n.positions[i].z);
         if (!n.ids.empty()) std::fprintf(stderr, " id %u", n.ids[i]);

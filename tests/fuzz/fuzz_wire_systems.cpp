@@ -5,7 +5,7 @@
 // Properties, every frame: no crash or UB (ASan+UBSan); every drawn vertex, ring and rendered curve control
 // point finite, indices in range; errors reported once per wire (a report only when a wire's error appears or
 // its message changes, naming the wire's entity, equal to its WireError, and through on_error exactly once).
-// At the end of the input, frames run with no further change: every geomorph ends (no wire blending) within
+// At the end of the input, frames run with no further change: every blend ends (no wire blending) within
 // kSettleFrames, and then every valid wire's rendered curve equals a fresh build_curve of its nodes and style.
 // WIRE_FUZZ_DUMP=1 prints the decoded operations.
 #include "fuzz_checks.hpp"
@@ -38,8 +38,8 @@ using engine::ecs::Registry;
 namespace ws = wire::systems;
 
 constexpr double kDt = 1.0 / 60.0;
-// Frames run after the last operation until no wire blends. A geomorph lasts Style::blend_s (0 -> 0.25 s) and at
-// most MultiresSettings::max_blend_s (4 s, 240 frames at 60 Hz): 600 frames of 1/60 s (10 s) is beyond that, and
+// Frames run after the last operation until no wire blends. A blend lasts Style::blend_s (0 -> 0.25 s) and at
+// most PopFreeSettings::max_blend_s (4 s, 240 frames at 60 Hz): 600 frames of 1/60 s (10 s) is beyond that, and
 // the property reads only the public WireContext::blending / WireCurve::blending.
 constexpr int kSettleFrames = 600;
 constexpr std::size_t kMaxWires = 6;
@@ -371,7 +371,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     }
     h.frame();
 
-    // Settle: with no further change every geomorph ends, and each valid wire then shows its exact curve.
+    // Settle: with no further change every blend ends, and each valid wire then shows its exact curve.
     int settle = 0;
     while (!h.ctx.blending.empty() && settle < kSettleFrames) {
         h.frame();

@@ -195,8 +195,8 @@ TEST(CurveErrors, ClosedLoopOfTwoNodes) {
     EXPECT_EQ(pipeline_error(nodes, s), "a closed loop needs at least 3 distinct nodes, got 2 after merging coincident ones");
 }
 
-// A node id used twice in one state (ids key the pop-free remedy across states): the node and the id, with or
-// without the remedy. (wiretool's JSON reader reports it earlier, naming the file and wire.)
+// A node id used twice in one state (ids key the pop-free blend across states): the node and the id, with or
+// without the pop-free blend. (wiretool's JSON reader reports it earlier, naming the file and wire.)
 TEST(CurveErrors, DuplicateNodeId) {
     wire::WireNodes nodes;
     nodes.positions = {{0, 0, 0}, {1, 0, 0}, {2, 1, 0}, {3, 1, 0}};

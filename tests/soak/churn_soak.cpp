@@ -364,7 +364,7 @@ void Soak::churn() {
                 if (n <= kMinNodes) continue;
                 ws::remove_node(registry_, w.entity, static_cast<std::size_t>(integer(0, n - 1)));
                 ++removed_;
-            } else {  // restyle: radius, sides, spline kind (the curve is rebuilt, the geomorph restarts)
+            } else {  // restyle: radius, sides, spline kind (the curve is rebuilt, the blend restarts)
                 ws::Style style = registry_.get<ws::Style>(w.entity);
                 style.radius_m = static_cast<float>(uniform(0.005, 0.05));
                 style.max_sides = static_cast<uint32_t>(integer(3, 16));

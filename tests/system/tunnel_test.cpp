@@ -393,7 +393,7 @@ RunFigures run_figures(platform::Context& ctx, tunnel::LevelSettings settings, i
             if (s.piece_levels[static_cast<std::size_t>(l)] > 0)
                 out.max_level_used = std::max(out.max_level_used, l);
     }
-    // Reported, not asserted (the wire module's geomorph, issue 17): how far the drawn rope curves lag behind
+    // Reported, not asserted (the wire module's blend, issue 17): how far the drawn rope curves lag behind
     // the curves through their current nodes.
     for (std::size_t c = 0; c < level.cables().size(); ++c) {
         if (!level.cables()[c].hanging) continue;

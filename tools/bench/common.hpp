@@ -1,6 +1,6 @@
 // `wiretool bench`: what its parts share: options, clocks, medians, the exact upload size of a DrawList, and
 // CSV/Markdown writing. The bench parts: systems/ (ECS scenes, bench.csv), accuracy/ (reference scenes,
-// accuracy.csv, the plot; families, remedy, DESIGN §5 hard cases). The subcommand's options:
+// accuracy.csv, the plot; families, pop-free blend, DESIGN §5 hard cases). The subcommand's options:
 // tools/wiretool/bench_command.cpp.
 #pragma once
 
@@ -66,7 +66,7 @@ std::string num(std::size_t v);
 // (exit_ok, or exit_failure when a file could not be written).
 int run_systems_bench(const Options& o);   ///< bench.csv, bench.md
 int run_accuracy_bench(const Options& o);  ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
-int run_remedy_bench(const Options& o);    ///< remedy_families.csv, remedy_families.md (accuracy/remedy.cpp)
+int run_pop_free_bench(const Options& o);    ///< remedy_families.csv, remedy_families.md (accuracy/pop_free.cpp)
 /// The DESIGN §5 hard cases as a Markdown section (case, result, max error).
 std::string stability_report();
 

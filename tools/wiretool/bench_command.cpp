@@ -26,7 +26,7 @@ int run_bench(const bench::Options& o) {
     if (!o.skip_accuracy) {
         if (const int st = bench::run_accuracy_bench(o); st != exit_ok) return st;
         if (bench::selected(o, "remedy_families")) {
-            if (const int st = bench::run_remedy_bench(o); st != exit_ok) return st;
+            if (const int st = bench::run_pop_free_bench(o); st != exit_ok) return st;
         }
     }
     std::fprintf(stderr, "wiretool bench: wrote %s\n", o.out_dir.c_str());

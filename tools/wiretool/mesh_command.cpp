@@ -57,7 +57,7 @@ engine::assets::MeshData to_mesh_data(const wire::TubeMesh& tube, std::size_t wi
 }
 
 /// One generation: every frame in order, every wire, from parsed input to finished vertex and index arrays.
-/// Wires keep their pipeline state (pop-free remedy, carried-over first frame) across frames.
+/// Wires keep their pipeline state (pop-free blend, carried-over first frame) across frames.
 engine::Status generate(const wire::io::SceneSpec& scene, const std::vector<std::vector<wire::PipelineSettings>>& settings,
                       const MeshOptions& o, bool want_outputs, Output& out) {
     const std::size_t wires = scene.frames.front().wires.size();

@@ -14,17 +14,17 @@ bool same_spline(const SplineSettings& a, const SplineSettings& b) {
 }  // namespace
 
 Status WirePipeline::update(const WireNodes& nodes, const PipelineSettings& settings) {
-    // A change of spline settings or of the remedy starts a new history: the curves are not comparable.
-    if (states_ == 0 || pop_free_ != settings.pop_free || !same_spline(multires_spline_, settings.spline)) {
-        MultiresSettings m = settings.multires;
+    // A change of spline settings or of the pop-free blend starts a new history: the curves are not comparable.
+    if (states_ == 0 || pop_free_ != settings.pop_free || !same_spline(pop_free_spline_, settings.spline)) {
+        PopFreeSettings m = settings.blend;
         m.spline = settings.spline;
-        m.geomorph = settings.pop_free;
-        multires_ = MultiresCurve(m);
-        multires_spline_ = settings.spline;
+        m.enabled = settings.pop_free;
+        pop_free_curve_ = PopFreeCurve(m);
+        pop_free_spline_ = settings.spline;
         pop_free_ = settings.pop_free;
     }
     Curve next;
-    if (Status st = multires_.update(nodes, next); !st.ok()) return st;
+    if (Status st = pop_free_curve_.update(nodes, next); !st.ok()) return st;
     rendered_ = std::move(next);
 
     segment_ring_counts(rendered_, settings.tessellate, counts_);

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "wire/bezier.hpp"
-#include "wire/multires.hpp"
+#include "wire/pop_free.hpp"
 #include "wire/nodes.hpp"
 #include "wire/testing/reference.hpp"
 #include "wire/spline.hpp"
@@ -146,26 +146,26 @@ inline WireNodes cable_with_removed_node(const Catenary& cable) {
 }
 
 struct PopNumbers {
-    double no_remedy_m = 0.0;    ///< jump of the exact curves from one state to the next
-    double remedy_max_m = 0.0;   ///< largest jump between consecutive rendered frames with the geomorph
-    int frames = 0;              ///< frames until the geomorph ended
+    double unblended_m = 0.0;    ///< jump of the exact curves from one state to the next
+    double blended_max_m = 0.0;   ///< largest jump between consecutive rendered frames with the blend
+    int frames = 0;              ///< frames until the blend ended
     double final_gap_m = 0.0;    ///< distance between the last rendered frame and the exact new curve
 };
 
-/// Shows `before` for two frames, then `after` until the geomorph ends (at most 1000 frames).
+/// Shows `before` for two frames, then `after` until the blend ends (at most 1000 frames).
 inline PopNumbers measure_pop(const SplineSettings& spline, const WireNodes& before, const WireNodes& after) {
     PopNumbers r;
     Curve a, b;
     (void)build_curve(before, spline, a);
     (void)build_curve(after, spline, b);
-    r.no_remedy_m = curve_jump_m(a, b);
-    MultiresCurve m({.spline = spline});
+    r.unblended_m = curve_jump_m(a, b);
+    PopFreeCurve m({.spline = spline});
     Curve prev, cur;
     (void)m.update(before, prev);
     (void)m.update(before, prev);
     for (int f = 0; f < 1000; ++f) {
         (void)m.update(after, cur);
-        r.remedy_max_m = std::max(r.remedy_max_m, curve_jump_m(prev, cur));
+        r.blended_max_m = std::max(r.blended_max_m, curve_jump_m(prev, cur));
         prev = cur;
         ++r.frames;
         if (!m.blending()) break;

@@ -1,5 +1,5 @@
 // wire_curve_report: prints the numbers quoted for the curve stage (catenary accuracy per spline kind,
-// the stretched-then-bent run, pops with and without the multiresolution remedy).
+// the stretched-then-bent run, pops with and without the multiresolution pop-free blend).
 #include "curve_cases.hpp"
 
 #include <chrono>
@@ -80,7 +80,7 @@ int main() {
             {"insert on catenary", base, on_cat}};
         for (const auto& e : events) {
             const PopNumbers p = measure_pop(v.settings, e.from, e.to);
-            std::printf("%-22s %-26s %12.3e %12.3e %7d %12.1e\n", v.name.c_str(), e.name, p.no_remedy_m, p.remedy_max_m, p.frames, p.final_gap_m);
+            std::printf("%-22s %-26s %12.3e %12.3e %7d %12.1e\n", v.name.c_str(), e.name, p.unblended_m, p.blended_max_m, p.frames, p.final_gap_m);
         }
     }
     return 0;

@@ -153,7 +153,7 @@ TEST(MotionTest, FramesTurnWithRigidMotion) {
         std::vector<RingSet> sets;
         for (int k : path) {
             const WireNodes nodes = moved(rest, pose_q(k), pivot, slide * static_cast<double>(k));
-            ASSERT_TRUE(pipe.update(nodes, settings).ok) << "case " << c;
+            ASSERT_TRUE(pipe.update(nodes, settings).ok()) << "case " << c;
             sets.push_back(pipe.rings());
         }
         for (std::size_t f = 1; f < path.size(); ++f) {
@@ -236,7 +236,7 @@ TEST(MotionTest, NonRigidTwistBoundedByTheMotion) {
                 const double envelope = c % 2 == 0 ? x : 1.0 - x;  // whipped at the far end, or shaken at the start
                 nodes.positions[i] += amp * envelope * std::sin(phase) * dir;
             }
-            ASSERT_TRUE(pipe.update(nodes, settings).ok);
+            ASSERT_TRUE(pipe.update(nodes, settings).ok());
             const RingSet& now = pipe.rings();
             if (k > 0) {
                 const double local = largest_local_rotation(prev, nodes);

@@ -6,7 +6,7 @@
 
 #include "draw_bytes.hpp"
 
-#include "wire/multires.hpp"
+#include "wire/pop_free.hpp"
 
 #include <engine/ecs/registry.hpp>
 #include <engine/ecs/schedule.hpp>
@@ -339,7 +339,7 @@ TEST(WireSystems, InsertedNodeIsBlendedInWithoutAPop) {
     EXPECT_LT(blend_frames, 300);  // ... and then the wire rests (no work)
     EXPECT_LE(worst_jump, 1e-3);
 
-    // With the remedy off the same change pops at once.
+    // With the pop-free blend off the same change pops at once.
     World raw;
     raw.ctx.pop_free = false;
     const Entity r = spawn_wire(raw.registry, cable(12, {-2, 0, 0}, 4.0, 0.6));
@@ -352,7 +352,7 @@ TEST(WireSystems, InsertedNodeIsBlendedInWithoutAPop) {
 }
 
 // A state with a node id used twice is an error naming the wire entity, the node and the id, with or without the
-// pop-free remedy; the wire keeps drawing its last valid curve.
+// pop-free blend; the wire keeps drawing its last valid curve.
 TEST(WireSystems, DuplicateNodeIdIsAnErrorNamingWireAndId) {
     for (bool pop_free : {true, false}) {
         World w;
@@ -376,13 +376,13 @@ TEST(WireSystems, DuplicateNodeIdIsAnErrorNamingWireAndId) {
     }
 }
 
-// Style::blend_s sets the geomorph length per wire: a small change on a wire with 1 s blends for 60 frames,
+// Style::blend_s sets the blend length per wire: a small change on a wire with 1 s blends for 60 frames,
 // the same change on a default wire for 15 (0.25 s at the 60 Hz frame).
 TEST(WireSystems, BlendTimeIsSetPerWire) {
     World w;
     // Catmull-Rom: a node inserted 2 mm off the sag is a small change for it. The automatic spline (the default)
-    // reads that node as a concentrated turn and re-parameterises the neighbouring spans, which the remedy then
-    // spreads over a longer blend to keep every frame under its 1 mm step (that case is in the remedy families).
+    // reads that node as a concentrated turn and re-parameterises the neighbouring spans, which the pop-free blend then
+    // spreads over a longer blend to keep every frame under its 1 mm step (that case is in the pop-free blend families).
     const SplineSettings cr{.kind = SplineKind::catmull_rom};
     const Entity quick = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.6), {.spline = cr});
     const Entity slow = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.6), {.spline = cr, .blend_s = 1.0f});

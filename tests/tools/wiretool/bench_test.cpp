@@ -168,7 +168,7 @@ void check_accuracy_csv(const fs::path& dir) {
 }
 
 // The issue's figures, as accuracy bounds: double reflection's twist error is at least 100x below the
-// rotation method's at equal rings (helix), the pop-free remedy keeps every frame's pop under 1 mm on the 20
+// rotation method's at equal rings (helix), the pop-free blend keeps every frame's pop under 1 mm on the 20
 // m cable while nodes come and go, and the automatic spline keeps a stretched run on its straight line.
 void check_accuracy_figures(const fs::path& dir) {
     const Csv csv = read_csv(dir / "accuracy.csv");
@@ -186,9 +186,9 @@ void check_accuracy_figures(const fs::path& dir) {
         EXPECT_LT(number(*rot, "max_twist_deg"), number(*proj, "max_twist_deg")) << "at " << tol << " px";
     }
     // churn: nodes inserted on the curve and removed again over 60 frames; catenary: one node inserted on the
-    // curve, then an original node removed. The geomorph keeps each frame under 1/10 of the event's offset and
-    // under MultiresSettings::max_step_m (1 mm) unless the change exceeds what 1 mm a frame carries within the
-    // longest geomorph (4 s: 16 cm; multires.hpp); these events stay below that.
+    // curve, then an original node removed. The blend keeps each frame under 1/10 of the event's offset and
+    // under PopFreeSettings::max_step_m (1 mm) unless the change exceeds what 1 mm a frame carries within the
+    // longest blend (4 s: 16 cm; pop_free.hpp); these events stay below that.
     for (const char* scene : {"churn", "catenary"}) {
         for (const char* method :
              {"linear", "uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
@@ -198,7 +198,7 @@ void check_accuracy_figures(const fs::path& dir) {
             EXPECT_LE(number(*r, "max_pop_remedy_m"), 0.2 * number(*r, "max_pop_m") * (1.0 + 1e-3) + 1e-12)
                 << scene << " " << method;
             if (std::string(method) !=
-                "linear") {  // a node inserted on a polyline changes nothing: no pop to remedy
+                "linear") {  // a node inserted on a polyline changes nothing: no pop to pop-free blend
                 EXPECT_LT(number(*r, "max_pop_remedy_m"), number(*r, "max_pop_m")) << scene << " " << method;
             }
         }
@@ -232,11 +232,11 @@ void check_stability_and_plot(const fs::path& dir) {
     }
 }
 
-// The remedy over random node-event families: one row per method, the distributions finite, every geomorph
+// The pop-free blend over random node-event families: one row per method, the distributions finite, every blend
 // settled exactly, and the issue-17 ratios (per-frame jump <= 1/5 of the running events' pops, lag <= those pops)
 // held. Uniform Catmull-Rom is the known exception (docs/speed_vs_error.md): its parameter speed varies so much
 // inside a segment that the parameter-to-parameter correspondence of a few events slides far along the curve.
-void check_remedy_csv(const fs::path& dir) {
+void check_pop_free_csv(const fs::path& dir) {
     const Csv csv = read_csv(dir / "remedy_families.csv");
     EXPECT_EQ(csv.header,
               "family,method,events,closed_events,overlapped_events,frames,pop_median_m,pop_p90_m,pop_max_m,"
@@ -292,7 +292,7 @@ TEST(WiretoolBench, QuickRunHonoursTheContract) {
     }
     {
         SCOPED_TRACE("remedy_families.csv");
-        check_remedy_csv(dir);
+        check_pop_free_csv(dir);
     }
     if (!::testing::Test::HasFailure()) {
         fs::remove_all(dir);

@@ -43,8 +43,8 @@ void measure_scene(const Options& o, const ReferenceScene& s, std::vector<Row>& 
             for (double tol : kTolerancesPx) rows.push_back(measure_row(s, m, nodes, tol, min_ms));
         }
         for (std::size_t k = rows.size() - std::size(kTolerancesPx); k < rows.size(); ++k) {
-            rows[k].pop_m = pops[m.spline_key].no_remedy_m;
-            rows[k].pop_remedy_m = pops[m.spline_key].remedy_m;
+            rows[k].pop_m = pops[m.spline_key].unblended_m;
+            rows[k].pop_blended_m = pops[m.spline_key].blended_m;
         }
     }
 }

@@ -29,7 +29,7 @@ std::vector<std::string> to_cells(const Row& r) {
             num(r.screen_px),
             num(r.twist_deg),
             num(r.pop_m),
-            num(r.pop_remedy_m)};
+            num(r.pop_blended_m)};
 }
 
 const Row* find_row(const std::vector<Row>& rows, const std::string& scene, const std::string& method,
@@ -207,7 +207,7 @@ int write_accuracy_report(const Options& o, const std::vector<ReferenceScene>& s
         for (const Method& m : methods()) {
             if (m.frames != wire::FrameMethod::double_reflection) continue;
             const Row* r = find_row(rows, scene, m.name, 0.5);
-            std::snprintf(buf, sizeof buf, " %s %.3g -> %.3g;", m.name.c_str(), r->pop_m, r->pop_remedy_m);
+            std::snprintf(buf, sizeof buf, " %s %.3g -> %.3g;", m.name.c_str(), r->pop_m, r->pop_blended_m);
             md += buf;
         }
         md += "\n";

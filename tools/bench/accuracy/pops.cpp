@@ -2,7 +2,7 @@
 #include "bench/accuracy/pops.hpp"
 
 #include <wire/bezier.hpp>
-#include <wire/multires.hpp>
+#include <wire/pop_free.hpp>
 #include <wire/spline.hpp>
 
 #include <algorithm>
@@ -34,13 +34,13 @@ void remove_node(wire::WireNodes& n, std::size_t at) {
         erase(n.length_m), erase(n.delta_length_m), erase(n.area_m2);
 }
 
-/// Runs `states` (each shown for at least one frame, then held until the geomorph ends) and returns the
-/// largest jump between consecutive rendered curves, with and without the remedy.
+/// Runs `states` (each shown for at least one frame, then held until the blend ends) and returns the
+/// largest jump between consecutive rendered curves, with and without the pop-free blend.
 Pops measure_pops(const std::vector<wire::WireNodes>& states, const wire::SplineSettings& spline,
                   int hold_frames, int samples) {
     Pops out;
     for (bool remedy : {false, true}) {
-        wire::MultiresCurve m({.spline = spline, .geomorph = remedy});
+        wire::PopFreeCurve m({.spline = spline, .enabled = remedy});
         wire::Curve prev, cur;
         bool first = true;
         double worst = 0.0;
@@ -53,7 +53,7 @@ Pops measure_pops(const std::vector<wire::WireNodes>& states, const wire::Spline
                 if (f > 0 && !m.blending()) break;
             }
         }
-        (remedy ? out.remedy_m : out.no_remedy_m) = worst;
+        (remedy ? out.blended_m : out.unblended_m) = worst;
     }
     return out;
 }

@@ -1,5 +1,5 @@
 // The accuracy bench's pops: the largest jump between consecutive rendered curves when nodes are inserted and
-// removed, without and with the pop-free remedy (the geomorph of wire::MultiresCurve).
+// removed, without and with the pop-free blend (the blend of wire::PopFreeCurve).
 #pragma once
 
 #include <wire/nodes.hpp>
@@ -15,8 +15,8 @@ constexpr int kPopSamplesPerSegment = 256;
 constexpr int kQuickPopSamplesPerSegment = 96;
 
 struct Pops {
-    double no_remedy_m = 0.0;
-    double remedy_m = 0.0;
+    double unblended_m = 0.0;
+    double blended_m = 0.0;
 };
 
 /// One event on a static scene: a node inserted exactly on the curve in the middle of the middle segment,

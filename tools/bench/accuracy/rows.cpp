@@ -5,7 +5,7 @@
 #include "bench/common.hpp"
 
 #include <wire/lod.hpp>
-#include <wire/multires.hpp>
+#include <wire/pop_free.hpp>
 #include <wire/rings.hpp>
 #include <wire/spline.hpp>
 #include <wire/tessellate.hpp>
@@ -104,7 +104,7 @@ Row measure_churn_row(const ReferenceScene& s, const Method& m, const std::vecto
     r.scene = s.name;
     r.method = m.name;
     r.tolerance_px = tol;
-    wire::MultiresCurve multires({.spline = m.spline});
+    wire::PopFreeCurve multires({.spline = m.spline});
     WireOutput w;
     std::vector<double> us;
     std::size_t frames = 0;

@@ -23,7 +23,7 @@ struct Row {
     double tolerance_px = 0.0;
     std::size_t rings = 0, sides = 0, vertices = 0, bytes_cpu = 0, bytes_gpu = 0;
     double ns_per_vertex = 0.0, us_cpu = 0.0, us_gpu = 0.0;
-    double world_m = 0.0, screen_px = 0.0, twist_deg = 0.0, pop_m = 0.0, pop_remedy_m = 0.0;
+    double world_m = 0.0, screen_px = 0.0, twist_deg = 0.0, pop_m = 0.0, pop_blended_m = 0.0;
 };
 
 /// A static scene's row; CPU times are medians of 3 trials of at least `min_ms` each.

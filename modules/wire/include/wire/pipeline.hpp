@@ -1,10 +1,10 @@
 // One wire's whole path from nodes to tube mesh, with the state it keeps between successive states of the
-// same wire (pop-free remedy, carried-over first frame). Used by wiretool and by the ECS systems' tests.
+// same wire (pop-free blend, carried-over first frame). Used by wiretool and by the ECS systems' tests.
 #pragma once
 
 #include "wire/curve.hpp"
 #include "wire/motion.hpp"
-#include "wire/multires.hpp"
+#include "wire/pop_free.hpp"
 #include "wire/nodes.hpp"
 #include "wire/rings.hpp"
 #include "wire/status.hpp"
@@ -21,8 +21,8 @@ struct PipelineSettings {
     TessellateSettings tessellate{};
     TubeSettings tube{};
     FrameMethod frame_method = FrameMethod::double_reflection;
-    bool pop_free = true;  ///< geomorph (MultiresCurve) when node ids appear or vanish between states
-    MultiresSettings multires{};  ///< blend length and per-frame step bound; its `spline` is taken from `spline`
+    bool pop_free = true;  ///< blend (PopFreeCurve) when node ids appear or vanish between states
+    PopFreeSettings blend{};  ///< blend length and per-frame step bound; its `spline` is taken from `spline`
 };
 
 /// Stateful per wire: call update() with each new state of the wire's nodes, in order.
@@ -33,16 +33,16 @@ public:
     [[nodiscard]] Status update(const WireNodes& nodes, const PipelineSettings& settings);
 
     [[nodiscard]] const Curve& curve() const { return rendered_; }
-    [[nodiscard]] const MultiresCurve& multires() const { return multires_; }
+    [[nodiscard]] const PopFreeCurve& pop_free() const { return pop_free_curve_; }
     [[nodiscard]] const RingSet& rings() const { return rings_; }
     [[nodiscard]] const TubeMesh& mesh() const { return mesh_; }
     [[nodiscard]] std::size_t states() const { return states_; }
 
 private:
-    MultiresCurve multires_;
-    SplineSettings multires_spline_{};  ///< the spline settings multires_ was made with
+    PopFreeCurve pop_free_curve_;
+    SplineSettings pop_free_spline_{};  ///< the spline settings pop_free_curve_ was made with
     bool pop_free_ = false;
-    Curve rendered_;  ///< what is drawn (the newest nodes' curve unless the pop-free remedy is blending)
+    Curve rendered_;  ///< what is drawn (the newest nodes' curve unless the pop-free blend is blending)
     std::vector<uint32_t> counts_;
     std::vector<RingParam> params_;
     RingSet rings_;

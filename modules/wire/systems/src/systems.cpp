@@ -241,20 +241,20 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         step.spline = spline_of(*job.style);
         step.released_spline = c.spline;
         const SplineSettings& spline = step.spline;
-        if (c.builds == 0 || spline != c.spline || c.geomorph != pop_free || c.blend_s != job.style->blend_s) {
-            c.multires = MultiresCurve(MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
+        if (c.builds == 0 || spline != c.spline || c.pop_free_on != pop_free || c.blend_s != job.style->blend_s) {
+            c.pop_free = PopFreeCurve(PopFreeSettings{.spline = spline, .enabled = pop_free, .blend_s = job.style->blend_s});
             c.spline = spline;
-            c.geomorph = pop_free;
+            c.pop_free_on = pop_free;
             c.blend_s = job.style->blend_s;
         }
         const WireNodes& nodes = *job.nodes;
         const WireNodes& prev = c.previous_nodes;
         const bool same_ids = c.generation > 0 && !c.blending && nodes.ids == prev.ids &&
                               (!nodes.ids.empty() || nodes.size() == prev.size());
-        // The first valid state has nothing to blend from: the multires would show its exact curve too (and is
+        // The first valid state has nothing to blend from: the pop-free blend would show its exact curve too (and is
         // primed from previous_nodes if the next state changes ids, as after any fast-path frame).
         const bool first = c.generation == 0;
-        // No node appeared or vanished and nothing blends: the exact curve is what the multires would show.
+        // No node appeared or vanished and nothing blends: the exact curve is what the pop-free blend would show.
         step.exact = !pop_free || same_ids || first;
     };
     // After the build (exact: job.status is build_curve's, its curve in `scratch`, a per-thread buffer swapped
@@ -280,20 +280,20 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                     std::swap(c.curve, scratch);
                 }
             }
-            if (!c.multires_stale) {
+            if (!c.pop_free_stale) {
                 // Re-priming rebuilds the pop-free state from previous_nodes: release it until then.
-                c.multires = MultiresCurve(
-                    MultiresSettings{.spline = spline, .geomorph = pop_free, .blend_s = job.style->blend_s});
-                c.multires_stale = true;
+                c.pop_free = PopFreeCurve(
+                    PopFreeSettings{.spline = spline, .enabled = pop_free, .blend_s = job.style->blend_s});
+                c.pop_free_stale = true;
             }
         } else {
-            if (c.multires_stale) {
+            if (c.pop_free_stale) {
                 // Re-prime the pop-free state with the last valid nodes (what is on screen now), then step.
-                c.multires.reset();
-                (void)c.multires.update(prev, scratch);
-                c.multires_stale = false;
+                c.pop_free.reset();
+                (void)c.pop_free.update(prev, scratch);
+                c.pop_free_stale = false;
             }
-            job.status = c.multires.update(nodes, c.curve);
+            job.status = c.pop_free.update(nodes, c.curve);
         }
         ++c.builds;
         if (job.status.ok()) {
@@ -306,12 +306,12 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             c.released = stays_released;
             job.kept_released = stays_released;
         } else {
-            // The multires path may have put its last state back into `curve` (or restore_curve below rebuilds
+            // The pop-free blend path may have put its last state back into `curve` (or restore_curve below rebuilds
             // it): `bounds` is not known to be its sphere.
             c.bounds_generation = 0;
         }
         if (!job.status.ok() && c.released) {
-            // Invalid nodes: the wire keeps its last valid curve, which was released. The multires path has
+            // Invalid nodes: the wire keeps its last valid curve, which was released. The pop-free blend path has
             // already put it back (it shows its last state on failure); the fast path leaves it empty.
             if (!c.curve.segments.empty()) {
                 c.released = false;
@@ -319,7 +319,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 job.restored = true;
             }
         }
-        c.blending = job.status.ok() && !c.multires_stale && c.multires.blending();
+        c.blending = job.status.ok() && !c.pop_free_stale && c.pop_free.blending();
     };
     parallel_over((jobs.size() + 3) / 4, [&](std::size_t group) {
         thread_local Curve scratch[4];
@@ -469,7 +469,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
             if (s.lod.counts.capacity() != 0) release(s.lod.counts);
             if (s.lod.required.capacity() != 0) release(s.lod.required);
             // Culled while moving: the next frame rebuilds the curve anyway (WireCurve).
-            if (curve_changed && !c.released && c.multires_stale && !c.blending && !c.curve.segments.empty()) {
+            if (curve_changed && !c.released && c.pop_free_stale && !c.blending && !c.curve.segments.empty()) {
                 release_curve(c);
                 outcome[i] = 1;
             }
@@ -676,8 +676,8 @@ namespace {
 void add_wire_memory(Registry& registry, Entity e, const WireCurve& c, WireMemory& m) {
     std::size_t curve =
         sizeof(WireCurve) + bytes_of(c.curve) + bytes_of(c.previous_nodes) + bytes_of(c.lod_bounds.data);
-    if (!c.multires_stale) {  // live pop-free state: target and rendered curves, one id per node of each
-        const Curve& t = c.multires.target();
+    if (!c.pop_free_stale) {  // live pop-free state: target and rendered curves, one id per node of each
+        const Curve& t = c.pop_free.target();
         curve += 2 * (bytes_of(t) + t.node_count() * sizeof(uint32_t));
     }
     std::size_t lod = 0, rings = 0, mesh = 0;

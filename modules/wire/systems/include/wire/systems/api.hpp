@@ -29,7 +29,7 @@ void set_nodes(engine::ecs::Registry& registry, engine::ecs::Entity wire, WireNo
 /// The wire's nodes for writing in place, marked changed (the stamp is taken now: write before the systems run).
 [[nodiscard]] WireNodes& edit_nodes(engine::ecs::Registry& registry, engine::ecs::Entity wire);
 
-/// Replaces the style and marks it changed (the curve is rebuilt; a spline change restarts the geomorph state).
+/// Replaces the style and marks it changed (the curve is rebuilt; a spline change restarts the blend state).
 void set_style(engine::ecs::Registry& registry, engine::ecs::Entity wire, const Style& style);
 
 /// Inserts a node before index `at` (at == size(): appends) with a new stable id (max id + 1; ids are made explicit

@@ -5,7 +5,7 @@
 #include "wire/curve.hpp"
 #include "wire/lod.hpp"
 #include "wire/motion.hpp"
-#include "wire/multires.hpp"
+#include "wire/pop_free.hpp"
 #include "wire/nodes.hpp"
 #include "wire/rings.hpp"
 #include "wire/tube.hpp"
@@ -29,7 +29,7 @@ struct Style {
     uint32_t material = 0;        ///< renderer material index
     bool caps = true;             ///< flat end caps on open wires
     bool closed = false;          ///< closed loop
-    float blend_s = 0.0f;         ///< pop-free geomorph length for small changes, seconds (multires.hpp); 0 -> 0.25 s
+    float blend_s = 0.0f;         ///< pop-free blend length for small changes, seconds (pop_free.hpp); 0 -> 0.25 s
 };
 
 // ---- derived state, owned by the systems (read them, do not write them) ----
@@ -37,7 +37,7 @@ struct Style {
 /// Curve stage: the rendered curve (pop-free: blended while nodes appear or vanish) and its change counter.
 ///
 /// Released while culled and moving: a wire the LOD stage culls in a frame its curve changed (it moves), that is
-/// on the fast path (multires_stale) and not blending, releases `curve` (`released` set; `bounds` and
+/// on the fast path (pop_free_stale) and not blending, releases `curve` (`released` set; `bounds` and
 /// `previous_nodes` stay): its next change rebuilds the curve anyway. The LOD stage rebuilds a released curve
 /// from `previous_nodes` (bit for bit the released one) as soon as `bounds` is not outside the view, before it
 /// decides the wire, so the wire comes back as if it had never been released (generation advances, so rings and
@@ -55,26 +55,26 @@ struct WireCurve {
     /// LOD stage and keeps none; a wire whose sphere is outside the view needs none; a culled wire releases them.
     LodBounds lod_bounds{};
     Curve curve;                       ///< what is drawn; empty until the nodes were valid once, or released
-    SplineSettings spline{};           ///< settings the multires state was made with (a change resets it)
+    SplineSettings spline{};           ///< settings the pop-free state was made with (a change resets it)
     uint64_t generation = 0;           ///< +1 each time `curve` changes (or is rebuilt after a release)
     uint64_t builds = 0;               ///< times the curve was built for this wire (test/statistics counter)
     bool released = false;             ///< `curve` is released (culled and moving, see above)
-    bool blending = false;             ///< a geomorph is in progress: the curve changes next frame too
-    bool geomorph = true;              ///< WireContext::pop_free the multires state was made with
-    bool multires_stale = false;       ///< `multires` lags behind `curve` (the fast path ran); released while it does
-    float blend_s = 0.0f;              ///< Style::blend_s the multires state was made with
+    bool blending = false;             ///< a blend is in progress: the curve changes next frame too
+    bool pop_free_on = true;           ///< WireContext::pop_free the pop-free state was made with
+    bool pop_free_stale = false;       ///< `pop-free blend` lags behind `curve` (the fast path ran); released while it does
+    float blend_s = 0.0f;              ///< Style::blend_s the pop-free state was made with
     BoundingSphere bounds{};           ///< of `curve`, recomputed with it (the LOD's O(1) off-screen test); kept
                                        ///< while released
     uint64_t bounds_generation = 0;    ///< `generation` whose curve `bounds` was computed from (0: none known; a
                                        ///< failed update may rewrite `curve`): then the LOD stage takes `bounds`
                                        ///< as the LodBounds' sphere instead of computing it again
     uint64_t lod_bounds_generation = 0;  ///< `generation` lod_bounds were computed for (0: none kept)
-    // Fast path: while no node id appears or vanishes and nothing blends, the multires state would only show the
-    // exact curve, so build_curve runs alone (5x cheaper) and the multires state is re-primed from
-    // `previous_nodes` (the last valid state) when the ids change. While stale the multires state is released
+    // Fast path: while no node id appears or vanishes and nothing blends, the pop-free state would only show the
+    // exact curve, so build_curve runs alone (5x cheaper) and the pop-free state is re-primed from
+    // `previous_nodes` (the last valid state) when the ids change. While stale the pop-free state is released
     // (re-priming rebuilds it from previous_nodes anyway); build_curve's output buffer is per thread, not per wire.
-    WireNodes previous_nodes;          ///< the last valid nodes (re-primes `multires` when ids change)
-    MultiresCurve multires{MultiresSettings{}};  ///< pop-free state: blends nodes in and out over frames
+    WireNodes previous_nodes;          ///< the last valid nodes (re-primes `pop-free blend` when ids change)
+    PopFreeCurve pop_free{PopFreeSettings{}};  ///< pop-free state: blends nodes in and out over frames
 };
 
 /// LOD stage: visibility, per-segment ring counts and sides for the context's camera.

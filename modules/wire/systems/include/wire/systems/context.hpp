@@ -19,7 +19,7 @@ namespace wire::systems {
 /// Counts of one frame (reset by the curve system, filled by each system). "Rebuilt" counts are the work done.
 struct RunStats {
     std::size_t wires = 0;             ///< wire entities (with Nodes and Style)
-    std::size_t curves_built = 0;      ///< curve stage runs (changed nodes/style, or an ongoing geomorph)
+    std::size_t curves_built = 0;      ///< curve stage runs (changed nodes/style, or an ongoing blend)
     std::size_t lod_updates = 0;       ///< update_lod runs (hull tests); 0 when nothing moved
     std::size_t curves_released = 0;   ///< culled moving wires holding no curve after this frame: released by the
                                        ///< LOD stage, or rebuilt in the curve stage's per-thread buffer only
@@ -53,7 +53,7 @@ struct WireContext {
     double viewport_height_px = 1080.0;  ///< viewport height, pixels
     LodSettings lod{};                           ///< tolerance (px), max rings per segment, hysteresis
     UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_rings stops at ring records
-    bool pop_free = true;                        ///< geomorph when node ids appear or vanish (multires.hpp)
+    bool pop_free = true;                        ///< blend when node ids appear or vanish (pop_free.hpp)
     /// Called once per new error (after the curve system, in entity order). Empty: nothing is called.
     std::function<void(const ErrorReport&)> on_error;
 
@@ -68,7 +68,7 @@ struct WireContext {
     LodSettings seen_lod{};                      ///< the LOD settings `view_generation` was taken with
     bool has_view = false;                       ///< `view` was computed at least once
     std::vector<engine::ecs::Entity> curve_changed;  ///< wires whose curve changed this frame
-    std::vector<engine::ecs::Entity> blending;       ///< wires in a geomorph (their curve changes next frame)
+    std::vector<engine::ecs::Entity> blending;       ///< wires in a blend (their curve changes next frame)
 };
 
 }  // namespace wire::systems

@@ -1,7 +1,7 @@
 // The wire systems and their order. install() registers, in this order, on a schedule:
 // \verbatim
 //   wire.curve      wires whose Nodes or Style changed since it last ran (change tracking), plus wires in
-//                   a geomorph: pop-free curve (multires.hpp); bad nodes -> WireError, reported once,
+//                   a blend: pop-free curve (pop_free.hpp); bad nodes -> WireError, reported once,
 //                   wire skipped
 //   wire.lod        if the camera (or LOD settings) changed: every wire; otherwise only wires whose curve
 //                   changed: hull culling, per-segment ring counts, sides, hysteresis (lod.hpp); releases
@@ -43,7 +43,7 @@ void install(engine::ecs::Schedule& schedule, WireContext& context);
 // The systems one by one (install() calls these; tests and tools may too).
 
 /// Curve stage (wire.curve): rebuilds the curve of wires whose Nodes or Style changed since registry tick
-/// `since` (the curve system's previous run, FrameContext::last_run_tick) and of wires in a geomorph; resets
+/// `since` (the curve system's previous run, FrameContext::last_run_tick) and of wires in a blend; resets
 /// WireContext::stats; reports new WireErrors.
 void curve_system(engine::ecs::Registry& registry, WireContext& context, uint64_t since);
 /// LOD stage (wire.lod): visibility and per-segment ring counts for the context's camera (every wire when the
@@ -76,7 +76,7 @@ bool wire_ring_set(engine::ecs::Registry& registry, engine::ecs::Entity wire, Ri
 /// (curve, previous nodes, LOD bounds), WireLodState, WireRings and WireMesh, summed, plus the components' sizes,
 /// split by the wire's last LOD visibility. What is kept: see WireCurve (a culled moving wire releases its curve,
 /// a moving wire keeps no LodBounds), WireRings (a culled moving wire releases its rings) and WireMesh; a culled
-/// wire keeps no LOD counts. Nodes (the game's input) is reported apart. The multires state's
+/// wire keeps no LOD counts. Nodes (the game's input) is reported apart. The pop-free state's
 /// private buffers are estimated from its target curve (target and rendered curve, one id per node) while it is
 /// live; a released (stale) state holds nothing.
 struct WireMemory {

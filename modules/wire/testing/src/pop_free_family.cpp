@@ -1,5 +1,5 @@
-// Random node-event families for the pop-free remedy and the exact curve distance they are measured with.
-#include "wire/testing/remedy_family.hpp"
+// Random node-event families for the pop-free blend and the exact curve distance they are measured with.
+#include "wire/testing/pop_free_family.hpp"
 #include "wire/testing/random.hpp"
 
 #include "wire/bezier.hpp"
@@ -173,8 +173,8 @@ double curve_distance_m(const Curve& a, const Curve& b, int samples_per_segment)
     return std::max(directed_m(a, b, s), directed_m(b, a, s));
 }
 
-RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
-    RemedyFamilyResult out;
+PopFreeFamilyResult run_pop_free_family(const PopFreeFamilySettings& settings) {
+    PopFreeFamilyResult out;
     Rng rng{settings.seed * 0x2545F4914F6CDD1Dull + 12345u};
     const int per_seg = std::max(1, settings.samples_per_segment);
     for (int cable = 0; cable < settings.cables && out.error.empty(); ++cable) {
@@ -185,10 +185,10 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
         const double spacing = length / static_cast<double>(closed ? n0 : n0 - 1);
         uint32_t next_id = static_cast<uint32_t>(rng.integer(1, 1000)) * 1000u;
         for (std::size_t i = 0; i < nodes.size(); ++i) nodes.ids.push_back(next_id), next_id += 3;
-        MultiresSettings ms = settings.multires;
+        PopFreeSettings ms = settings.blend;
         ms.spline = settings.spline;
         ms.spline.closed = closed;
-        MultiresCurve m(ms);
+        PopFreeCurve m(ms);
         out.large_offset_m = settings.jump_bound_m * m.max_blend_frames() / 1.5;
         Curve prev, cur;
         if (Status st = m.update(nodes, prev); !st) {
@@ -216,7 +216,7 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
             // off the exact curve in frames f .. f+N-1.
             std::erase_if(running, [&](const Running& r) { return r.end_frame < frame; });
             if (type >= 0) {
-                RemedyEvent e;
+                PopFreeEvent e;
                 e.type = type, e.closed = closed, e.cable = cable, e.length_m = length;
                 e.pop_m = curve_distance_m(before, m.target(), per_seg);
                 e.frames = m.events_started() > started ? m.last_blend_frames() : 0;
@@ -226,7 +226,7 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
                 out.large_events += e.offset_m > out.large_offset_m;
                 out.events.push_back(e);
                 if (e.frames > 0) {
-                    // The remedy folds the running events into the new one (multires.hpp): what is left of them
+                    // The pop-free blend folds the running events into the new one (pop_free.hpp): what is left of them
                     // ends with it, and from the next frame on the new event's speed is the design's bound.
                     for (Running& r : running) r.end_frame = frame + static_cast<std::size_t>(e.frames), r.folded_after = std::min(r.folded_after, frame);
                     running.push_back({out.events.size() - 1, frame + static_cast<std::size_t>(e.frames), e.pop_m, 1.5 * e.offset_m / e.frames});
@@ -252,7 +252,7 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
             if (jr > out.max_jump_ratio) out.max_jump_ratio = jr, out.worst_jump = where + ", jump " + std::to_string(jump) + " m, pops " + std::to_string(pops) + " m";
             if (lr > out.max_lag_ratio) out.max_lag_ratio = lr, out.worst_lag = where + ", lag " + std::to_string(lag) + " m, pops " + std::to_string(pops) + " m";
             for (const Running& r : running) {
-                RemedyEvent& e = out.events[r.event];
+                PopFreeEvent& e = out.events[r.event];
                 e.jump_m = std::max(e.jump_m, jump), e.lag_m = std::max(e.lag_m, lag);
                 e.jump_ratio = std::max(e.jump_ratio, jr), e.lag_ratio = std::max(e.lag_ratio, lr);
             }
@@ -265,32 +265,32 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
             const std::size_t n = nodes.size();
             const bool may_insert = n < n0 + 8, may_remove = n + 4 > n0;
             const double r = rng.uniform(0.0, 1.0);
-            int type = RemedyEvent::insert;
-            if (r < 0.45) type = may_insert ? RemedyEvent::insert : RemedyEvent::remove;
-            else if (r < 0.9) type = may_remove ? RemedyEvent::remove : RemedyEvent::insert;
-            else type = closed ? (may_remove ? RemedyEvent::seam : RemedyEvent::insert) : RemedyEvent::replace_end;
+            int type = PopFreeEvent::insert;
+            if (r < 0.45) type = may_insert ? PopFreeEvent::insert : PopFreeEvent::remove;
+            else if (r < 0.9) type = may_remove ? PopFreeEvent::remove : PopFreeEvent::insert;
+            else type = closed ? (may_remove ? PopFreeEvent::seam : PopFreeEvent::insert) : PopFreeEvent::replace_end;
             // Removal: anywhere along the wire (a loop's seam node 0 included), where a coarsening physics would
             // remove a node: the merged element stays within 2.5x the cable's own spacing (it would not leave a
             // 4 m element among 1 m ones). Where no such node is found in 20 draws, the event is an insertion.
             std::size_t victim = n;
-            if (type == RemedyEvent::remove || type == RemedyEvent::seam) {
+            if (type == PopFreeEvent::remove || type == PopFreeEvent::seam) {
                 for (int tries = 0; tries < 20 && victim == n; ++tries) {
-                    const std::size_t at = type == RemedyEvent::seam && tries == 0 ? 0
+                    const std::size_t at = type == PopFreeEvent::seam && tries == 0 ? 0
                                            : closed ? static_cast<std::size_t>(rng.integer(0, static_cast<int>(n) - 1))
                                                     : static_cast<std::size_t>(rng.integer(1, static_cast<int>(n) - 2));
                     const std::size_t a = at == 0 ? n - 1 : at - 1, b = at + 1 == n ? 0 : at + 1;
                     if (glm::length(nodes.positions[a] - nodes.positions[b]) <= 2.5 * spacing) victim = at;
                 }
-                type = victim == n ? RemedyEvent::insert : closed && victim == 0 ? RemedyEvent::seam : RemedyEvent::remove;
+                type = victim == n ? PopFreeEvent::insert : closed && victim == 0 ? PopFreeEvent::seam : PopFreeEvent::remove;
             }
-            if (type == RemedyEvent::insert) {  // exactly on the current curve, inside a random segment
+            if (type == PopFreeEvent::insert) {  // exactly on the current curve, inside a random segment
                 const Curve& t = m.target();
                 const std::size_t k = static_cast<std::size_t>(rng.integer(0, static_cast<int>(t.segment_count()) - 1));
                 const dvec3 p = position(t.segments[k], rng.uniform(0.15, 0.85));
                 const std::size_t at = t.source_node[k] + 1;
                 nodes.positions.insert(nodes.positions.begin() + static_cast<std::ptrdiff_t>(at), p);
                 nodes.ids.insert(nodes.ids.begin() + static_cast<std::ptrdiff_t>(at), next_id++);
-            } else if (type == RemedyEvent::remove || type == RemedyEvent::seam) {
+            } else if (type == PopFreeEvent::remove || type == PopFreeEvent::seam) {
                 nodes.positions.erase(nodes.positions.begin() + static_cast<std::ptrdiff_t>(victim));
                 nodes.ids.erase(nodes.ids.begin() + static_cast<std::ptrdiff_t>(victim));
             } else {  // an end node re-created by the physics under a new id, up to 2 mm from where it was
@@ -300,9 +300,9 @@ RemedyFamilyResult run_remedy_family(const RemedyFamilySettings& settings) {
             }
             step(type);
         }
-        // Hold the last state until every geomorph has ended, then one more frame to see it settled.
+        // Hold the last state until every blend has ended, then one more frame to see it settled.
         for (int f = 0; f <= m.max_blend_frames() + 1 && out.error.empty() && (m.blending() || !running.empty()); ++f) step(-1);
-        // (the frame after the last geomorph ended: nothing running, the exact curve drawn)
+        // (the frame after the last blend ended: nothing running, the exact curve drawn)
         if (out.error.empty()) step(-1);
     }
     return out;

@@ -1,6 +1,6 @@
-// Pop-free multiresolution: per-event geomorphs of the offset between the previous and the current exact
-// curve, keyed by node id (see multires.hpp).
-#include "wire/multires.hpp"
+// The pop-free blend: per-event blends of the offset between the previous and the current exact
+// curve, keyed by node id (see pop_free.hpp).
+#include "wire/pop_free.hpp"
 
 #include "wire/bezier.hpp"
 #include "wire/spline.hpp"
@@ -23,7 +23,7 @@ bool is_zero(const CubicBezier& d) {
     const dvec3 z(0.0);
     return d.b0 == z && d.b1 == z && d.b2 == z && d.b3 == z;
 }
-// max over t of |D(t)|: how far the point at parameter t travels over a whole geomorph (sampled densely, plus
+// max over t of |D(t)|: how far the point at parameter t travels over a whole blend (sampled densely, plus
 // the control points' bound where it is attained at an end).
 double max_displacement(const CubicBezier& d) {
     double worst = 0.0;
@@ -157,7 +157,7 @@ Status check_unique_ids(const WireNodes& nodes) {
     return Status::success();
 }
 
-MultiresCurve::MultiresCurve(const MultiresSettings& settings) : settings_(settings) {
+PopFreeCurve::PopFreeCurve(const PopFreeSettings& settings) : settings_(settings) {
     auto fix = [](double& v, double fallback) {
         if (!(v > 0.0) || !std::isfinite(v)) v = fallback;
     };
@@ -166,19 +166,19 @@ MultiresCurve::MultiresCurve(const MultiresSettings& settings) : settings_(setti
     fix(settings_.max_step_m, 1e-3);
     fix(settings_.max_blend_s, 4.0);
     settings_.max_blend_s = std::max(settings_.max_blend_s, settings_.blend_s);
-    // Frames, at least 1 and at most a million (a geomorph of hours is a settings mistake, not a request).
+    // Frames, at least 1 and at most a million (a blend of hours is a settings mistake, not a request).
     auto frames = [](double s) { return static_cast<int>(std::clamp(std::ceil(s - 1e-9), 1.0, 1e6)); };
     min_frames_ = frames(settings_.blend_s / settings_.frame_s);
     max_frames_ = std::max(min_frames_, frames(settings_.max_blend_s / settings_.frame_s));
 }
 
-void MultiresCurve::reset() {
+void PopFreeCurve::reset() {
     has_state_ = false;
     target_ = Curve{}, rendered_ = Curve{};
     target_ids_.clear(), events_.clear(), pieces_.clear();
 }
 
-Status MultiresCurve::update(const WireNodes& nodes, Curve& rendered) {
+Status PopFreeCurve::update(const WireNodes& nodes, Curve& rendered) {
     Curve T;
     Status st = build_curve(nodes, settings_.spline, T);
     if (st.ok()) st = check_unique_ids(nodes);
@@ -203,8 +203,8 @@ Status MultiresCurve::update(const WireNodes& nodes, Curve& rendered) {
     const bool changed = tid != target_ids_ || T.segment_count() != target_.segment_count();
     // Without ids, nodes are named by index: a count change renames nodes, so then there is nothing to key on.
     const bool renamed = nodes.ids.empty() && tn != target_ids_.size();
-    if (!settings_.geomorph || !has_state_ || T.closed != target_.closed || renamed) {
-        if (has_state_ && settings_.geomorph && changed) ++unremedied_, last_reason_ = renamed ? 2 : 1;
+    if (!settings_.enabled || !has_state_ || T.closed != target_.closed || renamed) {
+        if (has_state_ && settings_.enabled && changed) ++unremedied_, last_reason_ = renamed ? 2 : 1;
         events_.clear(), pieces_.clear();
     } else if (changed) {
         remap(T, tid);
@@ -236,7 +236,7 @@ Status MultiresCurve::update(const WireNodes& nodes, Curve& rendered) {
 }
 
 // Maps the pieces (on the previous target) onto T and adds the new event's offset P - T.
-void MultiresCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
+void PopFreeCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
     const Curve& P = target_;
     const std::size_t pn = P.node_count(), tn = T.node_count();
     const std::size_t ps = P.segment_count(), ts = T.segment_count();
@@ -337,9 +337,9 @@ void MultiresCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
 
     // The new event, unless nothing moved. The running events are folded into it: its offset is what the
     // curve drawn this frame holds off T (their offsets at this frame's weights, plus P - T), so the switch
-    // shows what they would have shown, and from here one geomorph carries the whole remaining change. Events
+    // shows what they would have shown, and from here one blend carries the whole remaining change. Events
     // that kept their own clocks would add their speeds (three of them at 1 mm a frame: 3 mm); one event keeps
-    // the per-frame bound. Its length: see multires.hpp.
+    // the per-frame bound. Its length: see pop_free.hpp.
     if (max_d > 0.0) {
         std::vector<double> keep(layers);
         for (std::size_t e = 0; e < layers; ++e) keep[e] = 1.0 - smoothstep(static_cast<double>(events_[e].elapsed) / events_[e].frames);
@@ -363,7 +363,7 @@ void MultiresCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
     }
 }
 
-void MultiresCurve::assemble(const Curve& T, Curve& out) const {
+void PopFreeCurve::assemble(const Curve& T, Curve& out) const {
     std::vector<double> keep(events_.size());
     for (std::size_t e = 0; e < events_.size(); ++e) {
         keep[e] = 1.0 - smoothstep(static_cast<double>(events_[e].elapsed) / events_[e].frames);

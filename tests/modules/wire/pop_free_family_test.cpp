@@ -1,11 +1,11 @@
-// The pop-free remedy over random families (issue 17, item 4): >= 500 node events per spline kind on random
+// The pop-free blend over random families (issue 17, item 4): >= 500 node events per spline kind on random
 // 20-40 m cables, open and closed, nodes inserted exactly on the curve, removed anywhere (the seam node of a
 // loop included), end nodes re-created under a new id, often several events running at once. Asserted on every
 // frame: the jump is at most 1/5 of the instant pops of the events running and at most 2 mm; the lag (drawn
 // against the exact curve of the same nodes) never exceeds those pops; with no event running the drawn curve
 // is the exact one (to 1e-6 m; in fact bit for bit), which happens at most max_blend_s after the last event.
-#include "wire/multires.hpp"
-#include "wire/testing/remedy_family.hpp"
+#include "wire/pop_free.hpp"
+#include "wire/testing/pop_free_family.hpp"
 #include "wire/testing/random.hpp"
 
 #include <glm/geometric.hpp>
@@ -43,21 +43,21 @@ double quantile(std::vector<double> v, double q) {
     return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
-class RemedyFamily : public ::testing::TestWithParam<int> {};
+class PopFreeFamily : public ::testing::TestWithParam<int> {};
 
-TEST_P(RemedyFamily, EveryFrameWithinThePopAndSettles) {
+TEST_P(PopFreeFamily, EveryFrameWithinThePopAndSettles) {
     const Kind& kind = kKinds[GetParam()];
-    RemedyFamilySettings s;
+    PopFreeFamilySettings s;
     s.spline = kind.spline;
     s.cables = 40;
     s.events_per_cable = 13;  // 520 events
     s.seed = 17 + static_cast<uint64_t>(GetParam());
-    const RemedyFamilyResult r = run_remedy_family(s);
+    const PopFreeFamilyResult r = run_pop_free_family(s);
     ASSERT_TRUE(r.error.empty()) << r.error;
     ASSERT_GE(r.events.size(), 500u);
     std::size_t overlapped = 0, closed = 0, per_type[4] = {0, 0, 0, 0};
     std::vector<double> pop, jump, lag, settle;
-    for (const RemedyEvent& e : r.events) {
+    for (const PopFreeEvent& e : r.events) {
         overlapped += e.overlapped, closed += e.closed, ++per_type[e.type];
         pop.push_back(e.pop_m), jump.push_back(e.jump_m), lag.push_back(e.lag_m);
         settle.push_back(e.frames / 60.0);
@@ -72,11 +72,11 @@ TEST_P(RemedyFamily, EveryFrameWithinThePopAndSettles) {
     EXPECT_LE(r.max_jump_ratio, 0.2) << kind.name << ": " << r.worst_jump;
     EXPECT_LE(r.max_jump_m, 2e-3) << kind.name;
     // Every frame within the design's bound (sum over the running events of 1.5 max|D| / N), which is what
-    // keeps 2 mm except for changes too large for it within the longest geomorph (max|D| > 32 cm: counted).
+    // keeps 2 mm except for changes too large for it within the longest blend (max|D| > 32 cm: counted).
     EXPECT_LE(r.max_jump_over_design, 1.0 + 1e-6) << kind.name;
     EXPECT_LE(r.max_lag_ratio, 1.0 + 1e-6) << kind.name << ": " << r.worst_lag;
     EXPECT_LE(r.max_settled_gap_m, 1e-6) << kind.name;
-    EXPECT_LE(r.max_frames, MultiresCurve().max_blend_frames()) << kind.name;
+    EXPECT_LE(r.max_frames, PopFreeCurve().max_blend_frames()) << kind.name;
 
     std::printf("%-12s events %zu (closed %zu, overlapped %zu) frames %zu | pop mm med %.3g p90 %.3g max %.3g | "
                 "jump mm med %.3g p90 %.3g max %.3g | lag mm med %.3g p90 %.3g max %.3g | settle s med %.3g p90 %.3g "
@@ -88,17 +88,17 @@ TEST_P(RemedyFamily, EveryFrameWithinThePopAndSettles) {
                 r.large_events, r.max_jump_over_design, r.worst_jump.c_str(), r.worst_lag.c_str());
 }
 
-// Issue 31: events closer together than one geomorph (0-3 frames apart, so nearly every event overlaps others),
+// Issue 31: events closer together than one blend (0-3 frames apart, so nearly every event overlaps others),
 // on end-dense open cables (1 - cos spacing) and on closed loops (seam removals and insertions across the seam
 // among them). Every frame within the stated per-frame bound (1 mm while the running change is under 16 cm,
 // design bound 1.5 max|D| / N otherwise: events are folded into one, so the bound is per frame, not per event),
 // within the running pops, and exactly on the fresh curve once nothing runs.
-class RemedyOverlap : public ::testing::TestWithParam<std::tuple<int, int>> {};
+class PopFreeOverlap : public ::testing::TestWithParam<std::tuple<int, int>> {};
 
-TEST_P(RemedyOverlap, FoldedEventsKeepTheFrameBound) {
+TEST_P(PopFreeOverlap, FoldedEventsKeepTheFrameBound) {
     const Kind& kind = kKinds[std::get<0>(GetParam())];
     const int shapes = std::get<1>(GetParam());  // 1 open end-dense, 2 closed
-    RemedyFamilySettings s;
+    PopFreeFamilySettings s;
     s.spline = kind.spline;
     s.cables = 12;
     s.events_per_cable = 13;
@@ -106,12 +106,12 @@ TEST_P(RemedyOverlap, FoldedEventsKeepTheFrameBound) {
     s.shapes = shapes;
     s.open_spacing = 1;
     s.seed = 3100 + static_cast<uint64_t>(std::get<0>(GetParam())) * 10 + static_cast<uint64_t>(shapes);
-    const RemedyFamilyResult r = run_remedy_family(s);
+    const PopFreeFamilyResult r = run_pop_free_family(s);
     ASSERT_TRUE(r.error.empty()) << r.error;
     std::size_t overlapped = 0, seams = 0;
     std::vector<double> pop, jump, lag, settle;
-    for (const RemedyEvent& e : r.events) {
-        overlapped += e.overlapped, seams += e.type == RemedyEvent::seam;
+    for (const PopFreeEvent& e : r.events) {
+        overlapped += e.overlapped, seams += e.type == PopFreeEvent::seam;
         pop.push_back(e.pop_m), jump.push_back(e.jump_m), lag.push_back(e.lag_m), settle.push_back(e.frames / 60.0);
     }
     EXPECT_GT(overlapped, r.events.size() / 2);
@@ -121,7 +121,7 @@ TEST_P(RemedyOverlap, FoldedEventsKeepTheFrameBound) {
     EXPECT_EQ(r.unremedied, 0u);
     EXPECT_EQ(r.state_mismatch, 0u);
     // Every frame within 1.5 max|D| / N of the running (folded) event: max_step_m (1 mm) up to 16 cm, 2 mm up to
-    // 32 cm (the longest geomorph), and 2 mm in every frame without a larger change.
+    // 32 cm (the longest blend), and 2 mm in every frame without a larger change.
     EXPECT_LE(r.max_jump_m, 2e-3) << kind.name;
     EXPECT_LE(r.max_jump_over_design, 1.0 + 1e-6) << kind.name << ": " << r.worst_jump;
     if (kind.spline.alpha != 0.0 || kind.spline.kind != SplineKind::catmull_rom) {  // uniform slides (docs)
@@ -129,7 +129,7 @@ TEST_P(RemedyOverlap, FoldedEventsKeepTheFrameBound) {
         EXPECT_LE(r.max_lag_ratio, 1.0 + 1e-6) << kind.name << ": " << r.worst_lag;
     }
     EXPECT_LE(r.max_settled_gap_m, 1e-9) << kind.name;
-    EXPECT_LE(r.max_frames, MultiresCurve().max_blend_frames()) << kind.name;
+    EXPECT_LE(r.max_frames, PopFreeCurve().max_blend_frames()) << kind.name;
     std::printf("%-12s %s events %zu (overlapped %zu, seam %zu) frames %zu | pop mm med %.3g p90 %.3g max %.3g | "
                 "jump mm med %.3g p90 %.3g max %.3g | lag mm med %.3g p90 %.3g max %.3g | settle s med %.3g p90 %.3g max %.3g | "
                 "worst jump/pop %.3f, lag/pop %.4f, jump/design %.3f, settled gap %.2g m, large %zu\n  worst jump: %s\n  worst lag: %s\n",
@@ -140,17 +140,17 @@ TEST_P(RemedyOverlap, FoldedEventsKeepTheFrameBound) {
                 r.max_lag_ratio, r.max_jump_over_design, r.max_settled_gap_m, r.large_events, r.worst_jump.c_str(), r.worst_lag.c_str());
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryKind, RemedyOverlap, ::testing::Combine(::testing::Range(0, 5), ::testing::Values(1, 2)),
+INSTANTIATE_TEST_SUITE_P(EveryKind, PopFreeOverlap, ::testing::Combine(::testing::Range(0, 5), ::testing::Values(1, 2)),
                          [](const ::testing::TestParamInfo<std::tuple<int, int>>& info) {
                              return std::string(kKinds[std::get<0>(info.param)].name) + (std::get<1>(info.param) == 1 ? "_end_dense" : "_closed");
                          });
 
 // Issue 31's seam scene: a tilted 14-node loop with out-of-plane lobes (the family's loop shape), a node
 // inserted exactly on the curve (every segment, the closing one included, appended or prepended), then node 0
-// (the seam) removed, then the inserted node removed, 0 or 2 frames apart so the three geomorphs overlap.
+// (the seam) removed, then the inserted node removed, 0 or 2 frames apart so the three blends overlap.
 // Every frame within 2 mm (1 mm below 16 cm of offset) and 1/5 of the three pops, never further from the fresh curve than their sum, and
-// exactly on it once the geomorph ends.
-TEST(RemedySeam, InsertRemoveTheSeamThenTheInsertedNode) {
+// exactly on it once the blend ends.
+TEST(PopFreeSeam, InsertRemoveTheSeamThenTheInsertedNode) {
     double worst_ratio = 0.0, worst_jump = 0.0, worst_lag_ratio = 0.0;
     std::string worst;
     int cases = 0;
@@ -173,14 +173,14 @@ TEST(RemedySeam, InsertRemoveTheSeamThenTheInsertedNode) {
             spline.closed = true;
             for (int gap : {0, 2}) {
                 for (int seg = 0; seg <= 14; ++seg) {  // 14: in the closing segment, prepended as the new node 0
-                    MultiresCurve m({.spline = spline});
+                    PopFreeCurve m({.spline = spline});
                     WireNodes nodes = loop;
                     Curve prev, cur;
-                    ASSERT_TRUE(m.update(nodes, prev).ok);
+                    ASSERT_TRUE(m.update(nodes, prev).ok());
                     double pops = 0.0, jump = 0.0, lag = 0.0;
                     auto step = [&]() {
                         const Curve before = m.target();
-                        ASSERT_TRUE(m.update(nodes, cur).ok);
+                        ASSERT_TRUE(m.update(nodes, cur).ok());
                         pops += curve_distance_m(before, m.target());
                         jump = std::max(jump, curve_distance_m(prev, cur));
                         lag = std::max(lag, curve_distance_m(cur, m.target()));
@@ -208,7 +208,7 @@ TEST(RemedySeam, InsertRemoveTheSeamThenTheInsertedNode) {
                     EXPECT_FALSE(m.blending()) << what;
                     EXPECT_EQ(curve_distance_m(cur, m.target()), 0.0) << what;
                     EXPECT_EQ(m.unremedied(), 0u) << what;
-                    EXPECT_LE(jump, 2e-3) << what;  // 1 mm up to max|D| = 16 cm, 2 mm up to 32 cm (multires.hpp)
+                    EXPECT_LE(jump, 2e-3) << what;  // 1 mm up to max|D| = 16 cm, 2 mm up to 32 cm (pop_free.hpp)
                     EXPECT_LE(jump, 0.2 * pops + 1e-12) << what;
                     EXPECT_LE(lag, pops * (1.0 + 1e-9) + 1e-12) << what;
                     if (pops > 1e-9 && jump / pops > worst_ratio) worst_ratio = jump / pops, worst = what;
@@ -223,7 +223,7 @@ TEST(RemedySeam, InsertRemoveTheSeamThenTheInsertedNode) {
                 cases, 1e3 * worst_jump, worst_ratio, worst.c_str(), worst_lag_ratio);
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryKind, RemedyFamily, ::testing::Range(0, 6),
+INSTANTIATE_TEST_SUITE_P(EveryKind, PopFreeFamily, ::testing::Range(0, 6),
                          [](const ::testing::TestParamInfo<int>& info) { return std::string(kKinds[info.param].name); });
 
 }  // namespace

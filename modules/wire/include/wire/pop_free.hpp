@@ -1,7 +1,7 @@
-// Pop-free multiresolution: a small per-wire object that turns successive node states (with stable ids) into
-// the curve to render, geomorphing the change when nodes appear or vanish.
+// The pop-free blend (of multiresolution node events): a small per-wire object that turns successive node states (with stable ids) into
+// the curve to render, blending the change when nodes appear or vanish.
 //
-// Remedy. Let P be the exact curve of the previous state and T the exact curve (build_curve) of the current
+// The pop-free blend. Let P be the exact curve of the previous state and T the exact curve (build_curve) of the current
 // one. When the ids change, P is mapped onto T's parameterisation: nodes present in both are matched exactly;
 // an open wire's two ends always correspond (so a replaced end node, an end re-created by the physics under a
 // new id, is covered); a closed loop is cut at a common node (the seam node is a node like any other). Between
@@ -35,14 +35,14 @@
 // Events overlap: the running one is folded into the new one, so the per-frame bound holds for the frame, not
 // per event: the switch frame moves as the folded event would have (<= its bound), later frames by at most
 // 1.5 max|D| / N of the folded event (<= max_step_m up to max|D| = 16 cm). Events arriving faster than one
-// geomorph restart it; the curve then settles at most max_blend_s after the last event.
+// blend restart it; the curve then settles at most max_blend_s after the last event.
 // Known limit: between junctions D pairs points by parameter; where the two curves' parameter speeds differ
 // strongly (uniform Catmull-Rom across very unequal elements) D slides along the curve, max|D| can exceed the
 // pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md). It is
 // not only uniform: on end-dense cables max|D| reaches 120x the pop for centripetal and 220x for auto, so their
 // events are lengthened for a slide that barely shows (centripetal end-dense: settles 2 s median, 4 s p90;
 // docs/issue31_popfree.md has the figures and the refinement that was tried).
-// Not remedied (the new curve is shown at once, counted in unremedied()): a node count change when
+// Not blended (the new curve is shown at once, counted in unblended()): a node count change when
 // WireNodes::ids is empty (nodes are then named by index), or a change between open and closed.
 // A duplicate id in one state is an error (Status naming the node and the id); the previous curve stays.
 // Cost per state: O(n) plus O(pieces * running events) while blending; at an event, projections of the
@@ -58,13 +58,13 @@
 
 namespace wire {
 
-struct MultiresSettings {
+struct PopFreeSettings {
     SplineSettings spline{};
-    bool geomorph = true;          ///< false: render each state's exact curve (the "no remedy" baseline)
-    double blend_s = 0.25;         ///< shortest geomorph, seconds (<= 0 or not finite: 0.25 s)
+    bool enabled = true;           ///< false: render each state's exact curve (the "no blend" baseline)
+    double blend_s = 0.25;         ///< shortest blend, seconds (<= 0 or not finite: 0.25 s)
     double frame_s = 1.0 / 60.0;   ///< time one update() stands for, seconds (<= 0 or not finite: 1/60 s)
     double max_step_m = 1e-3;      ///< per-frame jump bound that lengthens a large event (<= 0 or not finite: 1 mm)
-    double max_blend_s = 4.0;      ///< longest geomorph, seconds (<= 0 or not finite: 4 s; at least blend_s)
+    double max_blend_s = 4.0;      ///< longest blend, seconds (<= 0 or not finite: 4 s; at least blend_s)
 };
 
 /// The pop metric (same as curve_jump_m in bezier.hpp): the symmetric Hausdorff distance between the dense
@@ -74,9 +74,9 @@ struct MultiresSettings {
 /// Ok, or "node j: id X is used twice (also node i)" for the first repeated id of `nodes` (empty ids: ok).
 [[nodiscard]] Status check_unique_ids(const WireNodes& nodes);
 
-class MultiresCurve {
+class PopFreeCurve {
 public:
-    explicit MultiresCurve(const MultiresSettings& settings = {});
+    explicit PopFreeCurve(const PopFreeSettings& settings = {});
 
     /// Takes the next state (one frame, frame_s seconds after the previous one). On success `rendered` is the
     /// curve to draw this frame (its nodes: the current nodes plus the junctions of pieces still morphing;
@@ -88,17 +88,17 @@ public:
     [[nodiscard]] const Curve& target() const { return target_; }  ///< the exact curve of the last state
     [[nodiscard]] bool blending() const { return !events_.empty(); }
     [[nodiscard]] std::size_t active_blends() const { return events_.size(); }  ///< events still morphing
-    /// Length in frames of the newest event's geomorph (0 before any); the event has settled that many
+    /// Length in frames of the newest event's blend (0 before any); the event has settled that many
     /// frames after the frame that showed it.
     [[nodiscard]] int last_blend_frames() const { return last_frames_; }
-    /// The longest geomorph these settings allow, frames.
+    /// The longest blend these settings allow, frames.
     [[nodiscard]] int max_blend_frames() const { return max_frames_; }
     /// max over the wire of |D| of the newest event, metres (its frames move the curve by at most
     /// 1.5 * that / last_blend_frames()).
     [[nodiscard]] double last_max_offset_m() const { return events_.empty() ? 0.0 : events_.back().max_d; }
     /// Geomorphs started so far (an id change that moved nothing starts none).
     [[nodiscard]] std::size_t events_started() const { return started_; }
-    /// States that changed topology but were shown without a geomorph (see above), and the code of the last.
+    /// States that changed topology but were shown without a blend (see above), and the code of the last.
     [[nodiscard]] std::size_t unremedied() const { return unremedied_; }
     [[nodiscard]] int last_unremedied_reason() const { return last_reason_; }
 
@@ -117,7 +117,7 @@ private:
     void remap(const Curve& T, const std::vector<uint32_t>& tid);
     void assemble(const Curve& T, Curve& out) const;
 
-    MultiresSettings settings_;
+    PopFreeSettings settings_;
     int min_frames_ = 15, max_frames_ = 120;
     bool has_state_ = false;
     Curve target_;                      // exact curve of the last state

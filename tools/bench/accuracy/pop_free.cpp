@@ -1,10 +1,10 @@
-// `wiretool bench`: the pop-free remedy over random node-event families (wire/remedy_family.hpp), per spline
+// `wiretool bench`: the pop-free blend over random node-event families (wire/remedy_family.hpp), per spline
 // method: remedy_families.csv and remedy_families.md (distributions of the instant pop, the per-frame jump, the
 // lag and the settling time; the worst ratios and the worst case).
 #include "bench/common.hpp"
 #include "wiretool/commands.hpp"
 
-#include <wire/testing/remedy_family.hpp>
+#include <wire/testing/pop_free_family.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -20,16 +20,16 @@ double quantile(std::vector<double> v, double q) {
     return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
-struct RemedyMethod {
+struct PopFreeMethod {
     const char* name;
     wire::SplineSettings spline;
 };
 
 }  // namespace
 
-int run_remedy_bench(const Options& o) {
+int run_pop_free_bench(const Options& o) {
     using wire::SplineKind;
-    const RemedyMethod methods[] = {
+    const PopFreeMethod methods[] = {
         {"linear", {.kind = SplineKind::linear}},
         {"uniform", {.kind = SplineKind::catmull_rom, .alpha = 0.0}},
         {"centripetal", {.kind = SplineKind::catmull_rom, .alpha = 0.5}},
@@ -37,7 +37,7 @@ int run_remedy_bench(const Options& o) {
         {"c2", {.kind = SplineKind::c2}},
         {"auto", {.kind = SplineKind::automatic}},
     };
-    const wire::MultiresSettings defaults{};
+    const wire::PopFreeSettings defaults{};
     Table csv;
     csv.header = {"family", "method", "events", "closed_events", "overlapped_events", "frames",
                   "pop_median_m", "pop_p90_m", "pop_max_m", "jump_median_m", "jump_p90_m", "jump_max_m",
@@ -46,18 +46,18 @@ int run_remedy_bench(const Options& o) {
     std::string worst;
     for (std::size_t k = 0; k < std::size(methods); ++k) {
         std::fprintf(stderr, "bench: remedy family %s\n", methods[k].name);
-        wire::RemedyFamilySettings s;
+        wire::PopFreeFamilySettings s;
         s.spline = methods[k].spline;
         s.cables = o.quick ? 10 : 40;  // 130 or 520 events, half on closed loops
         s.seed = 17 + k;
-        const wire::RemedyFamilyResult r = wire::run_remedy_family(s);
+        const wire::PopFreeFamilyResult r = wire::run_pop_free_family(s);
         if (!r.error.empty()) {
             std::fprintf(stderr, "wiretool bench: remedy family %s: %s\n", methods[k].name, r.error.c_str());
             return exit_failure;
         }
         std::vector<double> pop, jump, lag, settle;
         std::size_t closed = 0, overlapped = 0;
-        for (const wire::RemedyEvent& e : r.events) {
+        for (const wire::PopFreeEvent& e : r.events) {
             pop.push_back(e.pop_m), jump.push_back(e.jump_m), lag.push_back(e.lag_m);
             settle.push_back(e.frames * defaults.frame_s);
             closed += e.closed, overlapped += e.overlapped;

@@ -1,15 +1,15 @@
-// Tests of pop-free multiresolution (modules/wire/src/multires.cpp): node insertions and removals blend in without
+// Tests of pop-free multiresolution (modules/wire/src/pop_free.cpp): node insertions and removals blend in without
 // a pop, bad states keep the previous curve, closed loops and replaced end nodes.
 #include <gtest/gtest.h>
 
 #include "curve_cases.hpp"
 #include "wire/bezier.hpp"
 #include "wire/curve.hpp"
-#include "wire/multires.hpp"
+#include "wire/pop_free.hpp"
 #include "wire/nodes.hpp"
 #include "wire/spline.hpp"
 #include "wire/status.hpp"
-#include "wire/testing/remedy_family.hpp"
+#include "wire/testing/pop_free_family.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -45,12 +45,12 @@ void expect_joined(const Curve& c, const std::string& what) {
 
 }  // namespace
 
-TEST(WireMultires, InsertingOnTheCurveAndRemovingDoNotPop) {
+TEST(PopFree, InsertingOnTheCurveAndRemovingDoNotPop) {
     const Catenary cable = hanging_cable();
     const WireNodes base = cable_nodes(cable, 16);
     const WireNodes removed = cable_with_removed_node(cable);
-    // Without remedy the centripetal curve jumps 6.1 mm (insert on curve) and 47.7 mm (remove node 8);
-    // with the geomorph the largest frame-to-frame jump is 0.04 mm and 0.30 mm.
+    // Without pop-free blend the centripetal curve jumps 6.1 mm (insert on curve) and 47.7 mm (remove node 8);
+    // with the blend the largest frame-to-frame jump is 0.04 mm and 0.30 mm.
     for (const NamedSettings& v : spline_variants()) {
         const WireNodes inserted = cable_with_inserted_node(cable, v.settings);
         const struct { const char* name; const WireNodes& from; const WireNodes& to; } events[] = {
@@ -58,36 +58,36 @@ TEST(WireMultires, InsertingOnTheCurveAndRemovingDoNotPop) {
         for (const auto& e : events) {
             const PopNumbers p = measure_pop(v.settings, e.from, e.to);
             const std::string what = v.name + ", " + e.name;
-            EXPECT_LT(p.remedy_max_m, 1e-3) << what;
+            EXPECT_LT(p.blended_max_m, 1e-3) << what;
             // Never worse than the raw jump, except for changes so small (c2: 0.02 mm) that the morph's sliding
             // along the curve dominates; those stay under 0.1 mm.
-            EXPECT_LE(p.remedy_max_m, std::max(p.no_remedy_m, 1e-4)) << what;
-            EXPECT_LT(p.final_gap_m, 1e-12) << what;  // the geomorph ends exactly on the new curve
+            EXPECT_LE(p.blended_max_m, std::max(p.unblended_m, 1e-4)) << what;
+            EXPECT_LT(p.final_gap_m, 1e-12) << what;  // the blend ends exactly on the new curve
             EXPECT_LE(p.frames, 241) << what;
-            ::testing::Test::RecordProperty(v.name + "_" + e.name + "_no_remedy_m", std::to_string(p.no_remedy_m));
-            ::testing::Test::RecordProperty(v.name + "_" + e.name + "_geomorph_m", std::to_string(p.remedy_max_m));
+            ::testing::Test::RecordProperty(v.name + "_" + e.name + "_no_remedy_m", std::to_string(p.unblended_m));
+            ::testing::Test::RecordProperty(v.name + "_" + e.name + "_geomorph_m", std::to_string(p.blended_max_m));
         }
     }
-    // The remedy must matter: for the default (centripetal) spline the raw jumps exceed 1 mm and the
-    // geomorph cuts them by more than 20x.
+    // The pop-free blend must matter: for the default (centripetal) spline the raw jumps exceed 1 mm and the
+    // blend cuts them by more than 20x.
     const SplineSettings centripetal{};
     const PopNumbers ins = measure_pop(centripetal, base, cable_with_inserted_node(cable, centripetal));
     const PopNumbers rem = measure_pop(centripetal, base, removed);
-    EXPECT_GT(ins.no_remedy_m, 1e-3);
-    EXPECT_GT(rem.no_remedy_m, 1e-3);
-    EXPECT_LT(ins.remedy_max_m * 20.0, ins.no_remedy_m);
-    EXPECT_LT(rem.remedy_max_m * 20.0, rem.no_remedy_m);
-    // And without the geomorph the object shows the raw jump.
-    MultiresCurve raw({.geomorph = false});
+    EXPECT_GT(ins.unblended_m, 1e-3);
+    EXPECT_GT(rem.unblended_m, 1e-3);
+    EXPECT_LT(ins.blended_max_m * 20.0, ins.unblended_m);
+    EXPECT_LT(rem.blended_max_m * 20.0, rem.unblended_m);
+    // And without the blend the object shows the raw jump.
+    PopFreeCurve raw({.enabled = false});
     Curve r0, r1;
     ASSERT_TRUE(raw.update(base, r0).ok());
     ASSERT_TRUE(raw.update(removed, r1).ok());
-    EXPECT_NEAR(curve_jump_m(r0, r1), rem.no_remedy_m, 1e-12);
+    EXPECT_NEAR(curve_jump_m(r0, r1), rem.unblended_m, 1e-12);
 }
 
-TEST(WireMultires, SwitchFrameShowsThePreviousCurveExactly) {
+TEST(PopFree, SwitchFrameShowsThePreviousCurveExactly) {
     const Catenary cable = hanging_cable();
-    MultiresCurve m;
+    PopFreeCurve m;
     Curve before, at_switch;
     ASSERT_TRUE(m.update(cable_nodes(cable, 16), before).ok());
     ASSERT_TRUE(m.update(cable_with_removed_node(cable), at_switch).ok());
@@ -97,7 +97,7 @@ TEST(WireMultires, SwitchFrameShowsThePreviousCurveExactly) {
     expect_joined(at_switch, "switch");
 }
 
-TEST(WireMultires, RandomInsertionsAndRemovalsNeverJumpMoreThanAMillimetre) {
+TEST(PopFree, RandomInsertionsAndRemovalsNeverJumpMoreThanAMillimetre) {
     const Catenary cable = hanging_cable();
     for (const SplineSettings& spline : {SplineSettings{}, SplineSettings{.kind = SplineKind::automatic},
                                          SplineSettings{.kind = SplineKind::c2}}) {
@@ -105,13 +105,13 @@ TEST(WireMultires, RandomInsertionsAndRemovalsNeverJumpMoreThanAMillimetre) {
         // removes interior ones at random, often while earlier morphs still run.
         std::mt19937_64 rng(99);
         WireNodes nodes = cable_nodes(cable, 32);
-        MultiresCurve m({.spline = spline});
+        PopFreeCurve m({.spline = spline});
         Curve prev, cur;
         ASSERT_TRUE(m.update(nodes, prev).ok());
         uint32_t next_id = 1000;
         double worst = 0.0;
         for (int frame = 0; frame < 400; ++frame) {
-            const int action = static_cast<int>(rng() % 6);  // often several events overlap a running geomorph
+            const int action = static_cast<int>(rng() % 6);  // often several events overlap a running blend
             if (action == 0 && nodes.size() < 40) {
                 const std::size_t k = 1 + rng() % (nodes.size() - 2);  // insert after node k on the exact curve
                 const double u = 0.2 + 0.6 * static_cast<double>(rng() % 1000) / 1000.0;
@@ -141,12 +141,12 @@ TEST(WireMultires, RandomInsertionsAndRemovalsNeverJumpMoreThanAMillimetre) {
     }
 }
 
-TEST(WireMultires, MovingWireFollowsTheNodesWhileMorphing) {
+TEST(PopFree, MovingWireFollowsTheNodesWhileMorphing) {
     // All nodes sway by up to 2 mm per frame; a node is inserted mid-sway. Every frame's jump stays within the
-    // motion itself plus the geomorph bound, and the result never lags the target once the morph ends.
+    // motion itself plus the blend bound, and the result never lags the target once the morph ends.
     const Catenary cable = hanging_cable();
     WireNodes rest = cable_nodes(cable, 16);
-    MultiresCurve m;
+    PopFreeCurve m;
     Curve prev, cur;
     double worst = 0.0;
     for (int frame = 0; frame < 300; ++frame) {
@@ -163,9 +163,9 @@ TEST(WireMultires, MovingWireFollowsTheNodesWhileMorphing) {
     EXPECT_LT(curve_jump_m(cur, m.target()), 1e-12);
 }
 
-TEST(WireMultires, BadStatesKeepThePreviousCurve) {
+TEST(PopFree, BadStatesKeepThePreviousCurve) {
     const WireNodes loop = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(0.0, 1.0, 0.0), dvec3(-1.0, 0.0, 0.5)});
-    MultiresCurve m({.spline = {.closed = true}});
+    PopFreeCurve m({.spline = {.closed = true}});
     Curve c;
     ASSERT_TRUE(m.update(loop, c).ok());
     EXPECT_TRUE(c.closed);
@@ -178,7 +178,7 @@ TEST(WireMultires, BadStatesKeepThePreviousCurve) {
     // A duplicate id is an error naming the node and the id (the caller prefixes the wire), in the first state too.
     WireNodes dup = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0)});
     dup.ids = {5, 6, 5};
-    MultiresCurve d;
+    PopFreeCurve d;
     const Status first = d.update(dup, c);
     EXPECT_FALSE(first.ok());
     EXPECT_EQ(first.message, "node 2: id 5 is used twice (also node 0)");
@@ -190,7 +190,7 @@ TEST(WireMultires, BadStatesKeepThePreviousCurve) {
     EXPECT_EQ(c.segment_count(), 2u);
     // Without ids a node count change renames the nodes: shown at once and counted.
     WireNodes plain = make_nodes({dvec3(0.0), dvec3(1.0, 0.0, 0.0), dvec3(2.0, 1.0, 0.0)});
-    MultiresCurve p;
+    PopFreeCurve p;
     ASSERT_TRUE(p.update(plain, c).ok());
     plain.positions.push_back(dvec3(3.0, 1.0, 0.0));
     ASSERT_TRUE(p.update(plain, c).ok());
@@ -201,14 +201,14 @@ TEST(WireMultires, BadStatesKeepThePreviousCurve) {
 // Issue 17's two-event case: a node inserted on the curve of the 16-node cable, then another node removed, each
 // held for at least 60 frames. Every kind ends exactly on the fresh curve within the blend time (at most
 // max_blend_frames) and never lags more than the instant pop of the event.
-TEST(WireMultires, SettlesOnTheFreshCurveWithinTheBlendTime) {
+TEST(PopFree, SettlesOnTheFreshCurveWithinTheBlendTime) {
     const Catenary cable = hanging_cable();
     for (const NamedSettings& v : spline_variants()) {
         const WireNodes base = cable_nodes(cable, 16);
         const WireNodes inserted = cable_with_inserted_node(cable, v.settings);
         WireNodes removed = inserted;
         removed.positions.erase(removed.positions.begin() + 4), removed.ids.erase(removed.ids.begin() + 4);
-        MultiresCurve m({.spline = v.settings});
+        PopFreeCurve m({.spline = v.settings});
         Curve prev, cur;
         ASSERT_TRUE(m.update(base, prev).ok());
         for (const WireNodes* state : {&inserted, static_cast<const WireNodes*>(&removed)}) {
@@ -235,8 +235,8 @@ TEST(WireMultires, SettlesOnTheFreshCurveWithinTheBlendTime) {
 }
 
 // A closed loop (a coil of 3 m radius, 12 nodes): a node inserted on its curve in the last segment (across the
-// seam), then the seam node itself removed. Both are geomorphed, not popped.
-TEST(WireMultires, ClosedLoopsAndTheSeamNodeAreRemedied) {
+// seam), then the seam node itself removed. Both are blended, not popped.
+TEST(PopFree, ClosedLoopsAndTheSeamNodeAreRemedied) {
     for (SplineKind kind : {SplineKind::catmull_rom, SplineKind::c2, SplineKind::automatic, SplineKind::linear}) {
         WireNodes loop;
         for (int i = 0; i < 12; ++i) {
@@ -244,7 +244,7 @@ TEST(WireMultires, ClosedLoopsAndTheSeamNodeAreRemedied) {
             loop.positions.emplace_back(3.0 * std::cos(th), 0.4 * std::sin(3.0 * th), 3.0 * std::sin(th));
             loop.ids.push_back(static_cast<uint32_t>(10 + i));
         }
-        MultiresCurve m({.spline = {.kind = kind, .closed = true}});
+        PopFreeCurve m({.spline = {.kind = kind, .closed = true}});
         Curve prev, cur;
         ASSERT_TRUE(m.update(loop, prev).ok());
         WireNodes inserted = loop;
@@ -280,14 +280,14 @@ TEST(WireMultires, ClosedLoopsAndTheSeamNodeAreRemedied) {
 
 // The physics re-creates an end node under a new id (1 cm from the old one): the wire's ends still correspond,
 // so the change is blended like any other.
-TEST(WireMultires, ReplacedEndNodesAreRemedied) {
+TEST(PopFree, ReplacedEndNodesAreRemedied) {
     const Catenary cable = hanging_cable();
     for (const NamedSettings& v : spline_variants()) {
         const WireNodes base = cable_nodes(cable, 16);
         WireNodes replaced = base;
         replaced.ids.back() = 4242, replaced.positions.back() += dvec3(0.0, 0.01, 0.0);
         replaced.ids.front() = 4243;
-        MultiresCurve m({.spline = v.settings});
+        PopFreeCurve m({.spline = v.settings});
         Curve prev, cur;
         ASSERT_TRUE(m.update(base, prev).ok());
         ASSERT_TRUE(m.update(replaced, cur).ok());
