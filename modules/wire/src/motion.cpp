@@ -186,4 +186,16 @@ glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal)
     return part * previous_normal;
 }
 
+FrameSettings carried_frames(FrameMethod method, const Frame* last_first, const MotionReference& built_from,
+                             const WireNodes& nodes) {
+    FrameSettings settings;
+    settings.method = method;
+    if (last_first != nullptr) {
+        // Temporal coherence: the first normal moves with the wire instead of being re-seeded from a world axis.
+        settings.has_previous_normal = true;
+        settings.previous_normal = carry_normal(fit_motion(built_from, nodes), last_first->r);
+    }
+    return settings;
+}
+
 }  // namespace wire

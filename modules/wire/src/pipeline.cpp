@@ -1,21 +1,11 @@
 // WirePipeline: the stages of one wire chained, with state carried between successive states.
 #include "wire/pipeline.hpp"
 
-
 namespace wire {
-namespace {
-
-bool same_spline(const SplineSettings& a, const SplineSettings& b) {
-    return a.kind == b.kind && a.alpha == b.alpha && a.tension == b.tension && a.bias == b.bias &&
-           a.continuity == b.continuity && a.curvature_tension == b.curvature_tension && a.closed == b.closed &&
-           a.radius_m == b.radius_m && a.merge_epsilon_rel == b.merge_epsilon_rel;
-}
-
-}  // namespace
 
 Status WirePipeline::update(const WireNodes& nodes, const PipelineSettings& settings) {
     // A change of spline settings or of the pop-free blend starts a new history: the curves are not comparable.
-    if (states_ == 0 || pop_free_ != settings.pop_free || !same_spline(pop_free_spline_, settings.spline)) {
+    if (states_ == 0 || pop_free_ != settings.pop_free || pop_free_spline_ != settings.spline) {
         PopFreeSettings m = settings.blend;
         m.spline = settings.spline;
         m.enabled = settings.pop_free;
@@ -31,12 +21,9 @@ Status WirePipeline::update(const WireNodes& nodes, const PipelineSettings& sett
     place_rings(rendered_, counts_, params_);
 
     RingSettings ring_settings;
-    ring_settings.frames.method = settings.frame_method;
-    if (states_ > 0 && !rings_.frames.empty()) {
-        // Temporal coherence: the first normal moves with the wire (motion.hpp) instead of being re-seeded.
-        ring_settings.frames.has_previous_normal = true;
-        ring_settings.frames.previous_normal = carry_normal(fit_motion(motion_, nodes), rings_.frames.front().r);
-    }
+    ring_settings.frames = carried_frames(settings.frame_method,
+                                          states_ > 0 && !rings_.frames.empty() ? &rings_.frames.front() : nullptr,
+                                          motion_, nodes);
     build_rings(rendered_, params_, ring_settings, rings_);
     motion_ = motion_reference(nodes);
     build_tube(rings_, settings.tube, mesh_);

@@ -20,6 +20,7 @@
 // a wire without ids whose node count changed) also falls back to the projection.
 #pragma once
 
+#include "wire/frames.hpp"
 #include "wire/nodes.hpp"
 
 #include <glm/gtc/quaternion.hpp>
@@ -58,5 +59,11 @@ struct MotionFit {
 /// about its axis (all of it when the fit is sure, none when it is not: the frame stage then projects the plain
 /// previous normal). Not yet orthogonal to the new first tangent: pass it as FrameSettings::previous_normal.
 [[nodiscard]] glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal);
+
+/// The frame settings of a wire's next ring build, the one place both drivers of the stages (the ECS systems and
+/// WirePipeline) take them from: `method`, and, when the wire's rings were built before, ring 0's normal of that
+/// build (`last_first`, built from the nodes `built_from`) carried by the wire's motion to `nodes`.
+[[nodiscard]] FrameSettings carried_frames(FrameMethod method, const Frame* last_first, const MotionReference& built_from,
+                                           const WireNodes& nodes);
 
 }  // namespace wire

@@ -1,5 +1,8 @@
-// One wire's whole path from nodes to tube mesh, with the state it keeps between successive states of the
-// same wire (pop-free blend, carried-over first frame). Used by wiretool and by the ECS systems' tests.
+// One wire's stages driven without the ECS, for offline use (wiretool mesh, the tests' reference): fixed or
+// tolerance tessellation instead of the screen-space LOD, and the state one wire keeps between successive states
+// (the pop-free blend, the first frame carried by the wire's motion). Every step is a wire-core function that the
+// ECS systems (modules/wire/systems) call too: PopFreeCurve::update, segment_ring_counts / the LOD, place_rings,
+// carried_frames, build_rings, build_tube; the systems add the per-frame scheduling, change tracking and caching.
 #pragma once
 
 #include "wire/curve.hpp"

@@ -40,13 +40,6 @@ void sort_unique(std::vector<Entity>& v) {
     v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
-bool same_lod(const LodSettings& a, const LodSettings& b) {
-    return a.tolerance_px == b.tolerance_px && a.max_rings_per_segment == b.max_rings_per_segment &&
-           a.max_sides == b.max_sides && a.hysteresis_band == b.hysteresis_band &&
-           a.coarse_offscreen_segments == b.coarse_offscreen_segments &&
-           a.keep_node_resolution == b.keep_node_resolution;
-}
-
 SplineSettings spline_of(const Style& style) {
     SplineSettings s = style.spline;
     s.closed = style.closed;
@@ -383,7 +376,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
 
 void lod_system(Registry& registry, WireContext& ctx) {
     const LodView view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
-    const bool view_changed = !ctx.has_view || !(view == ctx.view) || !same_lod(ctx.lod, ctx.seen_lod);
+    const bool view_changed = !ctx.has_view || !(view == ctx.view) || ctx.lod != ctx.seen_lod;
     if (view_changed) {
         ctx.view = view;
         ctx.seen_lod = ctx.lod;
@@ -507,11 +500,8 @@ void rings_system(Registry& registry, WireContext& ctx) {
         place_rings(job.curve->curve, job.lod->lod.counts, r.params);
         RingSettings settings;
         const WireNodes& nodes = job.curve->previous_nodes;  // the last valid nodes: what the curve shows
-        if (!r.rings.frames.empty()) {
-            // Temporal coherence: the first normal moves with the wire (motion.hpp) instead of being re-seeded.
-            settings.frames.has_previous_normal = true;
-            settings.frames.previous_normal = carry_normal(fit_motion(r.motion, nodes), r.rings.frames.front().r);
-        }
+        settings.frames = carried_frames(FrameMethod::double_reflection,
+                                         r.rings.frames.empty() ? nullptr : &r.rings.frames.front(), r.motion, nodes);
         thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
         // The float records are built straight into the wire's own buffer (lent to the scratch set for the build,
         // taken back in keep_rings): each wire's and the thread's buffers keep their capacity, so a frame
