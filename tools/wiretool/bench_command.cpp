@@ -54,7 +54,7 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_flag(
         "--gl", o->gl,
         "Draw every frame of `standard` with the real WireRenderer (headless EGL) on cpu-mesh, gpu-rings "
-        "streamed and gpu-rings retained: check FrameStats::bytes_uploaded against the computed bytes and "
+        "streamed and gpu-rings retained: check DrawStats::bytes_uploaded against the computed bytes and "
         "report draw() ms, GPU ms (GL_TIME_ELAPSED timer queries) and draw + finish ms per path in bench.md");
     cmd->add_flag("--no-systems", o->skip_systems, "Skip bench.csv/md (the ECS scenes)");
     cmd->add_option("--spline", o->spline,

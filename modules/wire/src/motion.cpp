@@ -12,42 +12,61 @@ namespace {
 
 using glm::dvec3;
 
-// Eigen-decomposition of a symmetric 4x4 matrix by cyclic Jacobi rotations (converges quadratically; a handful of
-// sweeps reach double precision). On return a's diagonal holds the eigenvalues and v's columns the eigenvectors.
-void jacobi4(double a[4][4], double v[4][4]) {
+// det of the 3x3 minor of m without row r and column c.
+double minor3(const double m[4][4], int r, int c) {
+    int rows[3], cols[3];
+    for (int i = 0, k = 0; i < 4; ++i)
+        if (i != r) rows[k++] = i;
+    for (int j = 0, k = 0; j < 4; ++j)
+        if (j != c) cols[k++] = j;
+    const auto e = [&](int i, int j) { return m[rows[i]][cols[j]]; };
+    return e(0, 0) * (e(1, 1) * e(2, 2) - e(1, 2) * e(2, 1)) - e(0, 1) * (e(1, 0) * e(2, 2) - e(1, 2) * e(2, 0)) +
+           e(0, 2) * (e(1, 0) * e(2, 1) - e(1, 1) * e(2, 0));
+}
+
+// The top eigenpair of Horn's symmetric, traceless 4x4 matrix N (the quaternion characteristic polynomial method,
+// Theobald 2005): the largest root of det(N - x I) = x^4 + c2 x^2 + c1 x + c0 by Newton from an upper bound (it
+// descends monotonically onto it), then the eigenvector as the largest column of the adjugate of N - x I (rank 3).
+// A few hundred operations where Jacobi sweeps take thousands. Returns false when no column stands out.
+bool top_eigenvector(const double N[4][4], double upper, double q[4]) {
+    double N2[4][4] = {};
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) v[i][j] = i == j ? 1.0 : 0.0;
-    for (int sweep = 0; sweep < 32; ++sweep) {
-        double off = 0.0, diag = 0.0;
-        for (int i = 0; i < 4; ++i) {
-            diag += a[i][i] * a[i][i];
-            for (int j = i + 1; j < 4; ++j) off += a[i][j] * a[i][j];
-        }
-        if (!(off > 1e-34 * diag)) break;  // also stops on NaN
-        for (int p = 0; p < 4; ++p) {
-            for (int q = p + 1; q < 4; ++q) {
-                if (a[p][q] == 0.0) continue;
-                const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                const double t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
-                const double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
-                for (int k = 0; k < 4; ++k) {  // a = J^T a J
-                    const double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 4; ++k) {
-                    const double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for (int k = 0; k < 4; ++k) {
-                    const double vkp = v[k][p], vkq = v[k][q];
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
-                }
-            }
-        }
+        for (int j = 0; j < 4; ++j)
+            for (int k = 0; k < 4; ++k) N2[i][j] += N[i][k] * N[k][j];
+    double tr2 = 0.0, tr3 = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        tr2 += N2[i][i];
+        for (int k = 0; k < 4; ++k) tr3 += N2[i][k] * N[k][i];
     }
+    double det = 0.0;
+    for (int c = 0; c < 4; ++c) det += ((c & 1) ? -1.0 : 1.0) * N[0][c] * minor3(N, 0, c);
+    const double c2 = -0.5 * tr2, c1 = -tr3 / 3.0, c0 = det;
+    double x = upper;
+    for (int it = 0; it < 60; ++it) {
+        const double x2 = x * x;
+        const double p = (x2 + c2) * x2 + c1 * x + c0, dp = 4.0 * x2 * x + 2.0 * c2 * x + c1;
+        if (!(dp != 0.0)) break;
+        const double step = p / dp;
+        x -= step;
+        if (!(std::abs(step) > 1e-15 * std::abs(x))) break;
+    }
+    double A[4][4];
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) A[i][j] = N[i][j] - (i == j ? x : 0.0);
+    // Column j of adj(A): (-1)^(i+j) det(minor(A, j, i)), i = 0..3; adj(A) = k q q^T, so the column through the
+    // largest diagonal entry is the largest and most accurate one.
+    int j = 0;
+    double diag = -1.0;
+    for (int k = 0; k < 4; ++k) {
+        const double d = std::abs(minor3(A, k, k));
+        if (d > diag) diag = d, j = k;
+    }
+    double best = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        q[i] = (((i + j) & 1) ? -1.0 : 1.0) * minor3(A, j, i);
+        best += q[i] * q[i];
+    }
+    return best > 0.0 && std::isfinite(best);
 }
 
 // Where `id` sits in `to` (or -1): the same index first (ids rarely move far), then outward from it.
@@ -70,6 +89,31 @@ double smoothstep(double e0, double e1, double x) {
 
 }  // namespace
 
+namespace {
+
+// 2 e2 / e1^2 of the weighted covariance of `p` (e1 = s1 + s2 + s3, e2 = s1 s2 + s1 s3 + s2 s3, its eigenvalues): 0
+// for collinear points, and 2 (s2 + s3) / (s1 + s2 + s3) to first order in (s2 + s3) / s1, which is Horn's
+// eigenvalue gap over its top eigenvalue for a rigid motion of these points. No root, no trigonometry.
+double determinacy(const dvec3* p, const double* w, uint32_t m) {
+    double wsum = 0.0;
+    dvec3 c(0.0);
+    for (uint32_t k = 0; k < m; ++k) wsum += w[k], c += w[k] * p[k];
+    if (!(wsum > 0.0)) return 0.0;
+    c /= wsum;
+    double xx = 0.0, yy = 0.0, zz = 0.0, xy = 0.0, xz = 0.0, yz = 0.0;
+    for (uint32_t k = 0; k < m; ++k) {
+        const dvec3 d = p[k] - c;
+        xx += w[k] * d.x * d.x, yy += w[k] * d.y * d.y, zz += w[k] * d.z * d.z;
+        xy += w[k] * d.x * d.y, xz += w[k] * d.x * d.z, yz += w[k] * d.y * d.z;
+    }
+    const double e1 = xx + yy + zz;
+    const double e2 = xx * yy - xy * xy + xx * zz - xz * xz + yy * zz - yz * yz;
+    if (!(e1 > 0.0) || !std::isfinite(e1)) return 0.0;
+    return std::max(0.0, 2.0 * e2 / (e1 * e1));
+}
+
+}  // namespace
+
 MotionReference motion_reference(const WireNodes& nodes) {
     MotionReference ref;
     const std::size_t n = nodes.size();
@@ -78,6 +122,7 @@ MotionReference motion_reference(const WireNodes& nodes) {
     if (n == 0) return ref;
     // Nodes 0, 1, 2, 3, then each step 1.5x the last, and always the last node: the start dense, the whole wire
     // spanned (a far node pins the rotation about a straight start).
+    double arc[MotionReference::kCapacity];
     std::size_t i = 0, step = 1, at = 0;  // `at`: the node whose polyline length `s` is
     double s = 0.0;
     while (ref.count < MotionReference::kCapacity) {
@@ -85,18 +130,35 @@ MotionReference motion_reference(const WireNodes& nodes) {
         const uint32_t k = ref.count++;
         ref.position[k] = nodes.positions[i];
         ref.id[k] = ref.by_index ? static_cast<uint32_t>(i) : nodes.ids[i];
-        ref.arc[k] = static_cast<float>(s);
+        arc[k] = s;
         if (i + 1 >= n) break;
         if (i >= 3) step = std::max<std::size_t>(step + 1, (step * 3) / 2);
         i = ref.count + 1 == MotionReference::kCapacity ? n - 1 : std::min(n - 1, i + step);
     }
+    // The reach: from two elements, quadrupled until the nodes within it fix a rotation (or it spans the wire).
+    const uint32_t m = ref.count;
+    const double whole = arc[m - 1];
+    double reach = std::max(arc[std::min<uint32_t>(2, m - 1)], 1e-300);
+    double w[MotionReference::kCapacity];
+    double fixed = 0.0;
+    for (;;) {
+        for (uint32_t k = 0; k < m; ++k) {  // (1 + s / 4l)^-4: falls like exp(-s / l) near the start, no exp
+            const double r = 1.0 / (1.0 + arc[k] / (4.0 * reach));
+            w[k] = (r * r) * (r * r);
+        }
+        fixed = determinacy(ref.position.data(), w, m);
+        if (fixed >= 1e-3 || !(reach < whole)) break;
+        reach *= 4.0;
+    }
+    for (uint32_t k = 0; k < m; ++k) ref.weight[k] = static_cast<float>(w[k]);
+    ref.determinacy = static_cast<float>(fixed);
     return ref;
 }
 
 namespace {
 
 // One weighted fit of matched pairs (a old, b new) with weights w; confidence from the eigenvalue gap.
-MotionFit fit_pairs(const dvec3* a, const dvec3* b, const double* w, uint32_t m) {
+MotionFit fit_pairs(const dvec3* a, const dvec3* b, const double* w, uint32_t m, double fixed) {
     MotionFit fit;
     fit.matched = m;
     double wsum = 0.0;
@@ -122,23 +184,17 @@ MotionFit fit_pairs(const dvec3* a, const dvec3* b, const double* w, uint32_t m)
                       {syz - szy, sxx - syy - szz, sxy + syx, szx + sxz},
                       {szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy},
                       {sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz}};
-    double V[4][4];
-    jacobi4(N, V);
-    int top = 0;
-    for (int i = 1; i < 4; ++i)
-        if (N[i][i] > N[top][top]) top = i;
-    double second = -HUGE_VAL;
-    for (int i = 0; i < 4; ++i)
-        if (i != top) second = std::max(second, N[i][i]);
-    glm::dquat q(V[0][top], V[1][top], V[2][top], V[3][top]);
+    double v[4] = {};
+    if (!top_eigenvector(N, spread, v)) return fit;
+    glm::dquat q(v[0], v[1], v[2], v[3]);
     const double len = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
     if (!(len > 0.0) || !std::isfinite(len)) return fit;
     q = q * (1.0 / len);
     if (q.w < 0.0) q = -q;  // the shorter way round
     fit.rotation = q;
-    // For a rigid motion the top eigenvalue is the spread; the gap to the next one is what fixes the rotation
-    // about the line through the nodes (see the header for the two thresholds).
-    fit.confidence = smoothstep(1e-4, 1e-3, (N[top][top] - second) / spread);
+    // For a rigid motion the top eigenvalue is the spread and the gap to the next one, over it, is the reference's
+    // determinacy: what fixes the rotation about the line through the nodes (see the header for the thresholds).
+    fit.confidence = smoothstep(1e-4, 1e-3, fixed);
     return fit;
 }
 
@@ -150,27 +206,25 @@ MotionFit fit_motion(const MotionReference& from, const WireNodes& to) {
     const bool by_index = to.ids.size() != to.size();
     if (by_index != from.by_index || (by_index && to.size() != from.node_count)) return fit;
     dvec3 a[MotionReference::kCapacity], b[MotionReference::kCapacity];
-    double arc[MotionReference::kCapacity], w[MotionReference::kCapacity];
+    double w[MotionReference::kCapacity];
     uint32_t m = 0;
+    bool moved = false;
     for (uint32_t k = 0; k < from.count; ++k) {
         const long j = by_index ? static_cast<long>(from.id[k]) : find_id(to, from.id[k], k);
         if (j < 0) continue;
         a[m] = from.position[k];
         b[m] = to.positions[static_cast<std::size_t>(j)];
-        arc[m] = from.arc[k];
+        w[m] = from.weight[k];
+        moved = moved || b[m] != a[m];
         ++m;
     }
     fit.matched = m;
     if (m < 3) return fit;
-    // The reach: from two elements, doubled until the nodes within it fix the rotation (or it spans the wire).
-    const double whole = arc[m - 1];
-    double reach = std::max(arc[std::min<uint32_t>(2, m - 1)], 1e-300);
-    for (;;) {
-        for (uint32_t k = 0; k < m; ++k) w[k] = std::exp(-arc[k] / reach);
-        fit = fit_pairs(a, b, w, m);
-        if (fit.confidence >= 1.0 || !(reach < whole)) return fit;
-        reach *= 2.0;
+    if (!moved) {  // the nodes did not move (a static wire seen anew): no rotation, none to solve for
+        fit.confidence = 1.0;
+        return fit;
     }
+    return fit_pairs(a, b, w, m, from.determinacy);
 }
 
 glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal) {

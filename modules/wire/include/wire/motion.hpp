@@ -7,9 +7,10 @@
 // the texture slides around a swinging cable (2-3 degrees a frame) and a pose that returns shows another angle.
 // The rotation that carries the nodes onto their new positions (weighted least squares, Horn 1987: the top
 // eigenvector of a symmetric 4x4 matrix) is exact for a rigid motion whatever the path, and for a non-rigid one it
-// is the mean rotation of the wire near its start: the weights exp(-s / l) fall with the distance s along the wire
-// from node 0, and the reach l starts at two elements and doubles until the nodes within it fix the rotation (a
-// straight start borrows the bend further along), so the first frame follows the wire where it sits.
+// is the mean rotation of the wire near its start: the weights fall with the distance s along the wire
+// from node 0 (as (1 + s / 4l)^-4, which falls like it without an exp), and the reach l starts at two elements and grows 4x until the nodes within it fix the rotation (a
+// straight start borrows the bend further along), so the first frame follows the wire where it sits. The reach is
+// chosen once, from the shape the rings were built on (motion_reference), so a fit is one 4x4 eigenproblem.
 //
 // Where that reason stops holding: the nodes of a wire determine its rotation about the line through them only
 // through their spread off that line. When the fit cannot tell rotations about that line apart (the gap between
@@ -37,7 +38,10 @@ struct MotionReference {
     static constexpr uint32_t kCapacity = 10;  // 64 nodes: 0, 1, 2, 3, 5, 8, 12, 18, 27 and 63
     std::array<glm::dvec3, kCapacity> position{};  ///< world metres
     std::array<uint32_t, kCapacity> id{};           ///< node ids (the node index when the wire has no ids)
-    std::array<float, kCapacity> arc{};             ///< polyline length from node 0 (metres)
+    std::array<float, kCapacity> weight{};          ///< (1 + s / (4 reach))^-4, s the polyline length from node 0
+    /// How well these nodes fix a rotation: 2 e2 / e1^2 of their weighted covariance (e1, e2 its first two invariants;
+    /// to first order Horn's eigenvalue gap over the top eigenvalue for a rigid motion; 0 for collinear nodes).
+    float determinacy = 0.0f;
     uint32_t count = 0;                             ///< 0: no reference (nothing to carry from)
     uint32_t node_count = 0;                        ///< nodes in the state (matching by index needs the same count)
     bool by_index = false;                          ///< the state had no ids: nodes are matched by index
