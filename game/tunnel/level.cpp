@@ -19,6 +19,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -38,7 +40,7 @@ LevelSettings with_defaults(const LevelSettings& settings_in) {
     if (settings.seed == 0) settings.seed = 1;
     if (settings.bend_scale == 0.0) settings.bend_scale = 1.0;
     if (settings.asset_dir.empty()) settings.asset_dir = TUNNEL_ASSET_DIR;
-    if (settings.max_subdivision_level < 0) settings.max_subdivision_level = 4;
+    if (settings.max_subdivision_level < 0) settings.max_subdivision_level = kDefaultMaxSubdivisionLevel;
     settings.max_subdivision_level =
         std::min(settings.max_subdivision_level, engine::assets::kMaxSubdivisionLevel);
     if (settings.prewarm_s == 0.0) settings.prewarm_s = 3.0;
@@ -138,8 +140,26 @@ void Level::install_systems() {
 }
 
 void Level::set_viewport(int width_px, int height_px) {
-    state_->width_px = std::max(1, width_px);
-    state_->height_px = std::max(1, height_px);
+    State& s = *state_;
+    s.width_px = std::max(1, width_px);
+    s.height_px = std::max(1, height_px);
+    // The predicted error of a piece on screen grows with the focal length in pixels (the viewport's height), and
+    // each subdivision level divides it by about 4 (Catmull-Clark: the error falls as h^2): the cache holds
+    // ceil(log4(height / 720)) levels more than at 720 p (4, where the default run stays within 0.5 px), so the
+    // tolerance holds at any screen size (1080 p and 2160 p: 5). The per-frame clamp follows unless it was lowered.
+    const double ratio = static_cast<double>(s.height_px) / 720.0;
+    const int extra = ratio > 1.0 ? static_cast<int>(std::ceil(std::log(ratio) / std::log(4.0) - 1e-12)) : 0;
+    const int need = std::min(engine::assets::kMaxSubdivisionLevel, kDefaultMaxSubdivisionLevel + extra);
+    const int cached = s.settings.max_subdivision_level;
+    if (need <= cached) return;
+    for (Group& g : s.groups)
+        if (auto st = extend_group(g, need, s.pieces); !st.ok()) {
+            std::fprintf(stderr, "tunnel: cannot refine the pieces to level %d for %dx%d: %s\n", need, s.width_px,
+                         s.height_px, st.message.c_str());
+            return;  // the level keeps its cache; piece_max_error_px reports what that costs
+        }
+    s.settings.max_subdivision_level = need;
+    if (options_.max_subdivision_level >= cached) options_.max_subdivision_level = need;
 }
 
 void Level::apply_options() {

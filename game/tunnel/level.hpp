@@ -51,7 +51,7 @@ struct LevelSettings {
     std::string asset_dir{};         ///< folder of straight_section.glb, wall_details.glb, cable_hooks.glb,
                                      ///< anchors.json; empty -> assets/tunnel, relative to the working directory
                                      ///< (the tunnel program passes the folder it found beside itself)
-    int max_subdivision_level = -1;  ///< highest refinement level cached; -1 -> 4
+    int max_subdivision_level = -1;  ///< highest refinement level cached; -1 -> 4, and more as set_viewport needs
     double prewarm_s = 0.0;          ///< rope simulation before frame 0 (settles the cables); 0 -> 3 s
 };
 

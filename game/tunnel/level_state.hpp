@@ -30,6 +30,9 @@ namespace tunnel {
 
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kWallRadius = 2.5;
+// Subdivision levels cached at 720 p (LevelSettings::max_subdivision_level -1); set_viewport adds what a larger
+// viewport needs.
+inline constexpr int kDefaultMaxSubdivisionLevel = 4;
 
 // Wire materials (indices into the WireRenderer's table; 0 is its copper weave).
 enum WireMaterial : uint32_t { copper = 0, rubber, orange, yellow, blue, red };

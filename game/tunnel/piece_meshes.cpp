@@ -71,19 +71,30 @@ engine::Status load_piece_meshes(const std::string& asset_dir, std::vector<Group
     return {};
 }
 
+namespace {
+
+// Level `lvl` of every control mesh of `g`, combined, uploaded and appended to g.meshes / g.vertices.
+engine::Status refine_level(Group& g, int lvl, PieceRenderer& pieces, engine::assets::MeshData& combined) {
+    combined = {};
+    combined.name = g.name;
+    for (const engine::assets::ControlMesh& c : g.controls) {
+        engine::assets::MeshData refined;
+        if (auto st = engine::assets::subdivide(c, lvl, refined); !st.ok()) return st;
+        append(combined, refined);
+    }
+    auto handle = pieces.add_mesh(combined, g.name + " level " + std::to_string(lvl));
+    if (!handle) return engine::Status::error(handle.error().message);
+    g.meshes.push_back(handle.value());
+    g.vertices.push_back(combined.vertex_count());
+    return {};
+}
+
+}  // namespace
+
 engine::Status refine_group(Group& g, int max_level, PieceRenderer& pieces) {
     for (int lvl = 0; lvl <= max_level; ++lvl) {
         engine::assets::MeshData combined;
-        combined.name = g.name;
-        for (const engine::assets::ControlMesh& c : g.controls) {
-            engine::assets::MeshData refined;
-            if (auto st = engine::assets::subdivide(c, lvl, refined); !st.ok()) return st;
-            append(combined, refined);
-        }
-        auto handle = pieces.add_mesh(combined, g.name + " level " + std::to_string(lvl));
-        if (!handle) return engine::Status::error(handle.error().message);
-        g.meshes.push_back(handle.value());
-        g.vertices.push_back(combined.vertex_count());
+        if (auto st = refine_level(g, lvl, pieces, combined); !st.ok()) return st;
         if (lvl == max_level) {
             g.inner_radius_m = 1e30;
             for (std::size_t v = 0; v < combined.vertex_count(); ++v)
@@ -91,6 +102,14 @@ engine::Status refine_group(Group& g, int max_level, PieceRenderer& pieces) {
                     g.inner_radius_m, std::hypot(combined.positions[3 * v], combined.positions[3 * v + 1]));
             g.top = std::move(combined);
         }
+    }
+    return {};
+}
+
+engine::Status extend_group(Group& g, int max_level, PieceRenderer& pieces) {
+    for (int lvl = static_cast<int>(g.meshes.size()); lvl <= max_level; ++lvl) {
+        engine::assets::MeshData combined;
+        if (auto st = refine_level(g, lvl, pieces, combined); !st.ok()) return st;
     }
     return {};
 }

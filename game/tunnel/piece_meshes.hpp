@@ -45,6 +45,10 @@ engine::Status load_piece_meshes(const std::string& asset_dir, std::vector<Group
 /// Refines every control mesh of `g` at levels 0..max_level, uploads each level's combined mesh to `pieces`,
 /// and keeps the vertex counts, the highest level (top) and its smallest distance from the axis.
 engine::Status refine_group(Group& g, int max_level, PieceRenderer& pieces);
+/// More levels for a refined group, up to `max_level` (a larger viewport needs them): uploaded like refine_group's,
+/// but the group's measurements (inner radius, the top mesh the contact shapes come from) stay those of its first
+/// refinement, so the ropes touch the same tunnel at every screen size.
+engine::Status extend_group(Group& g, int max_level, PieceRenderer& pieces);
 
 /// What the ropes collide with, measured on the refined wall, ribs and walkway (within a fraction of a
 /// millimetre of the limit surfaces at level 4; the wall's and ribs' refined polygons lie inside their limit
