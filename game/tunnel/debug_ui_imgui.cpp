@@ -3,6 +3,8 @@
 // glfwGetCurrentContext() finds it; ImGui's GLFW backend chains the engine's input callbacks.
 #include "tunnel/debug_ui.hpp"
 
+#include <engine/assets/subdivide.hpp>
+
 #include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
@@ -69,7 +71,7 @@ public:
         if (ImGui::SliderFloat("subdiv tolerance px", &subdiv, 0.25f, 16.0f, "%.2f",
                                ImGuiSliderFlags_Logarithmic))
             o.subdivision_tolerance_px = subdiv;
-        ImGui::SliderInt("max subdiv level", &o.max_subdivision_level, 0, 4);
+        ImGui::SliderInt("max subdiv level", &o.max_subdivision_level, 0, engine::assets::kMaxSubdivisionLevel);
         ImGui::Checkbox("pieces", &o.draw_pieces);
         ImGui::SameLine();
         ImGui::Checkbox("wires", &o.draw_wires);
