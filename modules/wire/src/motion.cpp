@@ -157,10 +157,15 @@ MotionReference motion_reference(const WireNodes& nodes) {
 
 namespace {
 
-// One weighted fit of matched pairs (a old, b new) with weights w; confidence from the eigenvalue gap.
+// One weighted fit of matched pairs (a old, b new) with weights w; confidence 0 where it cannot be had.
 MotionFit fit_pairs(const dvec3* a, const dvec3* b, const double* w, uint32_t m, double fixed) {
     MotionFit fit;
     fit.matched = m;
+    // For a rigid motion the top eigenvalue is the spread and the gap to the next one, over it, is the reference's
+    // determinacy: what fixes the rotation about the line through the nodes (see the header for the thresholds).
+    // Nodes that do not fix it get the projection: nothing to solve.
+    const double confidence = smoothstep(1e-4, 1e-3, fixed);
+    if (!(confidence > 0.0)) return fit;
     double wsum = 0.0;
     dvec3 ca(0.0), cb(0.0);
     for (uint32_t k = 0; k < m; ++k) wsum += w[k], ca += w[k] * a[k], cb += w[k] * b[k];
@@ -192,9 +197,7 @@ MotionFit fit_pairs(const dvec3* a, const dvec3* b, const double* w, uint32_t m,
     q = q * (1.0 / len);
     if (q.w < 0.0) q = -q;  // the shorter way round
     fit.rotation = q;
-    // For a rigid motion the top eigenvalue is the spread and the gap to the next one, over it, is the reference's
-    // determinacy: what fixes the rotation about the line through the nodes (see the header for the thresholds).
-    fit.confidence = smoothstep(1e-4, 1e-3, fixed);
+    fit.confidence = confidence;
     return fit;
 }
 
