@@ -271,13 +271,12 @@ public:
         if (!(near_m > 0.0 && far_m > near_m && std::isfinite(far_m)))
             value_error("camera: expected 0 < near < far (finite)");
         engine::scene::Camera& c = ctx_.camera;
-        c.position = glm::vec3(e);
-        c.target = glm::vec3(t);
-        c.up = glm::vec3(u);
+        c.position = e;
+        c.target = t;
+        c.up = u;
         c.fov_y_rad = static_cast<float>(fov_deg * std::numbers::pi / 180.0);
         c.near_m = static_cast<float>(near_m);
         c.far_m = static_cast<float>(far_m);
-        eye_m_ = e;
     }
 
     /// Runs the wire systems once (curve, lod, rings, mesh, draw list). New wire errors raise WireError after
@@ -306,7 +305,6 @@ public:
         const auto t0 = std::chrono::steady_clock::now();
         wire::render::DrawSettings settings;
         settings.light = light_;
-        settings.eye_m = eye_m_;
         drawn_ = renderer_.draw(ctx_.draw_list, ctx_.camera, settings);
         render_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         engine::platform::Image image = engine::platform::read_pixels(*gl_);
@@ -321,12 +319,12 @@ public:
     py::array_t<double> project(const DoubleArray& points) const {
         std::vector<glm::dvec3> p;
         read_positions(points, "points", p);
-        const glm::mat4 clip_from_world = ctx_.camera.view_projection();
+        const glm::dmat4 clip_from_rel(ctx_.camera.clip_from_relative());  // offsets from the eye: any distance
         py::array_t<double> out({static_cast<py::ssize_t>(p.size()), py::ssize_t{3}});
         double* o = out.mutable_data();
         for (std::size_t i = 0; i < p.size(); ++i) {
-            const glm::vec4 c = clip_from_world * glm::vec4(glm::vec3(p[i]), 1.0f);
-            const bool front = c.w > 0.0f;
+            const glm::dvec4 c = clip_from_rel * glm::dvec4(p[i] - ctx_.camera.position, 1.0);
+            const bool front = c.w > 0.0;
             const double nan = std::numeric_limits<double>::quiet_NaN();
             o[3 * i] = front ? (c.x / c.w * 0.5 + 0.5) * ctx_.viewport_width_px : nan;
             o[3 * i + 1] = front ? (0.5 - c.y / c.w * 0.5) * ctx_.viewport_height_px : nan;
@@ -419,7 +417,6 @@ private:
     std::vector<wire::systems::ErrorReport> errors_;
     wire::RingSet ring_set_;
     wire::render::Light light_{.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
-    std::optional<glm::dvec3> eye_m_;
     wire::render::DrawStats drawn_{};
     double render_ms_ = 0.0;
 };

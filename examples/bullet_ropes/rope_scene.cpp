@@ -225,7 +225,7 @@ void RopeView::draw(const RopeScene& scene, const wire::DrawList& list, const en
     (void)scene;
     engine::gfx::clear(glm::vec4(kBackground, 1.0f));
     const engine::gfx::DirectionalLight light{.to_light = {0.4f, 1.0f, 0.6f}, .ambient = 0.35f};
-    lit_.begin(camera.view_projection(), light);
+    lit_.begin(camera.view_projection(), light);  // floor and box sit near the origin
     lit_.draw(floor_, glm::mat4(1.0f), kFloorAlbedo);
     lit_.draw(box_, box_model_, kBoxAlbedo);
     wires_->draw(list, camera, {.light = {.to_light = {0.4f, 1.0f, 0.6f}, .ambient = 0.35f}});

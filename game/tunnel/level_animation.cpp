@@ -69,9 +69,9 @@ void Level::animate(double dt_s) {
         const glm::dvec3 look =
             glm::mix(glm::dvec3(0.0, 0.05, z + 7.0), glm::dvec3(2.2, -0.45, z + 2.0), 0.8 * u);
         const curved_space::BentVertex eye = chain_.transform(eye_unbent, {0.0, 1.0, 0.0});
-        camera_.position = glm::vec3(eye.position);
-        camera_.target = glm::vec3(chain_.transform_point(look));
-        camera_.up = glm::vec3(eye.normal);
+        camera_.position = eye.position;
+        camera_.target = chain_.transform_point(look);
+        camera_.up = eye.normal;
     }
     s.context.camera = camera_;
     s.context.viewport_width_px = s.width_px;

@@ -47,10 +47,9 @@ void Level::draw_pieces() {
     choose_piece_levels();
     if (!options_.draw_pieces) return;
 
-    const glm::dvec3 eye(camera_.position);
+    const glm::dvec3 eye = camera_.position;
     const std::vector<curved_space::GpuSegment> records = curved_space::gpu_segments(chain_, eye);
-    const glm::mat4 view_rel = glm::lookAt(glm::vec3(0.0f), camera_.target - camera_.position, camera_.up);
-    PieceFrame frame{.clip_from_rel = camera_.projection() * view_rel,
+    PieceFrame frame{.clip_from_rel = camera_.clip_from_relative(),
                      .segments = records,
                      .to_light = glm::normalize(glm::vec3(0.3f, 1.0f, 0.4f)),
                      .wireframe = options_.wireframe};

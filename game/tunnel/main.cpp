@@ -83,13 +83,13 @@ std::string frame_png(const std::string& dir, uint64_t frame) {
 
 // Mouse-look and WASD camera (right mouse button held to look; Q/E down/up; shift: faster).
 struct FreeCamera {
-    glm::vec3 position{0.0f};
+    glm::dvec3 position{0.0};  // double, as engine::scene::Camera: 1 mm steps hold far from the origin
     float yaw = 0.0f;
     float pitch = 0.0f;
 
     void take(const engine::scene::Camera& c) {
         position = c.position;
-        const glm::vec3 f = glm::normalize(c.target - c.position);
+        const glm::vec3 f(glm::normalize(c.target - c.position));
         pitch = std::asin(glm::clamp(f.y, -1.0f, 1.0f));
         yaw = std::atan2(f.x, -f.z);
     }
@@ -102,18 +102,18 @@ struct FreeCamera {
         const glm::vec3 f(std::cos(pitch) * std::sin(yaw), std::sin(pitch), -std::cos(pitch) * std::cos(yaw));
         const glm::vec3 r = glm::normalize(glm::cross(f, glm::vec3(0, 1, 0)));
         if (keys_free) {
-            const float speed = (in.down(platform::Key::left_shift) ? 12.0f : 3.0f) * static_cast<float>(dt);
+            const double speed = (in.down(platform::Key::left_shift) ? 12.0 : 3.0) * dt;
             using K = platform::Key;
-            if (in.down(K::w) || in.down(K::up)) position += f * speed;
-            if (in.down(K::s) || in.down(K::down)) position -= f * speed;
-            if (in.down(K::d) || in.down(K::right)) position += r * speed;
-            if (in.down(K::a) || in.down(K::left)) position -= r * speed;
+            if (in.down(K::w) || in.down(K::up)) position += glm::dvec3(f) * speed;
+            if (in.down(K::s) || in.down(K::down)) position -= glm::dvec3(f) * speed;
+            if (in.down(K::d) || in.down(K::right)) position += glm::dvec3(r) * speed;
+            if (in.down(K::a) || in.down(K::left)) position -= glm::dvec3(r) * speed;
             if (in.down(K::e)) position.y += speed;
             if (in.down(K::q)) position.y -= speed;
         }
         c.position = position;
-        c.target = position + f;
-        c.up = {0.0f, 1.0f, 0.0f};
+        c.target = position + glm::dvec3(f);
+        c.up = {0.0, 1.0, 0.0};
     }
 };
 

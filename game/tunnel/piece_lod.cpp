@@ -16,12 +16,12 @@ void Level::choose_piece_levels() {
     State& s = *state_;
     stats_.piece_levels.fill(0);
     stats_.piece_max_error_px = 0.0;
-    const glm::dvec3 eye(camera_.position);
+    const glm::dvec3 eye = camera_.position;
     // Per piece: visible? and the level its bend and its distance on screen need, per group (the caches
     // hold every level up to the cap). The distance of a group: along the bent centre line to the piece, and
     // radially from the eye to the group's innermost surface (the wall's, the ribs' inner faces, ...).
     const engine::scene::Frustum frustum =
-        engine::scene::Frustum::from_view_projection(camera_.view_projection());
+        engine::scene::Frustum::from_view_projection(camera_.clip_from_relative());  // offsets from the eye
     const double focal_px = camera_.focal_px(static_cast<float>(s.height_px));
     const int max_level = std::clamp(options_.max_subdivision_level, 0, s.settings.max_subdivision_level);
     const int n = piece_count();
@@ -29,7 +29,7 @@ void Level::choose_piece_levels() {
     for (int k = 0; k < n; ++k) {
         const double z0 = kPieceLength * k;
         const curved_space::Aabb box = chain_.bounds({{-2.7, -2.7, z0}, {2.7, 2.7, z0 + kPieceLength}});
-        if (!frustum.intersects_aabb(glm::vec3(box.min), glm::vec3(box.max))) continue;
+        if (!frustum.intersects_aabb(glm::vec3(box.min - eye), glm::vec3(box.max - eye))) continue;
         std::array<double, kGroups> distance;
         distance.fill(1e30);
         constexpr int kSamples = 8;

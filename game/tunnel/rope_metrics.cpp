@@ -76,7 +76,7 @@ void Level::measure_ropes() {
         }
     stats_.rope_penetration_m = deepest;
     // Close-up distances: eye to the nearest rope and wall cable centre lines.
-    const glm::dvec3 eye(camera_.position);
+    const glm::dvec3 eye = camera_.position;
     stats_.camera_rope_m = 1e30;
     for (std::size_t r = 0; r < ropes_.size(); ++r)
         for (const glm::dvec3& p : samples[r])

@@ -180,7 +180,7 @@ void set_camera(FuzzedDataProvider& in, ws::WireContext& ctx) {
     } else {  // anywhere, looking anywhere (inside wires, behind them)
         ctx.camera.position = {in.ConsumeFloatingPointInRange<float>(-10.0f, 10.0f), in.ConsumeFloatingPointInRange<float>(-10.0f, 10.0f),
                                in.ConsumeFloatingPointInRange<float>(-10.0f, 10.0f)};
-        ctx.camera.target = ctx.camera.position + glm::vec3(in.ConsumeFloatingPointInRange<float>(-1.0f, 1.0f),
+        ctx.camera.target = ctx.camera.position + glm::dvec3(in.ConsumeFloatingPointInRange<float>(-1.0f, 1.0f),
                                                             in.ConsumeFloatingPointInRange<float>(-1.0f, 1.0f), -1.0f);
     }
     ctx.lod.tolerance_px = in.ConsumeBool() ? 0.0 : in.ConsumeFloatingPointInRange<double>(0.05, 20.0);

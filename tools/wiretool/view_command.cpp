@@ -369,9 +369,9 @@ int run_view(const ViewOptions& o) try {
         const double close_near_m = std::max(1e-5 * far_m, std::min(0.05, 0.01 * reach));
         const double near_m = std::max(0.5 * (distance - reach), close_near_m);
         engine::scene::Camera& cam = ctx.camera;
-        cam.position = glm::vec3(pose.eye);
-        cam.target = glm::vec3(pose.target);
-        cam.up = glm::vec3(usable_up(pose));
+        cam.position = pose.eye;  // double: scenes far from the origin keep their precision
+        cam.target = pose.target;
+        cam.up = usable_up(pose);
         cam.fov_y_rad = static_cast<float>(pose.fov_deg * std::numbers::pi / 180.0);
         cam.aspect = static_cast<float>(aspect);
         cam.near_m = static_cast<float>(near_m);

@@ -41,7 +41,7 @@ TEST(CameraTest, ProjectsLikeAPinhole) {
     const float y_px = (ndc.y * 0.5f) * height_px;
     EXPECT_NEAR(x_px, cam.focal_px(height_px) * 1.0f / 5.0f, 1e-3f);
     EXPECT_NEAR(y_px, cam.focal_px(height_px) * 0.5f / 5.0f, 1e-3f);
-    EXPECT_NEAR(glm::length(cam.forward() - glm::vec3(0, 0, -1)), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::length(cam.forward() - glm::dvec3(0, 0, -1)), 0.0, 1e-12);
 }
 
 TEST(FrustumTest, PlanesAreNormalizedAndPointInward) {

@@ -13,18 +13,18 @@ void place_camera(engine::scene::Camera& cam, SceneKind kind, int frame) {
     const float t = static_cast<float>(frame);
     if (kind == SceneKind::offscreen) {
         cam.position = {3.0f * std::sin(0.02f * t), 5.0f + std::sin(0.03f * t), 12.0f};
-        cam.target = cam.position + glm::vec3(0.4f * std::sin(0.01f * t), -0.15f, 1.0f);
+        cam.target = cam.position + glm::dvec3(0.4f * std::sin(0.01f * t), -0.15f, 1.0f);
         return;
     }
     if (kind == SceneKind::far) {
         // Flying over the landscape 45 m up, along a gentle curve, looking ahead and a little down.
         const float x = -700.0f + 2.5f * t, z = -600.0f + 1.5f * t + 40.0f * std::sin(0.01f * t);
         cam.position = {x, static_cast<float>(ground_m(x, z)) + 45.0f, z};
-        cam.target = cam.position + glm::vec3(0.8f + 0.1f * std::sin(0.02f * t), -0.12f, 0.6f);
+        cam.target = cam.position + glm::dvec3(0.8f + 0.1f * std::sin(0.02f * t), -0.12f, 0.6f);
         return;
     }
     cam.position = {3.0f * std::sin(0.02f * t), 5.0f + std::sin(0.03f * t), 8.0f - 0.15f * t};
-    cam.target = cam.position + glm::vec3(0.4f * std::sin(0.01f * t), -0.15f, -1.0f);
+    cam.target = cam.position + glm::dvec3(0.4f * std::sin(0.01f * t), -0.15f, -1.0f);
 }
 
 wire::LodView whole_wire_view(const std::vector<glm::dvec3>& positions) {

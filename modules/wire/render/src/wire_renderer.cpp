@@ -397,7 +397,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     stats.waited_for_gpu = region.waited;
 
     // Fill the region with memcpy only (write-combined memory: never read it back).
-    const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : glm::dvec3(camera.position);
+    const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
     std::byte* base = region.data;
     std::size_t geometry_cursor = 0;  // bytes into the geometry section
     std::size_t index_cursor = 0;     // indices into the index section
@@ -496,8 +496,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     const gfx::Program& program = cpu ? s.cpu_program : s.rings_program;
     program.use();
     // Camera-relative: the view is the camera's rotation only; positions arrive as offsets from the eye.
-    const glm::mat4 view_rel = glm::lookAt(glm::vec3(0.0f), camera.target - camera.position, camera.up);
-    program.set("u_clip_from_rel", camera.projection() * view_rel);
+    program.set("u_clip_from_rel", camera.clip_from_relative());
     program.set("u_to_light", glm::normalize(settings.light.to_light));
     program.set("u_light_color", settings.light.color);
     program.set("u_ambient", settings.light.ambient);

@@ -4,7 +4,7 @@
 namespace wire::systems {
 
 LodView lod_view(const engine::scene::Camera& camera, double width_px, double height_px) {
-    return LodView::perspective(glm::dvec3(camera.position), glm::dvec3(camera.target), glm::dvec3(camera.up),
+    return LodView::perspective(camera.position, camera.target, camera.up,
                                 static_cast<double>(camera.fov_y_rad), width_px, height_px,
                                 static_cast<double>(camera.near_m), static_cast<double>(camera.far_m));
 }

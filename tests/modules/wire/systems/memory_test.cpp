@@ -57,9 +57,8 @@ struct World {
     }
     // The camera at (0, 5, 8); yaw 0 looks down -z (at the field), yaw pi looks the other way.
     void look(double yaw) {
-        ctx.camera.position = {0.0f, 5.0f, 8.0f};
-        ctx.camera.target = ctx.camera.position +
-                            glm::vec3(static_cast<float>(-std::sin(yaw)), -0.15f, static_cast<float>(-std::cos(yaw)));
+        ctx.camera.position = {0.0, 5.0, 8.0};
+        ctx.camera.target = ctx.camera.position + glm::dvec3(-std::sin(yaw), -0.15, -std::cos(yaw));
     }
     void run() { schedule.run(registry, 1.0 / 60.0); }
 };

@@ -83,8 +83,9 @@ struct RendererDesc {
 struct DrawSettings {
     Light light{};           ///< the frame's directional light
     bool wireframe = false;  ///< glPolygonMode(GL_LINE) for this frame's wires
-    /// Camera position in double (world metres); unset: camera.position. Offsets origin_m - eye are computed
-    /// in double and sent as float, so wires far from the world origin keep their precision.
+    /// Overrides the eye (world metres); unset: camera.position, which is double itself (kept for callers that
+    /// predate the double camera). Offsets origin_m - eye are computed in double and sent as float, and the view
+    /// is Camera::clip_from_relative(), so wires far from the world origin keep their precision.
     std::optional<glm::dvec3> eye_m{};
 };
 
