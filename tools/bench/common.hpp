@@ -24,6 +24,8 @@ struct Options {
     bool skip_systems = false;   ///< only accuracy/stability outputs
     bool gl = false;             ///< also draw `standard` with the real WireRenderer (headless EGL)
     std::string spline = "auto";  ///< spline of the ECS scenes' wires (bench.csv's method column)
+    int width_px = 1920, height_px = 1080;  ///< --gl rows: the viewport (--size WxH)
+    int wires = 0;                          ///< --gl rows: wires per scene (--wires; 0: the scene's own count)
 };
 
 /// Process CPU time (all threads), milliseconds: robust against other load on a shared machine.
@@ -66,7 +68,8 @@ std::string num(std::size_t v);
 // (exit_ok, or exit_failure when a file could not be written).
 int run_systems_bench(const Options& o);   ///< bench.csv, bench.md
 int run_accuracy_bench(const Options& o);  ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
-int run_pop_free_bench(const Options& o);    ///< remedy_families.csv, remedy_families.md (accuracy/pop_free.cpp)
+int run_pop_free_bench(const Options& o);
+int run_gl_scale_bench(const Options& o);    ///< bench_gl.csv, bench_gl.md (systems/gl_scale.cpp)    ///< remedy_families.csv, remedy_families.md (accuracy/pop_free.cpp)
 /// The DESIGN §5 hard cases as a Markdown section (case, result, max error).
 std::string stability_report();
 

@@ -23,6 +23,9 @@ int run_bench(const bench::Options& o) {
     if (!o.skip_systems) {
         if (const int st = bench::run_systems_bench(o); st != exit_ok) return st;
     }
+    if (o.gl) {
+        if (const int st = bench::run_gl_scale_bench(o); st != exit_ok) return st;
+    }
     if (!o.skip_accuracy) {
         if (const int st = bench::run_accuracy_bench(o); st != exit_ok) return st;
         if (bench::selected(o, "remedy_families")) {
@@ -53,9 +56,21 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
     cmd->add_flag(
         "--gl", o->gl,
-        "Draw every frame of `standard` with the real WireRenderer (headless EGL) on cpu-mesh, gpu-rings "
-        "streamed and gpu-rings retained: check DrawStats::bytes_uploaded against the computed bytes and "
-        "report draw() ms, GPU ms (GL_TIME_ELAPSED timer queries) and draw + finish ms per path in bench.md");
+        "Draw with the real WireRenderer (headless EGL: llvmpipe, or a GPU's EGL device): every frame of "
+        "`standard` in the systems rows (bench.md), and `standard`, `swaying` and `far` at --size with --wires "
+        "wires on cpu-mesh, gpu-rings streamed and retained at 1, 2 and all threads, plus strips and lines off "
+        "with the one-draw baseline (bench_gl.csv, bench_gl.md): systems, draw() and GPU ms, draw commands, "
+        "bytes, memory");
+    cmd->add_option_function<std::string>(
+           "--size",
+           [o](const std::string& text) {
+               const auto size = parse_size_wxh(text);
+               if (!size) throw CLI::ValidationError("--size", "expected WxH with whole numbers in [1, 16384], got '" + text + "'");
+               o->width_px = size->first, o->height_px = size->second;
+           },
+           "--gl rows: viewport WxH in pixels (default 1920x1080)");
+    cmd->add_option("--wires", o->wires, "--gl rows: wires per scene (default: the scene's, 1,000; far 10,000)")
+        ->check(CLI::Range(1, 10000000));
     cmd->add_flag("--no-systems", o->skip_systems, "Skip bench.csv/md (the ECS scenes)");
     cmd->add_option("--spline", o->spline,
                     "Spline of the ECS scenes' wires (bench.csv's method column): "

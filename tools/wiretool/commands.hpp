@@ -4,6 +4,9 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <optional>
+#include <string>
+#include <utility>
 
 namespace wiretool {
 
@@ -13,6 +16,9 @@ enum Exit : int {
     exit_failure = 1,    ///< the tool could not finish (an output could not be written, an internal error)
     exit_bad_input = 2,  ///< the input or the command line is wrong; nothing was written
 };
+
+/// "WxH" with whole numbers in [1, 16384] (--size of view and bench); nothing when it is not that.
+std::optional<std::pair<int, int>> parse_size_wxh(const std::string& text);
 
 /// A subcommand registers its options and returns the action to run when it was chosen.
 using Action = std::function<int()>;

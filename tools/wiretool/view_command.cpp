@@ -76,12 +76,8 @@ bool parse_number(const std::string& text, double& out) {
 }
 
 std::pair<int, int> parse_size(const std::string& text) {
-    const std::size_t x = text.find('x');
-    double w = 0, h = 0;
-    if (x == std::string::npos || !parse_number(text.substr(0, x), w) || !parse_number(text.substr(x + 1), h) ||
-        w != std::floor(w) || h != std::floor(h) || w < 1 || h < 1 || w > 16384 || h > 16384)
-        throw BadInput{"--size: expected WxH with whole numbers in [1, 16384], got '" + text + "'"};
-    return {static_cast<int>(w), static_cast<int>(h)};
+    if (const auto size = parse_size_wxh(text)) return *size;
+    throw BadInput{"--size: expected WxH with whole numbers in [1, 16384], got '" + text + "'"};
 }
 
 /// The camera in effect for a frame (world metres, double).
@@ -492,6 +488,15 @@ Action add_view_command(CLI::App& app) {
                                          "plus the sides the LOD chose)");
     cmd->add_option("--stats", o->stats_out, "Write per-frame statistics (JSON) with the measured screen error");
     return [o] { return run_view(*o); };
+}
+
+std::optional<std::pair<int, int>> parse_size_wxh(const std::string& text) {
+    const std::size_t x = text.find('x');
+    double w = 0, h = 0;
+    if (x == std::string::npos || !parse_number(text.substr(0, x), w) || !parse_number(text.substr(x + 1), h) ||
+        w != std::floor(w) || h != std::floor(h) || w < 1 || h < 1 || w > 16384 || h > 16384)
+        return std::nullopt;
+    return std::pair<int, int>{static_cast<int>(w), static_cast<int>(h)};
 }
 
 }  // namespace wiretool

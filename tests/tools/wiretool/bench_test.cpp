@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -259,6 +260,59 @@ void check_pop_free_csv(const fs::path& dir) {
             EXPECT_LE(number(r, "max_jump_over_pop"), 0.2) << m;
             EXPECT_LE(number(r, "max_lag_over_pop"), 1.0 + 1e-3) << m;  // (printed to 4 digits)
         }
+    }
+}
+
+// `--gl` rows (bench_gl.csv): every selected scene on every path at 1, 2 and all threads, then strips and lines off
+// with the one-draw baseline; the bytes draw() sent equal the computed plan on every frame, the baseline is one
+// command over exactly the triangles of the tube-only rows.
+TEST(WiretoolBench, GlRowsAtScale) {
+    const fs::path dir = out_dir().string() + "_gl";
+    fs::remove_all(dir);
+    const std::string cmd = std::string(WIRETOOL_PATH) +
+                            " bench --quick --gl --no-systems --no-accuracy --scenes standard,swaying --wires 40 "
+                            "--size 320x180 --out " + dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
+    const int raw = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "see " << dir.string() << ".log";
+    ASSERT_TRUE(fs::exists(dir / "bench_gl.md"));
+    if (!fs::exists(dir / "bench_gl.csv")) GTEST_SKIP() << "no headless GL here (bench_gl.md says why)";
+    const Csv csv = read_csv(dir / "bench_gl.csv");
+    for (const char* c : {"scene", "wires", "width", "height", "threads", "path", "thin_wires", "systems_wall_ms",
+                          "draw_ms", "gpu_ms", "end_to_end_ms", "draw_commands", "draw_calls", "bytes_per_frame",
+                          "bytes_mismatch_frames", "wire_memory_bytes", "gpu_buffer_bytes", "gpu_vs_one_draw"})
+        EXPECT_NE(std::find(csv.columns.begin(), csv.columns.end(), c), csv.columns.end()) << c;
+    std::set<std::string> threads;
+    for (const auto& r : csv.rows) threads.insert(r.at("threads"));
+    EXPECT_TRUE(threads.count("1") && threads.count("2"));
+    ASSERT_EQ(csv.rows.size(), 2 * (3 * threads.size() + 4)) << "2 scenes x (3 paths x threads + 4 tube-only rows)";
+    for (const char* scene : {"standard", "swaying"}) {
+        const auto* base = find(csv.rows, {{"scene", scene}, {"path", "one-draw baseline"}});
+        ASSERT_TRUE(base) << scene;
+        EXPECT_EQ(number(*base, "draw_commands"), 1.0);
+        EXPECT_EQ(number(*base, "draw_calls"), 1.0);
+        EXPECT_GT(number(*base, "triangles"), 1000.0);
+        for (const char* p : {"cpu-mesh", "gpu-rings", "gpu-retained"}) {
+            const auto* tubes = find(csv.rows, {{"scene", scene}, {"path", p}, {"thin_wires", "off"}});
+            ASSERT_TRUE(tubes) << scene << " " << p;
+            EXPECT_EQ(number(*tubes, "triangles"), number(*base, "triangles")) << scene << " " << p;
+            EXPECT_GT(number(*tubes, "gpu_vs_one_draw"), 0.0);
+        }
+    }
+    for (const auto& r : csv.rows) {
+        EXPECT_EQ(number(r, "bytes_mismatch_frames"), 0.0) << r.at("scene") << " " << r.at("path");
+        EXPECT_EQ(number(r, "wires"), 40.0);
+        EXPECT_EQ(number(r, "width"), 320.0);
+        EXPECT_EQ(number(r, "height"), 180.0);
+        EXPECT_GT(number(r, "visible"), 0.0);
+        EXPECT_GT(number(r, "bytes_per_frame"), 0.0);
+    }
+    // A size that is not WxH is a usage error (exit 2).
+    const int bad = std::system((std::string(WIRETOOL_PATH) + " bench --gl --size 12by7 --out " + dir.string() +
+                                 "_bad > /dev/null 2>&1").c_str());
+    EXPECT_TRUE(WIFEXITED(bad) && WEXITSTATUS(bad) == 2);
+    if (!::testing::Test::HasFailure()) {
+        fs::remove_all(dir);
+        fs::remove(dir.string() + ".log");
     }
 }
 

@@ -24,12 +24,13 @@ namespace {
 
 using engine::ecs::Entity;
 
-// The context every scene is seen through: 1920x1080, 16:9, the LOD at kTolerancePx.
+// The context every scene is seen through: spec's viewport (1920x1080 by default), the LOD at kTolerancePx.
 void set_up_view(wire::systems::WireContext& ctx, const RunSpec& spec) {
     ctx.path = spec.path;
-    ctx.viewport_width_px = 1920;
-    ctx.viewport_height_px = 1080;
-    ctx.camera.aspect = 16.0f / 9.0f;
+    ctx.viewport_width_px = spec.width_px;
+    ctx.viewport_height_px = spec.height_px;
+    ctx.camera.aspect = static_cast<float>(spec.width_px) / static_cast<float>(spec.height_px);
+    if (!spec.thin_wires) ctx.lod.strip_radius_px = ctx.lod.line_radius_px = -1.0;
     ctx.camera.far_m = spec.kind == SceneKind::far ? 3000.0f : 500.0f;
     ctx.lod.tolerance_px = kTolerancePx;
 }

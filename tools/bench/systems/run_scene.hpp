@@ -61,6 +61,8 @@ struct RunSpec {
     std::function<void(const wire::systems::WireContext&, int frame)> after_frame;
     wire::SplineSettings spline{.kind =
                                     wire::SplineKind::automatic};  ///< the wires' Style::spline (--spline)
+    int width_px = 1920, height_px = 1080;  ///< the viewport the LOD sees (the aspect follows)
+    bool thin_wires = true;  ///< false: no camera-facing strips or phone-wire lines (every wire a tube)
 };
 
 /// Runs the scene for spec.frames frames under a tbb::global_control of spec.threads.
