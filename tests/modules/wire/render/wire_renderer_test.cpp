@@ -15,6 +15,8 @@
 #include <numeric>
 #include <array>
 #include <random>
+#include <set>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -364,7 +366,7 @@ TEST(WireRendererTest, CpuMeshRendersLitTexturedWires) {
     save(image, "wire_render_cpu_mesh.png");
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
     EXPECT_EQ(stats.draw_items, scene.pipelines.size());
-    EXPECT_EQ(stats.indirect_commands, scene.pipelines.size());
+    EXPECT_EQ(stats.indirect_commands, 1u) << "one material, one class: one command for every wire";
     EXPECT_EQ(stats.multi_draw_calls, 1u);
     std::size_t vertices = 0, indices = 0;
     for (const auto& p : scene.pipelines) {
@@ -666,12 +668,21 @@ TEST(WireRendererTest, MaterialsAndWireframe) {
         DrawStats stats;
         const platform::Image filled = render(*ctx, renderer, scene.list(path), scene_camera(), {}, &stats);
         EXPECT_EQ(stats.multi_draw_calls, 2u);
-        // cpu-mesh: one command a wire; gpu-rings: one per started chunk of kChunkBands bands.
-        std::size_t commands = 0;
-        for (const DrawItem& item : scene.list(path).items)
-            commands += path == UploadPath::cpu_mesh ? 1 : wire::render::command_count(item);
-        EXPECT_EQ(stats.indirect_commands, commands);
-        EXPECT_GE(commands, scene.pipelines.size());
+        // cpu-mesh: one command a material; gpu-rings: one per (material, side count, chunk kind) in use.
+        const DrawList list = scene.list(path);
+        EXPECT_EQ(stats.indirect_commands, wire::render::draw_commands(list));
+        std::set<std::pair<uint32_t, uint32_t>> material_sides;
+        std::size_t chunks = 0;
+        for (const DrawItem& item : list.items) {
+            material_sides.insert({item.material, item.sides});
+            chunks += wire::render::chunk_count(item);
+        }
+        if (path == UploadPath::cpu_mesh) {
+            EXPECT_EQ(stats.indirect_commands, 2u);
+        } else {
+            EXPECT_LE(stats.indirect_commands, material_sides.size() * wire::render::kChunkKinds);
+            EXPECT_EQ(stats.chunks, chunks);
+        }
         std::size_t bluish = 0, orange = 0;
         for (std::size_t i = 0; i < filled.rgba.size(); i += 4) {
             bluish += filled.rgba[i + 2] > filled.rgba[i] + 30;
@@ -914,6 +925,7 @@ TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {
     render(*ctx, renderer, all, scene_camera(), {}, &stats);
     EXPECT_EQ(stats.wires_uploaded, 0u);
     EXPECT_EQ(stats.bytes_uploaded, all.items.size() * wire::render::kDrawRecordBytes +
+                                        stats.chunks * wire::render::kChunkRecordBytes +
                                         stats.indirect_commands * wire::render::kCommandBytes);
     for (int f = 0; f < 5; ++f) render(*ctx, renderer, none, scene_camera());
     EXPECT_EQ(renderer.resident_wires(), all.items.size());
