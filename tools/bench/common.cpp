@@ -8,6 +8,8 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <span>
+#include <vector>
 
 namespace wiretool::bench {
 
@@ -33,14 +35,24 @@ double median(std::vector<double> v) {
 
 // The renderer's own accounting (wire/render/upload_plan.hpp), so computed and drawn bytes agree.
 std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices) {
-    return items * (wire::render::kDrawRecordBytes + wire::render::kCommandBytes) +
-           vertices * sizeof(wire::TubeVertex) + indices * sizeof(uint32_t);
+    if (items == 0) return 0;
+    // One command draws every wire of the material; each vertex carries its 4-byte draw index.
+    return wire::render::kCommandBytes + items * wire::render::kDrawRecordBytes +
+           vertices * (sizeof(wire::TubeVertex) + wire::render::kVertexDrawIndexBytes) + indices * sizeof(uint32_t);
 }
 
 std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings) {
-    // One command a wire (wires longer than kChunkBands bands take one more per chunk; upload_bytes counts them).
-    return items * (wire::render::kDrawRecordBytes + wire::render::kCommandBytes) +
-           rings * sizeof(wire::render::PackedRing);
+    // Open capped tubes of one material and side count sharing the rings evenly: their chunk records and the
+    // frame's commands as the renderer writes them (exact for one wire).
+    if (items == 0) return 0;
+    const std::vector<wire::Ring> storage(rings / items + 1);  // chunk counts and bytes need only the ring count
+    wire::DrawList list{.path = wire::UploadPath::gpu_rings, .items = {}};
+    for (std::size_t i = 0; i < items; ++i) {
+        wire::DrawItem item;
+        item.rings = std::span<const wire::Ring>(storage.data(), rings / items + (i < rings % items ? 1 : 0));
+        list.items.push_back(item);
+    }
+    return wire::render::streamed_upload_bytes(list);
 }
 
 std::size_t upload_bytes(const wire::DrawList& list) {

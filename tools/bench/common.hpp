@@ -36,13 +36,15 @@ double wall_ms();
 double median(std::vector<double> v);
 
 /// Bytes WireRenderer::draw() memcpy's into its mapped buffers for `list` when every item is streamed
-/// (wire::render::streamed_upload_bytes): per drawn item a 32-byte draw record and 20-byte indirect commands
-/// (gpu-rings: one per 128 bands), plus vertices (32 B) and indices (4 B) or packed ring records (28 B). Items
-/// without geometry are skipped. The retained gpu-rings path: wire::render::plan_retained_frame.
+/// (wire::render::streamed_upload_bytes): per drawn item a 32-byte draw record, plus vertices (32 B) with a
+/// 4-byte draw index each and indices (4 B), or 8-byte chunk records (one per 16 bands or fewer, plus caps) and
+/// packed ring records (28 B); per frame 20 bytes a draw command (a bounded number: one per class and material,
+/// gpu-rings also per side count and chunk kind). Items without geometry are skipped. The retained gpu-rings path: wire::render::plan_retained_frame.
 std::size_t upload_bytes(const wire::DrawList& list);
-/// The same for a cpu-mesh upload of `items` meshes with these totals.
+/// The same for a cpu-mesh upload of `items` meshes of one material with these totals.
 std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices);
-/// The same for a gpu-rings upload of `items` wires with `rings` rings in total.
+/// The same for a gpu-rings upload of `items` open capped wires of one material and side count with `rings`
+/// rings in total, shared evenly (exact for one wire).
 std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings);
 
 /// Whether `scene` is selected by the options.

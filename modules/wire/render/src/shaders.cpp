@@ -10,12 +10,15 @@ namespace {
 constexpr std::string_view kHeader = R"(#version 450 core
 )";
 
+// record_index(): cpu-mesh, the vertex's draw index (a per-vertex attribute); gpu-rings, the chunk's index
+// (the command's base instance plus the instance), from ARB_shader_draw_parameters or from the instanced
+// attribute whose buffer holds 0, 1, 2, ...
 constexpr std::string_view kDrawParameters = R"(#extension GL_ARB_shader_draw_parameters : require
-uint draw_index() { return uint(gl_BaseInstanceARB); }
+uint record_index() { return uint(gl_BaseInstanceARB + gl_InstanceID); }
 )";
 
-constexpr std::string_view kDrawAttribute = R"(layout(location = 3) in uint a_draw;
-uint draw_index() { return a_draw; }
+constexpr std::string_view kDrawAttribute = R"(layout(location = 3) in uint a_record;
+uint record_index() { return a_record; }
 )";
 
 constexpr std::string_view kCommon = R"(
@@ -89,7 +92,7 @@ layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 void main() {
-  DrawData d = draws[draw_index()];
+  DrawData d = draws[record_index()];
   if (strip_mode(d) != 0u) {  // strip vertex (wire::write_strip): centre, frame quaternion xyz, (u, +-R)
     vec4 q = vec4(a_normal, sqrt(max(0.0, 1.0 - dot(a_normal, a_normal))));
     strip_vertex(d, strip_mode(d), a_position, rotate_by(q, vec3(1.0, 0.0, 0.0)), rotate_by(q, vec3(0.0, 1.0, 0.0)),
@@ -112,6 +115,8 @@ layout(std430, binding = 1) readonly buffer Rings { uint ring_words[]; };
 // cos and sin of 2 pi j / n for n = 3, 4, ... (n + 1 entries each, the last repeating j = 0), computed as
 // wire::write_tube's side table (double, then float): the two paths place rim vertices identically.
 layout(std430, binding = 2) readonly buffer Circle { vec2 circle[]; };
+// One record per instance (a chunk of a wire, upload_plan.hpp): the wire's draw index and its first band.
+layout(std430, binding = 3) readonly buffer Chunks { uvec2 chunks[]; };
 vec2 circle_at(uint n, uint j) { return circle[n * (n + 1u) / 2u - 6u + j]; }
 const uint kCapVertexBase = 1073741824u;  // 1 << 30: vertex ids of the two caps (kCapVertexBase in upload_plan.hpp)
 
@@ -169,14 +174,16 @@ uint div_row(uint vid, uint m) {
   return uint(q);
 }
 
-// Indexed: gl_VertexID is row * (n + 1) + s for the tube (row = ring, or ring_count for a closed wire's
-// repeat of ring 0), kCapVertexBase + cap * (n + 1) + k for the caps (k = 0 centre, 1 + j rim vertex j).
+// Indexed: gl_VertexID is local_row * (n + 1) + s for the tube (row = the chunk's first band + local_row = ring,
+// or ring_count for a closed wire's repeat of ring 0), kCapVertexBase + cap * (n + 1) + k for the caps (k = 0
+// centre, 1 + j rim vertex j).
 void main() {
-  DrawData d = draws[draw_index()];
+  uvec2 chunk = chunks[record_index()];
+  DrawData d = draws[chunk.x];
   uint n = d.sides;
   uint vid = uint(gl_VertexID);
   if (strip_mode(d) != 0u) {  // strip: vertex 2 row + (0: -side, 1: +side); a closed wire's last row repeats ring 0
-    uint row = vid >> 1u;
+    uint row = chunk.y + (vid >> 1u);
     uint i = row == d.ring_count ? 0u : row;
     Ring r = load_ring(d, i);
     float u = row == d.ring_count ? d.u_close : r.u;
@@ -188,8 +195,9 @@ void main() {
   vec3 nrm;
   vec2 uv;
   if (vid < kCapVertexBase) {
-    uint row = div_row(vid, n + 1u);
-    uint s = vid - row * (n + 1u);
+    uint local_row = div_row(vid, n + 1u);
+    uint s = vid - local_row * (n + 1u);
+    uint row = chunk.y + local_row;
     uint i = row == d.ring_count ? 0u : row;  // a closed wire's last row repeats ring 0 ...
     Ring r = load_ring(d, i);
     float u = row == d.ring_count ? d.u_close : r.u;  // ... with u = u_close
@@ -287,7 +295,7 @@ void main() {
 
 std::string vertex_source(bool cpu_mesh, bool draw_parameters) {
     std::string s(kHeader);
-    s += draw_parameters ? kDrawParameters : kDrawAttribute;
+    s += draw_parameters && !cpu_mesh ? kDrawParameters : kDrawAttribute;
     s += kCommon;
     s += cpu_mesh ? kCpuMain : kRingsMain;
     return s;

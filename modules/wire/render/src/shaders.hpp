@@ -19,9 +19,12 @@ struct GpuDraw {
 static_assert(sizeof(GpuDraw) == 32);
 inline constexpr uint32_t kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;  // kStrip: sides 2, kLine: sides 1
 
-/// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex). Otherwise the ring expansion from
-/// gl_VertexID of an indexed draw over the static pattern (upload_plan.hpp). `draw_parameters`: the draw index is gl_BaseInstanceARB (ARB_shader_draw_parameters), else
-/// the instanced attribute at location 3 (divisor 1; its buffer holds 0, 1, 2, ... so it reads baseInstance).
+/// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex) and 3 the vertex's draw index (uint,
+/// streamed beside the vertices). Otherwise the ring expansion from gl_VertexID of an instanced indexed draw over
+/// the static pattern, one instance per chunk (upload_plan.hpp), its record (draw index, first band) in the SSBO
+/// at binding 3. `draw_parameters` (gpu-rings only): the chunk index is gl_BaseInstanceARB + gl_InstanceID
+/// (ARB_shader_draw_parameters), else the instanced attribute at location 3 (divisor 1; its buffer holds 0, 1,
+/// 2, ... so it reads baseInstance + instance).
 std::string vertex_source(bool cpu_mesh, bool draw_parameters);
 /// `shading`: optional GLSL defining vec3 shade(vec3 albedo, vec3 n, vec3 to_eye); empty: the default
 /// lighting.

@@ -107,10 +107,48 @@ bool has_geometry(const DrawItem& item, UploadPath path) {
     return band_count(item) > 0 || (!item.closed && item.caps);
 }
 
-uint32_t command_count(const DrawItem& item) {
-    if (!has_geometry(item, UploadPath::gpu_rings)) return 0;
+std::array<uint32_t, kChunkKinds> chunk_counts(const DrawItem& item) {
+    std::array<uint32_t, kChunkKinds> counts{};
+    if (!has_geometry(item, UploadPath::gpu_rings)) return counts;
+    counts[0] = item.sides > 2 && !item.closed && item.caps ? 1u : 0u;
     const uint32_t bands = band_count(item);
-    return std::max<uint32_t>(1, (bands + kChunkBands - 1) / kChunkBands);
+    counts[1] = bands / kChunkBands;
+    for (uint32_t kind = 2; kind < kChunkKinds; ++kind)
+        counts[kind] = (bands & chunk_kind_bands(kind)) != 0 ? 1u : 0u;  // the remainder's binary digits
+    return counts;
+}
+
+uint32_t chunk_count(const DrawItem& item) {
+    const std::array<uint32_t, kChunkKinds> counts = chunk_counts(item);
+    uint32_t sum = 0;
+    for (uint32_t c : counts) sum += c;
+    return sum;
+}
+
+namespace {
+
+std::size_t count_commands(std::span<const DrawItem> items, UploadPath path) {
+    // Keys of the runs the renderer draws: (blended, material) on cpu-mesh, plus (side count, kind) on gpu-rings.
+    std::vector<uint64_t> keys;
+    for (const DrawItem& item : items) {
+        if (!has_geometry(item, path)) continue;
+        const uint64_t run = (item.sides == 1 ? uint64_t{1} << 63 : 0u) | (uint64_t{item.material} << 32);
+        if (path == UploadPath::cpu_mesh) {
+            keys.push_back(run);
+            continue;
+        }
+        const std::array<uint32_t, kChunkKinds> counts = chunk_counts(item);
+        for (uint32_t kind = 0; kind < kChunkKinds; ++kind)
+            if (counts[kind] != 0) keys.push_back(run | (uint64_t{item.sides} << 8) | kind);
+    }
+    std::sort(keys.begin(), keys.end());
+    return static_cast<std::size_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
+}
+
+}  // namespace
+
+std::size_t draw_commands(const DrawList& list) {
+    return count_commands(list.items, list.path);
 }
 
 uint32_t expanded_vertices(const DrawItem& item) {
@@ -129,13 +167,14 @@ uint32_t expanded_triangles(const DrawItem& item) {
 }
 
 std::size_t streamed_upload_bytes(const DrawList& list) {
-    std::size_t bytes = 0;
+    std::size_t bytes = draw_commands(list) * kCommandBytes;
     for (const DrawItem& item : list.items) {
         if (!has_geometry(item, list.path)) continue;
         if (list.path == UploadPath::cpu_mesh) {
-            bytes += kDrawRecordBytes + kCommandBytes + item.vertices.size_bytes() + item.indices.size_bytes();
+            bytes += kDrawRecordBytes + item.vertices.size() * (sizeof(TubeVertex) + kVertexDrawIndexBytes) +
+                     item.indices.size_bytes();
         } else {
-            bytes += kDrawRecordBytes + command_count(item) * kCommandBytes + item.rings.size() * sizeof(PackedRing);
+            bytes += kDrawRecordBytes + chunk_count(item) * kChunkRecordBytes + item.rings.size() * sizeof(PackedRing);
         }
     }
     return bytes;
@@ -181,9 +220,10 @@ const Residency* RingResidency::find(uint64_t wire_id) const {
 RetainedFrame plan_retained_frame(const DrawList& list, RingResidency& residency) {
     RetainedFrame f;
     residency.begin_frame();
+    f.bytes = count_commands(list.items, UploadPath::gpu_rings) * kCommandBytes;
     for (const DrawItem& item : list.items) {
         if (!has_geometry(item, UploadPath::gpu_rings)) continue;
-        f.bytes += kDrawRecordBytes + command_count(item) * kCommandBytes;
+        f.bytes += kDrawRecordBytes + chunk_count(item) * kChunkRecordBytes;
         if (residency.touch(item).upload) {
             f.ring_bytes += item.rings.size() * sizeof(PackedRing);
             ++f.wires_uploaded;

@@ -1,7 +1,7 @@
-// WireRenderer: one stream-buffer region per frame holding per-draw records, indirect commands and streamed
-// geometry (tube vertices + indices, or packed rings when not retained); retained ring records in a
-// RetainedBuffer; a static index pattern per side count for the ring expansion; one glMultiDrawElementsIndirect
-// per material.
+// WireRenderer: one stream-buffer region per frame holding per-draw records, chunk records (gpu-rings), indirect
+// commands and streamed geometry (tube vertices, their draw indices and rebased indices, or packed rings when not
+// retained); retained ring records in a RetainedBuffer; a static index pattern per side count for the ring
+// expansion; one glMultiDrawElementsIndirect per run of (class, material) with a bounded number of commands.
 #include "wire/render/wire_renderer.hpp"
 
 #include "shaders.hpp"
@@ -17,6 +17,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -42,7 +43,7 @@ static_assert(sizeof(detail::GpuDraw) == kDrawRecordBytes);
 
 constexpr std::size_t kSectionAlign =
     256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every driver we know
-constexpr GLuint kDrawIndexLocation = 3;
+constexpr GLuint kRecordLocation = 3;  // cpu-mesh: the vertex's draw index; gpu-rings fallback: the chunk index
 constexpr uint32_t kPatternMinSides = 16;  // patterns are built for 3..max(this, largest side count seen)
 
 std::size_t align_up(std::size_t v) {
@@ -76,7 +77,7 @@ struct WireRenderer::State {
     gfx::Program rings_program;
     gfx::VertexArray cpu_vao;
     gfx::VertexArray rings_vao;
-    gfx::Buffer draw_index_buffer;  ///< 0, 1, 2, ... for the instanced draw-index attribute (fallback only)
+    gfx::Buffer draw_index_buffer;  ///< 0, 1, 2, ... for the instanced chunk-index attribute (fallback only)
     std::size_t draw_index_capacity = 0;
     bool draw_parameters = false;
     StreamBuffer stream;
@@ -89,9 +90,12 @@ struct WireRenderer::State {
     std::vector<gfx::Texture> textures;
     std::vector<Material> materials;
     // Per-frame scratch, reused.
-    std::vector<uint32_t> order;          ///< items with geometry, sorted by material
-    std::vector<uint32_t> command_first;  ///< per order position: its first command (plus one past the end)
+    std::vector<uint32_t> order;          ///< items with geometry, sorted by class, material (and side count)
     std::vector<uint32_t> ring_word;      ///< per order position: first word of its rings (retained)
+    std::vector<uint32_t> run_first;      ///< per run of (class, material): first order position (+ one past the end)
+    std::vector<uint32_t> run_command;    ///< per run: its first command (plus one past the end)
+    std::vector<DrawElementsIndirectCommand> commands;
+    std::vector<uint32_t> chunks;         ///< gpu-rings: (draw index, first band) per chunk, in command order
     std::vector<PackedRing> packed;
 
     Status ensure_patterns(uint32_t max_sides) {
@@ -179,9 +183,7 @@ struct WireRenderer::State {
         if (!made) return made.error();
         draw_index_buffer = std::move(made).value();
         draw_index_capacity = capacity;
-        for (const gfx::VertexArray* vao : {&cpu_vao, &rings_vao}) {
-            glVertexArrayVertexBuffer(vao->id(), 1, draw_index_buffer.id(), 0, sizeof(uint32_t));
-        }
+        glVertexArrayVertexBuffer(rings_vao.id(), 1, draw_index_buffer.id(), 0, sizeof(uint32_t));
         return {};
     }
 };
@@ -211,8 +213,9 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     s.cpu_program = std::move(cpu).value();
     s.rings_program = std::move(rings).value();
 
-    // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 (the buffer is set per frame); both read
-    // the draw index at binding 1 when the draw-parameters extension is missing.
+    // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 and the vertex's draw index at binding 1
+    // (both streamed, set per frame); the gpu-rings one reads the chunk index at binding 1 (instanced, from the
+    // 0, 1, 2, ... buffer) when the draw-parameters extension is missing.
     s.cpu_vao = gfx::make_vertex_array({.label = "wire cpu-mesh"});
     s.rings_vao = gfx::make_vertex_array({.label = "wire gpu-rings"});
     const GLuint cpu_vao = s.cpu_vao.id();
@@ -228,13 +231,15 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
         glVertexArrayAttribFormat(cpu_vao, a.location, a.components, GL_FLOAT, GL_FALSE, a.offset);
         glVertexArrayAttribBinding(cpu_vao, a.location, 0);
     }
+    glEnableVertexArrayAttrib(cpu_vao, kRecordLocation);
+    glVertexArrayAttribIFormat(cpu_vao, kRecordLocation, 1, GL_UNSIGNED_INT, 0);
+    glVertexArrayAttribBinding(cpu_vao, kRecordLocation, 1);
     if (!s.draw_parameters) {
-        for (const gfx::VertexArray* vao : {&s.cpu_vao, &s.rings_vao}) {
-            glEnableVertexArrayAttrib(vao->id(), kDrawIndexLocation);
-            glVertexArrayAttribIFormat(vao->id(), kDrawIndexLocation, 1, GL_UNSIGNED_INT, 0);
-            glVertexArrayAttribBinding(vao->id(), kDrawIndexLocation, 1);
-            glVertexArrayBindingDivisor(vao->id(), 1, 1);
-        }
+        const GLuint rings_vao = s.rings_vao.id();
+        glEnableVertexArrayAttrib(rings_vao, kRecordLocation);
+        glVertexArrayAttribIFormat(rings_vao, kRecordLocation, 1, GL_UNSIGNED_INT, 0);
+        glVertexArrayAttribBinding(rings_vao, kRecordLocation, 1);
+        glVertexArrayBindingDivisor(rings_vao, 1, 1);
         if (Status st = s.ensure_draw_index_capacity(1); !st) return st;
     }
 
@@ -343,11 +348,15 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         s.order.push_back(i);
         max_sides = std::max(max_sides, item.sides);
     }
-    // Opaque items (tubes, strips) first, then the blended phone-wire lines (sides 1), each by material.
+    // Opaque items (tubes, strips) first, then the blended phone-wire lines (sides 1), each by material; on
+    // gpu-rings by side count within a material (one index pattern per side count).
     auto blended = [&](uint32_t i) { return list.items[i].sides == 1; };
     std::stable_sort(s.order.begin(), s.order.end(), [&](uint32_t a, uint32_t b) {
         if (blended(a) != blended(b)) return blended(b);
-        return list.items[a].material < list.items[b].material;
+        const DrawItem& x = list.items[a];
+        const DrawItem& y = list.items[b];
+        if (x.material != y.material) return x.material < y.material;
+        return !cpu && x.sides < y.sides;
     });
     if (retained) {
         s.retain(list, stats);  // also on an empty list: culled and destroyed wires age out
@@ -357,34 +366,99 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         return stats;
     }
     const std::size_t n = s.order.size();
-    if (Status st = s.ensure_draw_index_capacity(n); !st) return stats;
     if (!cpu) {
         if (Status st = s.ensure_patterns(max_sides); !st) return stats;
     }
 
-    // (2) Prepare: commands per item, then the region layout: per-draw records | indirect commands |
-    // streamed geometry (vertices, or packed rings) | indices.
-    s.command_first.resize(n + 1);
-    uint32_t commands = 0;
+    // (2) Prepare: runs of equal (class, material), one multi-draw each, and their commands. cpu-mesh: one
+    // command over the run's indices (rebased while copying, so no base vertex is needed). gpu-rings: one
+    // instanced command per (side count, chunk kind) over the side count's pattern, one instance per chunk record
+    // (upload_plan.hpp). The count never depends on the number of wires.
+    auto same_run = [&](uint32_t a, uint32_t b) {
+        return blended(a) == blended(b) && list.items[a].material == list.items[b].material;
+    };
+    s.run_first.clear();
+    s.run_command.clear();
+    s.commands.clear();
+    s.chunks.clear();
     std::size_t geometry_bytes = 0;
-    std::size_t index_bytes = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-        const DrawItem& item = list.items[s.order[k]];
-        s.command_first[k] = commands;
+    std::size_t vertex_total = 0;
+    std::size_t index_total = 0;
+    for (std::size_t r0 = 0; r0 < n;) {
+        const DrawItem& head = list.items[s.order[r0]];
+        if (r0 == 0 || !same_run(s.order[r0 - 1], s.order[r0])) {
+            s.run_first.push_back(static_cast<uint32_t>(r0));
+            s.run_command.push_back(static_cast<uint32_t>(s.commands.size()));
+            if (cpu) s.commands.push_back({0, 1, static_cast<uint32_t>(index_total), 0, 0});  // first index: relative
+        }
         if (cpu) {
-            commands += 1;
-            geometry_bytes += item.vertices.size_bytes();
-            index_bytes += item.indices.size_bytes();
-        } else {
-            commands += command_count(item);
+            geometry_bytes += head.vertices.size_bytes();
+            vertex_total += head.vertices.size();
+            index_total += head.indices.size();
+            s.commands.back().count += static_cast<uint32_t>(head.indices.size());
+            ++r0;
+            continue;
+        }
+        // gpu-rings: the items of one side count in this run.
+        std::size_t r1 = r0 + 1;
+        while (r1 < n && same_run(s.order[r0], s.order[r1]) && list.items[s.order[r1]].sides == head.sides) ++r1;
+        std::array<uint32_t, kChunkKinds> counts{};
+        for (std::size_t k = r0; k < r1; ++k) {
+            const DrawItem& item = list.items[s.order[k]];
+            const std::array<uint32_t, kChunkKinds> c = chunk_counts(item);
+            for (uint32_t kind = 0; kind < kChunkKinds; ++kind) counts[kind] += c[kind];
             if (!retained) geometry_bytes += item.rings.size() * sizeof(PackedRing);
         }
+        const uint32_t sides = head.sides;
+        const uint32_t pattern = s.pattern_first[sides];
+        const uint32_t band_indices = sides > 2 ? 6 * sides : 6;  // strips and lines: 2 triangles a band
+        std::array<uint32_t, kChunkKinds> next{};  // per kind: the next chunk record to write
+        auto cursor = static_cast<uint32_t>(s.chunks.size() / 2);
+        for (uint32_t kind = 0; kind < kChunkKinds; ++kind) {
+            if (counts[kind] == 0) continue;
+            next[kind] = cursor;
+            // Caps: [start cap 3n][end cap 3n] at the pattern's start; bands follow them (tubes only).
+            const uint32_t count = kind == 0 ? 6 * sides : chunk_kind_bands(kind) * band_indices;
+            const uint32_t first = kind == 0 || sides <= 2 ? pattern : pattern + 6 * sides;
+            s.commands.push_back({count, counts[kind], first, 0, cursor});
+            cursor += counts[kind];
+        }
+        s.chunks.resize(2 * std::size_t{cursor});
+        auto put = [&](uint32_t kind, std::size_t k, uint32_t first_band) {
+            const uint32_t at = next[kind]++;
+            s.chunks[2 * at] = static_cast<uint32_t>(k);
+            s.chunks[2 * at + 1] = first_band;
+        };
+        for (std::size_t k = r0; k < r1; ++k) {
+            const std::array<uint32_t, kChunkKinds> c = chunk_counts(list.items[s.order[k]]);
+            if (c[0] != 0) put(0, k, 0);
+            uint32_t band = 0;
+            for (uint32_t i = 0; i < c[1]; ++i, band += kChunkBands) put(1, k, band);
+            for (uint32_t kind = 2; kind < kChunkKinds; ++kind) {
+                if (c[kind] == 0) continue;
+                put(kind, k, band);
+                band += chunk_kind_bands(kind);
+            }
+        }
+        r0 = r1;
     }
-    s.command_first[n] = commands;
+    s.run_first.push_back(static_cast<uint32_t>(n));
+    s.run_command.push_back(static_cast<uint32_t>(s.commands.size()));
+    const std::size_t chunk_count_total = s.chunks.size() / 2;
+    if (Status st = s.ensure_draw_index_capacity(chunk_count_total); !st) return stats;
+
+    // Region layout: draw records | chunk records | commands | streamed geometry (vertices, or packed rings) |
+    // the vertices' draw indices (cpu-mesh) | indices (cpu-mesh).
     const std::size_t draws_bytes = n * sizeof(detail::GpuDraw);
-    const std::size_t command_offset = align_up(draws_bytes);
-    const std::size_t geometry_offset = align_up(command_offset + commands * sizeof(DrawElementsIndirectCommand));
-    const std::size_t index_offset = align_up(geometry_offset + geometry_bytes);
+    const std::size_t chunk_bytes = s.chunks.size() * sizeof(uint32_t);
+    const std::size_t command_bytes = s.commands.size() * sizeof(DrawElementsIndirectCommand);
+    const std::size_t record_bytes = vertex_total * kVertexDrawIndexBytes;
+    const std::size_t index_bytes = index_total * sizeof(uint32_t);
+    const std::size_t chunk_offset = align_up(draws_bytes);
+    const std::size_t command_offset = align_up(chunk_offset + chunk_bytes);
+    const std::size_t geometry_offset = align_up(command_offset + command_bytes);
+    const std::size_t record_offset = align_up(geometry_offset + geometry_bytes);
+    const std::size_t index_offset = align_up(record_offset + record_bytes);
     const std::size_t total = index_offset + index_bytes;
 
     Expected<StreamRegion> begun = s.stream.begin(total);
@@ -396,16 +470,20 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     stats.buffer_grew = stats.buffer_grew || region.grew;
     stats.waited_for_gpu = region.waited;
 
-    // Fill the region with memcpy only (write-combined memory: never read it back).
+    // Fill the region with sequential writes only (write-combined memory: never read it back).
     const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
     std::byte* base = region.data;
+    const auto first_index_base = static_cast<uint32_t>((region.offset_bytes + index_offset) / sizeof(uint32_t));
+    if (cpu) {
+        for (DrawElementsIndirectCommand& c : s.commands) c.first_index += first_index_base;
+    }
+    if (chunk_bytes > 0) std::memcpy(base + chunk_offset, s.chunks.data(), chunk_bytes);
+    std::memcpy(base + command_offset, s.commands.data(), command_bytes);
     std::size_t geometry_cursor = 0;  // bytes into the geometry section
     std::size_t index_cursor = 0;     // indices into the index section
     uint32_t vertex_cursor = 0;       // vertices into the vertex section
-    const std::size_t first_index_base = (region.offset_bytes + index_offset) / sizeof(uint32_t);
-    auto put_command = [&](uint32_t c, const DrawElementsIndirectCommand& command) {
-        std::memcpy(base + command_offset + c * sizeof(command), &command, sizeof(command));
-    };
+    auto* const vertex_records = reinterpret_cast<uint32_t*>(base + record_offset);
+    auto* const indices = reinterpret_cast<uint32_t*>(base + index_offset);
     for (std::size_t k = 0; k < n; ++k) {
         const DrawItem& item = list.items[s.order[k]];
         const glm::vec3 offset(item.origin_m - eye);  // difference in double, then float
@@ -415,14 +493,14 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         draw.flags = strip_flags;
         if (cpu) {
             const auto vertex_count = static_cast<uint32_t>(item.vertices.size());
-            const auto index_count = static_cast<uint32_t>(item.indices.size());
+            const std::size_t index_count = item.indices.size();
             std::memcpy(base + geometry_offset + geometry_cursor, item.vertices.data(),
                         item.vertices.size_bytes());
-            std::memcpy(base + index_offset + index_cursor * sizeof(uint32_t), item.indices.data(),
-                        item.indices.size_bytes());
-            put_command(s.command_first[k],
-                        {index_count, 1, static_cast<uint32_t>(first_index_base + index_cursor),
-                         static_cast<int32_t>(vertex_cursor), static_cast<uint32_t>(k)});
+            std::fill_n(vertex_records + vertex_cursor, vertex_count, static_cast<uint32_t>(k));
+            // Rebased while copying: one draw covers every wire of the run without a base vertex per wire.
+            const uint32_t* src = item.indices.data();
+            uint32_t* dst = indices + index_cursor;
+            for (std::size_t i = 0; i < index_count; ++i) dst[i] = src[i] + vertex_cursor;
             geometry_cursor += item.vertices.size_bytes();
             index_cursor += index_count;
             vertex_cursor += vertex_count;
@@ -449,42 +527,21 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
             const float r0 = item.rings.front().radius_m;
             const bool varying = std::any_of(item.rings.begin(), item.rings.end(),
                                              [r0](const Ring& r) { return r.radius_m != r0; });
-            const bool caps = !item.closed && item.caps;
             draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) |
                          (varying ? detail::kTilt : 0u) | strip_flags;
             draw.u_close = item.u_close;
-            // Commands over the side count's pattern: the first carries the caps, each covers <= kChunkBands.
-            const uint32_t sides = item.sides;
-            const uint32_t bands = band_count(item);
-            const uint32_t pattern = s.pattern_first[sides];
-            if (sides <= 2) {  // strip or line: 2 vertices a row, no caps
-                for (uint32_t c = 0, first_band = 0; c < s.command_first[k + 1] - s.command_first[k];
-                     ++c, first_band += kChunkBands) {
-                    const uint32_t chunk = std::min(kChunkBands, bands - std::min(bands, first_band));
-                    put_command(s.command_first[k] + c, {chunk * 6, 1, pattern,
-                                                         static_cast<int32_t>(first_band * 2), static_cast<uint32_t>(k)});
-                }
-            }
-            for (uint32_t c = 0; sides > 2 && c < s.command_first[k + 1] - s.command_first[k]; ++c) {
-                const uint32_t first_band = c * kChunkBands;
-                const uint32_t chunk = std::min(kChunkBands, bands - std::min(bands, first_band));
-                const bool with_caps = c == 0 && caps;
-                put_command(s.command_first[k] + c,
-                            {(chunk + (with_caps ? 1u : 0u)) * 6 * sides, 1,
-                             pattern + (with_caps ? 0u : 6 * sides),
-                             static_cast<int32_t>(first_band * (sides + 1)), static_cast<uint32_t>(k)});
-            }
             stats.vertices += expanded_vertices(item);
             stats.triangles += expanded_triangles(item);
         }
         std::memcpy(base + k * sizeof(detail::GpuDraw), &draw, sizeof(draw));
     }
-    stats.bytes_uploaded = draws_bytes + commands * sizeof(DrawElementsIndirectCommand) + geometry_bytes +
-                           index_bytes + (retained ? stats.ring_bytes_uploaded : 0);
+    stats.bytes_uploaded = draws_bytes + chunk_bytes + command_bytes + geometry_bytes + record_bytes + index_bytes +
+                           (retained ? stats.ring_bytes_uploaded : 0);
     stats.draw_items = n;
-    stats.indirect_commands = commands;
+    stats.chunks = chunk_count_total;
+    stats.indirect_commands = s.commands.size();
 
-    // (3) Submit: GL state for the wires, the mode's program and vertex array, one multi-draw per material.
+    // (3) Submit: GL state for the wires, the mode's program and vertex array, one multi-draw per run.
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
@@ -515,6 +572,8 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         glVertexArrayVertexBuffer(s.cpu_vao.id(), 0, buffer,
                                   static_cast<GLintptr>(region.offset_bytes + geometry_offset),
                                   sizeof(TubeVertex));
+        glVertexArrayVertexBuffer(s.cpu_vao.id(), 1, buffer,
+                                  static_cast<GLintptr>(region.offset_bytes + record_offset), sizeof(uint32_t));
         glVertexArrayElementBuffer(s.cpu_vao.id(), buffer);
         s.cpu_vao.bind();
     } else {
@@ -527,33 +586,31 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
                               static_cast<GLsizeiptr>(std::max<std::size_t>(geometry_bytes, 4)));
         }
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.circle.id());
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 3, buffer,
+                          static_cast<GLintptr>(region.offset_bytes + chunk_offset),
+                          static_cast<GLsizeiptr>(std::max<std::size_t>(chunk_bytes, 8)));
         s.rings_vao.bind();  // its element buffer is the pattern
     }
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, buffer);
 
     bool blending = false;
-    for (std::size_t first = 0; first < n;) {
-        const uint32_t material_index = list.items[s.order[first]].material;
-        const bool line = list.items[s.order[first]].sides == 1;
-        std::size_t last = first + 1;
-        while (last < n && list.items[s.order[last]].material == material_index &&
-               (list.items[s.order[last]].sides == 1) == line)
-            ++last;
+    for (std::size_t run = 0; run + 1 < s.run_first.size(); ++run) {
+        const DrawItem& head = list.items[s.order[s.run_first[run]]];
+        const bool line = head.sides == 1;
         if (line && !blending) {  // phone-wire lines: opacity = true width / drawn width, over the opaque wires
             glEnable(GL_BLEND);
             glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
             glDepthMask(GL_FALSE);
             blending = true;
         }
-        const Material& material = s.materials[material_index];
+        const Material& material = s.materials[head.material];
         program.set("u_tint", material.tint);
         s.textures[material.texture].bind(0);
         const auto* indirect = reinterpret_cast<const void*>(
-            region.offset_bytes + command_offset + s.command_first[first] * sizeof(DrawElementsIndirectCommand));
-        const auto count = static_cast<GLsizei>(s.command_first[last] - s.command_first[first]);
+            region.offset_bytes + command_offset + s.run_command[run] * sizeof(DrawElementsIndirectCommand));
+        const auto count = static_cast<GLsizei>(s.run_command[run + 1] - s.run_command[run]);
         glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, indirect, count, 0);
         ++stats.multi_draw_calls;
-        first = last;
     }
     if (blending) {
         glDisable(GL_BLEND);

@@ -124,7 +124,8 @@ TEST(PackedRingTest, RealisticWiresKeepFrameAndTexturePrecision) {
 }
 
 // Indexed expansion counts equal the CPU mesh's, for open/closed, capped/uncapped, 1..300 rings, 3..32 sides;
-// commands cover every band exactly once in chunks of kChunkBands.
+// chunks cover every band exactly once: kChunkBands-band chunks, then the remainder's binary digits, plus one cap
+// chunk on a capped open tube.
 TEST(UploadPlanTest, ExpansionCountsMatchTubeCounts) {
     std::vector<wire::Ring> rings(300);
     for (uint32_t sides : {3u, 7u, 16u, 32u}) {
@@ -145,8 +146,20 @@ TEST(UploadPlanTest, ExpansionCountsMatchTubeCounts) {
                     EXPECT_EQ(wire::render::expanded_vertices(item), c.vertices);
                     EXPECT_EQ(wire::render::expanded_triangles(item) * 3, c.indices);
                     const uint32_t bands = wire::render::band_count(item);
-                    EXPECT_EQ(wire::render::command_count(item),
-                              std::max<uint32_t>(1, (bands + wire::render::kChunkBands - 1) / wire::render::kChunkBands));
+                    const auto chunks = wire::render::chunk_counts(item);
+                    uint32_t covered = 0, records = 0;
+                    for (uint32_t kind = 0; kind < wire::render::kChunkKinds; ++kind) {
+                        covered += chunks[kind] * wire::render::chunk_kind_bands(kind);
+                        records += chunks[kind];
+                        if (kind >= 2) {
+                            EXPECT_LE(chunks[kind], 1u);
+                        }
+                    }
+                    EXPECT_EQ(covered, bands) << count << " rings";
+                    EXPECT_EQ(chunks[1], bands / wire::render::kChunkBands);
+                    EXPECT_EQ(chunks[0], !closed && caps && sides > 2 ? 1u : 0u);
+                    EXPECT_EQ(wire::render::chunk_count(item), records);
+                    EXPECT_GE(records, 1u);
                 }
             }
         }
@@ -167,14 +180,18 @@ TEST(UploadPlanTest, ResidencyUploadsOnlyChangedWires) {
     };
     wire::render::RingResidency residency(3);
     wire::DrawList list{.path = wire::UploadPath::gpu_rings, .items = {item(1, 1), item(2, 1), item(3, 0)}};
-    constexpr std::size_t per_item = wire::render::kDrawRecordBytes + wire::render::kCommandBytes;
+    // 10 rings, 9 bands, capped: chunks of 8 and 1 band and a cap chunk; the three wires share their 3 commands.
+    constexpr std::size_t per_item = wire::render::kDrawRecordBytes + 3 * wire::render::kChunkRecordBytes;
+    constexpr std::size_t commands = 3 * wire::render::kCommandBytes;
     constexpr std::size_t ring_bytes = 10 * sizeof(PackedRing);
+    EXPECT_EQ(wire::render::chunk_count(list.items[0]), 3u);
+    EXPECT_EQ(wire::render::draw_commands(list), 3u);
     wire::render::RetainedFrame f = wire::render::plan_retained_frame(list, residency);
     EXPECT_EQ(f.wires_uploaded, 3u);
-    EXPECT_EQ(f.bytes, 3 * per_item + 3 * ring_bytes);
+    EXPECT_EQ(f.bytes, commands + 3 * per_item + 3 * ring_bytes);
     f = wire::render::plan_retained_frame(list, residency);
     EXPECT_EQ(f.wires_uploaded, 1u) << "only the generation-0 wire";
-    EXPECT_EQ(f.bytes, 3 * per_item + ring_bytes);
+    EXPECT_EQ(f.bytes, commands + 3 * per_item + ring_bytes);
     list.items[1].rings_generation = 2;
     f = wire::render::plan_retained_frame(list, residency);
     EXPECT_EQ(f.wires_uploaded, 2u);

@@ -15,6 +15,8 @@
 #include <numeric>
 #include <array>
 #include <random>
+#include <set>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -364,7 +366,7 @@ TEST(WireRendererTest, CpuMeshRendersLitTexturedWires) {
     save(image, "wire_render_cpu_mesh.png");
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
     EXPECT_EQ(stats.draw_items, scene.pipelines.size());
-    EXPECT_EQ(stats.indirect_commands, scene.pipelines.size());
+    EXPECT_EQ(stats.indirect_commands, 1u) << "one material, one class: one command for every wire";
     EXPECT_EQ(stats.multi_draw_calls, 1u);
     std::size_t vertices = 0, indices = 0;
     for (const auto& p : scene.pipelines) {
@@ -666,12 +668,21 @@ TEST(WireRendererTest, MaterialsAndWireframe) {
         DrawStats stats;
         const platform::Image filled = render(*ctx, renderer, scene.list(path), scene_camera(), {}, &stats);
         EXPECT_EQ(stats.multi_draw_calls, 2u);
-        // cpu-mesh: one command a wire; gpu-rings: one per started chunk of kChunkBands bands.
-        std::size_t commands = 0;
-        for (const DrawItem& item : scene.list(path).items)
-            commands += path == UploadPath::cpu_mesh ? 1 : wire::render::command_count(item);
-        EXPECT_EQ(stats.indirect_commands, commands);
-        EXPECT_GE(commands, scene.pipelines.size());
+        // cpu-mesh: one command a material; gpu-rings: one per (material, side count, chunk kind) in use.
+        const DrawList list = scene.list(path);
+        EXPECT_EQ(stats.indirect_commands, wire::render::draw_commands(list));
+        std::set<std::pair<uint32_t, uint32_t>> material_sides;
+        std::size_t chunks = 0;
+        for (const DrawItem& item : list.items) {
+            material_sides.insert({item.material, item.sides});
+            chunks += wire::render::chunk_count(item);
+        }
+        if (path == UploadPath::cpu_mesh) {
+            EXPECT_EQ(stats.indirect_commands, 2u);
+        } else {
+            EXPECT_LE(stats.indirect_commands, material_sides.size() * wire::render::kChunkKinds);
+            EXPECT_EQ(stats.chunks, chunks);
+        }
         std::size_t bluish = 0, orange = 0;
         for (std::size_t i = 0; i < filled.rgba.size(); i += 4) {
             bluish += filled.rgba[i + 2] > filled.rgba[i] + 30;
@@ -920,6 +931,7 @@ TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {
     render(*ctx, renderer, all, scene_camera(), {}, &stats);
     EXPECT_EQ(stats.wires_uploaded, 0u);
     EXPECT_EQ(stats.bytes_uploaded, all.items.size() * wire::render::kDrawRecordBytes +
+                                        stats.chunks * wire::render::kChunkRecordBytes +
                                         stats.indirect_commands * wire::render::kCommandBytes);
     for (int f = 0; f < 5; ++f) render(*ctx, renderer, none, scene_camera());
     EXPECT_EQ(renderer.resident_wires(), all.items.size());
@@ -1004,6 +1016,86 @@ TEST(WireRendererTest, NoDebugOutputErrors) {
 }
 
 }  // namespace
+
+// Issue 29 item 1: the draw commands of a frame do not grow with the number of wires. Ten wires (tubes of three
+// side counts in two materials, a strip, a phone-wire line) and the same ten repeated to 1,000 (new ids, moved
+// apart): the same commands and multi-draws on cpu-mesh, streamed gpu-rings and retained gpu-rings (first
+// frame and an unchanged second one), equal to wire::render::draw_commands; items and triangles scale 100x.
+TEST(WireRendererTest, DrawCommandsDoNotGrowWithWires) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer retained = make_renderer();
+    WireRenderer streamed = make_renderer({.retain_rings = false});
+    const uint32_t blue = retained.add_material({.tint = {0.2f, 0.4f, 1.0f}});
+    EXPECT_EQ(streamed.add_material({.tint = {0.2f, 0.4f, 1.0f}}), blue);
+    Scene tubes;
+    const uint32_t sides[] = {6, 8, 12};
+    for (int i = 0; i < 8; ++i) {
+        const double x = -2.0 + 0.5 * i;
+        tubes.add(hanging_cable({x, 1.2, -0.4}, {x + 0.4, 0.9 - 0.1 * i, 0.3}, 0.3 + 0.05 * i, 5 + i),
+                  wire_settings(0.02f + 0.003f * static_cast<float>(i), sides[i % 3]), i % 2 == 0 ? 0u : blue);
+    }
+    const std::vector<wire::WireNodes> cables = thin_cables(29, 2);
+    const ThinWire strip = make_thin_wire(cables[0], 0.004f, 5);
+    const ThinWire line = make_thin_wire(cables[1], 0.0008f, 5);
+    auto ten = [&](UploadPath path) {
+        DrawList list = tubes.list(path);
+        list.items.push_back(strip.list(path, 2).items[0]);
+        list.items.push_back(line.list(path, 1).items[0]);
+        return list;
+    };
+    auto thousand = [&](UploadPath path) {
+        const DrawList base = ten(path);
+        DrawList list{.path = path, .items = {}};
+        for (uint64_t copy = 0; copy < 100; ++copy) {
+            for (DrawItem item : base.items) {
+                item.wire_id += (copy + 1) << 40;  // a new entity
+                item.origin_m += glm::dvec3(0.01 * static_cast<double>(copy % 10), 0.0, -0.2 * static_cast<double>(copy / 10));
+                list.items.push_back(item);
+            }
+        }
+        return list;
+    };
+    const struct {
+        const char* name;
+        UploadPath path;
+        WireRenderer* renderer;
+    } configs[] = {{"cpu-mesh", UploadPath::cpu_mesh, &streamed},
+                   {"gpu-rings streamed", UploadPath::gpu_rings, &streamed},
+                   {"gpu-rings retained", UploadPath::gpu_rings, &retained}};
+    for (const auto& config : configs) {
+        const DrawList small = ten(config.path);
+        const DrawList large = thousand(config.path);
+        ASSERT_EQ(small.items.size(), 10u);
+        ASSERT_EQ(large.items.size(), 1000u);
+        DrawStats a, b, c;
+        render(*ctx, *config.renderer, small, scene_camera(), {}, &a);
+        render(*ctx, *config.renderer, large, scene_camera(), {}, &b);
+        render(*ctx, *config.renderer, large, scene_camera(), {}, &c);  // retained: nothing uploads
+        ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        std::printf("%s: 10 wires %zu draw commands in %zu multi-draws; 1,000 wires %zu in %zu (%zu chunks)\n",
+                    config.name, a.indirect_commands, a.multi_draw_calls, b.indirect_commands, b.multi_draw_calls,
+                    b.chunks);
+        EXPECT_EQ(a.draw_items, 10u) << config.name;
+        EXPECT_EQ(b.draw_items, 1000u) << config.name;
+        EXPECT_EQ(b.triangles, 100 * a.triangles) << config.name;
+        EXPECT_EQ(a.indirect_commands, wire::render::draw_commands(small)) << config.name;
+        EXPECT_EQ(b.indirect_commands, a.indirect_commands) << config.name;
+        EXPECT_EQ(c.indirect_commands, a.indirect_commands) << config.name;
+        EXPECT_EQ(b.multi_draw_calls, a.multi_draw_calls) << config.name;
+        EXPECT_EQ(a.multi_draw_calls, 3u) << config.name << ": opaque x 2 materials, blended x 1";
+        if (config.path == UploadPath::cpu_mesh) {
+            EXPECT_EQ(a.indirect_commands, 3u) << "one command per (class, material)";
+        } else {
+            // At most the kinds of chunk per (class, material, side count): 3 tube side counts, strips, lines.
+            EXPECT_LE(a.indirect_commands, 5 * wire::render::kChunkKinds) << config.name;
+            EXPECT_EQ(b.chunks, 100 * a.chunks) << config.name;
+        }
+        if (config.renderer == &retained) {
+            EXPECT_EQ(c.wires_uploaded, 0u);
+        }
+    }
+}
 
 // Item 2 of issue 11: the LOD switches a tube to a strip when its projected radius falls below 2 px
 // (LodSettings::strip_radius_px); the switch must not pop. Random cables (fixed seed), each with the radius that

@@ -8,6 +8,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -45,20 +46,38 @@ struct DecodedFrame {
 // A wire of R rings and n sides has rows of n + 1 vertices (the seam is duplicated for u = 1), one row per ring
 // (a closed wire has one more row: ring 0 again with u = u_close), and, on open wires with caps, two caps of
 // n + 1 vertices (centre + rim) addressed by vertex ids from kCapVertexBase up. One static index pattern per
-// side count: [start cap 3n][end cap 3n][kChunkBands bands of 6n]; a wire with more bands draws several
-// commands over it with base vertex = chunk * kChunkBands * (n + 1). Every vertex is shaded once per draw
-// command, i.e. once per ring row (twice at a chunk boundary).
-// Strips (sides 2) and phone-wire lines (sides 1): 2 vertices a row (wire::write_strip's layout), no caps; one
-// pattern of kChunkBands bands of 6 indices shared by both.
-inline constexpr uint32_t kChunkBands = 128;
+// side count: [start cap 3n][end cap 3n][kChunkBands bands of 6n]. Strips (sides 2) and phone-wire lines
+// (sides 1): 2 vertices a row (wire::write_strip's layout), no caps; one pattern of kChunkBands bands of 6
+// indices shared by both.
+//
+// One draw for all wires (issue 29): a wire's bands are cut into chunks whose sizes are kChunkBands and then the
+// binary digits of the remainder (16, 8, 4, 2, 1), plus one cap chunk on a capped open tube. A chunk is one
+// instance of an instanced indexed draw over a prefix of its side count's pattern; its 8-byte record (draw
+// index, first band) tells the vertex shader whose rings to read. All chunks of one kind (caps, or a band count)
+// and one side count in a material's run are one indirect command, so a frame issues at most
+// kChunkKinds commands per (class, material, side count), whatever the number of wires; every chunk draws
+// exactly its own triangles (no padding) and each vertex is shaded once per chunk it belongs to (a row at a
+// chunk boundary twice).
+inline constexpr uint32_t kChunkBands = 16;
+inline constexpr uint32_t kChunkKinds = 6;  ///< kind 0: caps; kind k >= 1: chunks of kChunkBands >> (k - 1) bands
 inline constexpr uint32_t kCapVertexBase = 1u << 30;
 
 /// Bands (quads rows) of a gpu-rings item: rings - 1, plus 1 on a closed wire; 0 without rings.
 [[nodiscard]] uint32_t band_count(const DrawItem& item);
 /// Whether the item draws anything on `path` (the renderer skips the others).
 [[nodiscard]] bool has_geometry(const DrawItem& item, UploadPath path);
-/// Indirect commands a gpu-rings item needs (1 per started chunk of kChunkBands bands; 1 for caps only).
-[[nodiscard]] uint32_t command_count(const DrawItem& item);
+/// Bands in a chunk of `kind` (>= 1); 0 for the cap kind.
+[[nodiscard]] constexpr uint32_t chunk_kind_bands(uint32_t kind) {
+    return kind == 0 ? 0u : kChunkBands >> (kind - 1);
+}
+/// Chunks of each kind a gpu-rings item draws (all 0 without geometry).
+[[nodiscard]] std::array<uint32_t, kChunkKinds> chunk_counts(const DrawItem& item);
+/// Chunk records a gpu-rings item needs: the sum of chunk_counts.
+[[nodiscard]] uint32_t chunk_count(const DrawItem& item);
+/// Indirect draw commands a frame of `list` issues: cpu-mesh one per run of (class, material); gpu-rings one per
+/// (class, material, side count, chunk kind) in use. Classes: opaque (tubes, strips) and blended (lines, sides 1).
+/// Bounded by the materials, side counts and kinds in use, never by the number of wires.
+[[nodiscard]] std::size_t draw_commands(const DrawList& list);
 /// Vertices (unique, as a mesh would hold them) and triangles of a gpu-rings item: equal to wire::tube_counts.
 [[nodiscard]] uint32_t expanded_vertices(const DrawItem& item);
 [[nodiscard]] uint32_t expanded_triangles(const DrawItem& item);
@@ -66,9 +85,11 @@ inline constexpr uint32_t kCapVertexBase = 1u << 30;
 // ---- bytes per frame ----------------------------------------------------------------------------------------
 inline constexpr std::size_t kDrawRecordBytes = 32;  ///< per drawn item (detail::GpuDraw)
 inline constexpr std::size_t kCommandBytes = 20;     ///< per indirect command (DrawElementsIndirectCommand)
+inline constexpr std::size_t kChunkRecordBytes = 8;  ///< gpu-rings: per chunk (draw index, first band)
+inline constexpr std::size_t kVertexDrawIndexBytes = 4;  ///< cpu-mesh: per vertex, the draw index beside it
 
 /// Bytes a frame of `list` sends when every item's geometry is streamed (cpu-mesh; gpu-rings not retained):
-/// draw records, commands, and vertices + indices or packed rings.
+/// draw records, indirect commands, and vertices + their draw indices + indices, or chunk records + packed rings.
 [[nodiscard]] std::size_t streamed_upload_bytes(const DrawList& list);
 
 // ---- retained ring storage ----------------------------------------------------------------------------------
@@ -116,7 +137,8 @@ private:
 };
 
 /// What a retained gpu-rings frame of `list` uploads given `residency` (updated as the renderer would):
-/// draw records and commands of every drawn item plus the packed rings of the items that must upload.
+/// draw records and chunk records of every drawn item, the frame's commands, plus the packed rings of the items
+/// that must upload.
 struct RetainedFrame {
     std::size_t bytes = 0;
     std::size_t ring_bytes = 0;

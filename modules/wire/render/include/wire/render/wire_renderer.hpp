@@ -1,16 +1,19 @@
 // The wire renderer: draws a frame's DrawList (modules/wire/include/wire/draw.hpp) with batched uploads into
-// persistently mapped buffers and one multi-draw per material. The only wire code that touches GL.
+// persistently mapped buffers and one multi-draw per (class, material): its commands are bounded by the side
+// counts in use, never by the number of wires (issue 29). The only wire code that touches GL.
 //
-// Upload paths: cpu-mesh streams every visible wire's vertices and indices each frame; gpu-rings keeps each
+// Upload paths: cpu-mesh streams every visible wire's vertices, a 4-byte draw index per vertex and its indices
+// (rebased while copying) each frame, and draws a material's wires with one command. gpu-rings keeps each
 // wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
-// a frame sends the rings of changed wires plus one draw record and command per visible wire, and expands the
-// tube in the vertex shader over a static index pattern per side count (each vertex shaded once per ring).
+// a frame sends the rings of changed wires plus one draw record per visible wire and one 8-byte record per chunk
+// of bands, and expands the tube in the vertex shader over a static index pattern per side count, one instance
+// per chunk (each vertex shaded once per ring, twice at a chunk boundary).
 //
 // Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
-// by material, (2) a per-mode "prepare" step that writes each item's draw record and indirect commands (and
-// streams or retains its geometry), (3) one shared submission loop issuing glMultiDrawElementsIndirect per run
-// of equal materials with the mode's program, vertex array and element buffer. A new mode adds a program, a
-// prepare step and its element pattern.
+// by class and material (and side count on gpu-rings), (2) a per-mode "prepare" step that writes each item's
+// draw record and the run's commands (and streams or retains its geometry), (3) one shared submission loop
+// issuing glMultiDrawElementsIndirect per run of equal (class, material) with the mode's program, vertex array
+// and element buffer. A new mode adds a program, a prepare step and its element pattern.
 //
 // \code
 //   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
@@ -68,7 +71,8 @@ struct RendererDesc {
     /// u_to_light, u_light_color, u_ambient, u_specular, u_shininess are declared). A shader that fails to
     /// compile makes create() return the driver's log.
     std::string_view shading_glsl{};
-    /// Use the instanced draw-index attribute even when ARB_shader_draw_parameters is available (tests).
+    /// gpu-rings: use the instanced chunk-index attribute even when ARB_shader_draw_parameters is available
+    /// (tests). cpu-mesh always reads the draw index from its per-vertex attribute.
     bool force_draw_index_attribute = false;
     /// gpu-rings: keep ring records on the GPU between frames (false: stream every visible wire's rings each
     /// frame, the path's behaviour before retention; kept for comparison in benchmarks and tests).
@@ -91,15 +95,22 @@ struct DrawSettings {
 
 /// What one draw() did.
 struct DrawStats {
-    std::size_t bytes_uploaded = 0;  ///< bytes memcpy'd into mapped buffers (geometry, per-draw, commands)
+    /// Bytes written into mapped buffers: draw records (32 B a wire), commands (20 B each), and cpu-mesh
+    /// vertices (32 B) + their draw index (4 B a vertex) + indices (4 B), or gpu-rings chunk records (8 B each)
+    /// + packed rings (28 B each, streamed or uploaded to the retained storage). upload_plan.hpp computes the same.
+    std::size_t bytes_uploaded = 0;
     std::size_t ring_bytes_uploaded = 0;  ///< gpu-rings: the packed ring records among them
     std::size_t wires_uploaded = 0;       ///< gpu-rings: wires whose rings were written this frame
     std::size_t wires_evicted = 0;        ///< gpu-rings retained: ranges freed (wires not drawn for a while)
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
     std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
     std::size_t triangles = 0;          ///< triangles drawn
-    std::size_t indirect_commands = 0;  ///< indirect draw commands written (one per item drawn)
-    std::size_t multi_draw_calls = 0;  ///< one per material in use
+    /// Draw commands issued (indirect commands of the multi-draws): cpu-mesh one per (class, material) in use;
+    /// gpu-rings one per (class, material, side count, chunk kind) in use (wire::render::draw_commands). Does
+    /// not grow with the number of wires.
+    std::size_t indirect_commands = 0;
+    std::size_t multi_draw_calls = 0;  ///< glMultiDrawElementsIndirect calls: one per (class, material) in use
+    std::size_t chunks = 0;            ///< gpu-rings: chunk records (instances) drawn
     bool buffer_grew = false;          ///< the stream buffer was reallocated larger this frame
     bool waited_for_gpu =
         false;  ///< the region's fence had not signalled (more frames in flight than regions)
@@ -130,14 +141,14 @@ public:
     [[nodiscard]] const std::vector<Material>& materials() const;
 
     /// Uploads and draws `list` into the bound framebuffer with depth test and back-face culling (it does not
-    /// clear). All items go into one region of the stream buffer; one glMultiDraw*Indirect per material; the
-    /// region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material <
+    /// clear). All items go into one region of the stream buffer; one glMultiDraw*Indirect per (class,
+    /// material); the region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material <
     /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
     DrawStats draw(const DrawList& list, const engine::scene::Camera& camera,
                     const DrawSettings& settings = {});
 
-    /// True when the draw index comes from gl_BaseInstanceARB (ARB_shader_draw_parameters), false when from
-    /// the instanced attribute.
+    /// True when the gpu-rings chunk index comes from gl_BaseInstanceARB + gl_InstanceID
+    /// (ARB_shader_draw_parameters), false when from the instanced attribute.
     [[nodiscard]] bool uses_draw_parameters() const;
     /// GL buffers of the stream buffer alive now (1 plus retired buffers still waiting for their fences).
     [[nodiscard]] std::size_t live_stream_buffers() const;
