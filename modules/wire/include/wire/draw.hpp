@@ -3,12 +3,14 @@
 // stay valid until the next frame's systems run.
 #pragma once
 
+#include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
 #include "wire/tube.hpp"
 
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -37,6 +39,12 @@ struct DrawItem {
 
     // gpu_rings path
     std::span<const Ring> rings;  ///< ring records (gpu_rings path)
+    /// gpu_rings: `rings` in the GPU's 28-byte form (the rings system packs them on its worker threads); empty:
+    /// the renderer packs them itself. Same count as `rings` when set.
+    std::span<const PackedRing> packed;
+    /// gpu_rings: whether the rings' radius varies along the wire (the shader then tilts normals); unset: the
+    /// renderer checks the rings itself.
+    std::optional<bool> radius_varies;
     uint32_t sides = 8;      ///< radial sides of a tube (>= 3); 2 = camera-facing strip, 1 = one-pixel AA line
     bool closed = false;     ///< closed loop (the last ring connects back to the first)
     bool caps = true;        ///< flat end caps on open wires

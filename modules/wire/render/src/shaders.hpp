@@ -13,11 +13,13 @@ struct GpuDraw {
     uint32_t ring_first;  ///< gpu-rings: first 32-bit word of the wire's PackedRings in the ring SSBO (binding 1)
     uint32_t ring_count;
     uint32_t sides;
-    uint32_t flags;  ///< kClosed | kCaps | kTilt | kStrip | kLine
+    uint32_t flags;  ///< kClosed | kCaps | kTilt | kStrip | kLine | kStreamedRings
     float u_close;
 };
 static_assert(sizeof(GpuDraw) == 32);
 inline constexpr uint32_t kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;  // kStrip: sides 2, kLine: sides 1
+/// Retained path: this wire's rings are in the frame's region (SSBO binding 4), not in the retained storage.
+inline constexpr uint32_t kStreamedRings = 32u;
 
 /// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex) and 3 the vertex's draw index (uint,
 /// streamed beside the vertices). Otherwise the ring expansion from gl_VertexID of an instanced indexed draw over

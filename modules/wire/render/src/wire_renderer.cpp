@@ -97,6 +97,20 @@ struct WireRenderer::State {
     std::vector<DrawElementsIndirectCommand> commands;
     std::vector<uint32_t> chunks;         ///< gpu-rings: (draw index, first band) per chunk, in command order
     std::vector<PackedRing> packed;
+    std::vector<uint8_t> streamed;     ///< retained path, per drawn item (order): rings streamed this frame
+    std::size_t retained_ring_bytes = 0;  ///< retained path: bytes written into the ring storage this frame
+
+    /// The item's rings in GPU form at `out`: the rings system's packed records when the item has them (one
+    /// memcpy), else packed here.
+    void copy_packed(const DrawItem& item, std::byte* out) {
+        if (item.packed.size() == item.rings.size()) {
+            std::memcpy(out, item.packed.data(), item.packed.size_bytes());
+            return;
+        }
+        packed.resize(item.rings.size());
+        pack_rings(item.rings, packed.data());
+        std::memcpy(out, packed.data(), packed.size() * sizeof(PackedRing));
+    }
 
     Status ensure_patterns(uint32_t max_sides) {
         if (max_sides <= pattern_max_sides) return {};
@@ -140,6 +154,8 @@ struct WireRenderer::State {
         ring_storage.begin_frame();
         residency.begin_frame();
         ring_word.clear();
+        streamed.clear();
+        retained_ring_bytes = 0;
         std::size_t kept = 0;
         for (std::size_t k = 0; k < order.size(); ++k) {
             const DrawItem& item = list.items[order[k]];
@@ -153,15 +169,16 @@ struct WireRenderer::State {
                     residency.forget(item.wire_id);
                     continue;
                 }
-                packed.resize(item.rings.size());
-                pack_rings(item.rings, packed.data());
-                std::memcpy(range->data, packed.data(), bytes);  // write-only mapped memory: one memcpy
+                copy_packed(item, static_cast<std::byte*>(range->data));  // write-only mapped memory
                 t.entry->offset_bytes = range->offset_bytes;
                 t.entry->size_bytes = bytes;
+                retained_ring_bytes += bytes;
                 stats.ring_bytes_uploaded += bytes;
                 ++stats.wires_uploaded;
                 stats.buffer_grew = stats.buffer_grew || range->grew;
             }
+            if (t.stream) ++stats.wires_streamed;  // written into the frame's region by draw()
+            streamed.push_back(t.stream ? 1 : 0);
             ring_word.push_back(static_cast<uint32_t>(t.entry->offset_bytes / 4));
             order[kept++] = order[k];
         }
@@ -407,7 +424,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
             const DrawItem& item = list.items[s.order[k]];
             const std::array<uint32_t, kChunkKinds> c = chunk_counts(item);
             for (uint32_t kind = 0; kind < kChunkKinds; ++kind) counts[kind] += c[kind];
-            if (!retained) geometry_bytes += item.rings.size() * sizeof(PackedRing);
+            if (!retained || s.streamed[k]) geometry_bytes += item.rings.size() * sizeof(PackedRing);
         }
         const uint32_t sides = head.sides;
         const uint32_t pattern = s.pattern_first[sides];
@@ -508,27 +525,27 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
             stats.triangles += index_count / 3;
         } else {
             const auto ring_count = static_cast<uint32_t>(item.rings.size());
-            if (retained) {
-                draw.ring_first = s.ring_word[k];
-            } else {
-                s.packed.resize(ring_count);
-                pack_rings(item.rings, s.packed.data());
-                std::memcpy(base + geometry_offset + geometry_cursor, s.packed.data(),
-                            ring_count * sizeof(PackedRing));
+            const bool stream = !retained || s.streamed[k];
+            if (stream) {  // into this frame's region (binding 4); the retained path's moving wires too
+                s.copy_packed(item, base + geometry_offset + geometry_cursor);
                 draw.ring_first = static_cast<uint32_t>(geometry_cursor / 4);
                 geometry_cursor += ring_count * sizeof(PackedRing);
                 stats.ring_bytes_uploaded += ring_count * sizeof(PackedRing);
                 ++stats.wires_uploaded;
+            } else {
+                draw.ring_first = s.ring_word[k];
             }
             draw.ring_count = ring_count;
             draw.sides = item.sides;
             // Normals tilt by the radius slope as write_tube's default does; a wire of constant radius has
             // slope 0 everywhere, so the shader skips the neighbour fetches per vertex for it.
             const float r0 = item.rings.front().radius_m;
-            const bool varying = std::any_of(item.rings.begin(), item.rings.end(),
-                                             [r0](const Ring& r) { return r.radius_m != r0; });
+            const bool varying = item.radius_varies ? *item.radius_varies
+                                                    : std::any_of(item.rings.begin(), item.rings.end(),
+                                                                  [r0](const Ring& r) { return r.radius_m != r0; });
             draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) |
-                         (varying ? detail::kTilt : 0u) | strip_flags;
+                         (varying ? detail::kTilt : 0u) | (stream && retained ? detail::kStreamedRings : 0u) |
+                         strip_flags;
             draw.u_close = item.u_close;
             stats.vertices += expanded_vertices(item);
             stats.triangles += expanded_triangles(item);
@@ -536,7 +553,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         std::memcpy(base + k * sizeof(detail::GpuDraw), &draw, sizeof(draw));
     }
     stats.bytes_uploaded = draws_bytes + chunk_bytes + command_bytes + geometry_bytes + record_bytes + index_bytes +
-                           (retained ? stats.ring_bytes_uploaded : 0);
+                           (retained ? s.retained_ring_bytes : 0);
     stats.draw_items = n;
     stats.chunks = chunk_count_total;
     stats.indirect_commands = s.commands.size();
@@ -577,14 +594,17 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         glVertexArrayElementBuffer(s.cpu_vao.id(), buffer);
         s.cpu_vao.bind();
     } else {
+        // Binding 1: the rings a draw record addresses by default (retained storage, or the frame's region);
+        // binding 4: the frame's region, for retained-path wires streamed this frame (kStreamedRings).
+        const GLintptr geometry_at = static_cast<GLintptr>(region.offset_bytes + geometry_offset);
+        const auto geometry_size = static_cast<GLsizeiptr>(std::max<std::size_t>(geometry_bytes, 4));
         if (retained) {
             glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, s.ring_storage.buffer(), 0,
                               static_cast<GLsizeiptr>(s.ring_storage.capacity_bytes()));
         } else {
-            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, buffer,
-                              static_cast<GLintptr>(region.offset_bytes + geometry_offset),
-                              static_cast<GLsizeiptr>(std::max<std::size_t>(geometry_bytes, 4)));
+            glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 1, buffer, geometry_at, geometry_size);
         }
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 4, buffer, geometry_at, geometry_size);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.circle.id());
         glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 3, buffer,
                           static_cast<GLintptr>(region.offset_bytes + chunk_offset),

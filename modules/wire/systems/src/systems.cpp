@@ -171,6 +171,7 @@ bool restore_curve(WireCurve& c, const SplineSettings& spline) {
 void release_rings(WireRings& r) {
     release(r.params);
     release(r.rings.rings);  // ring 0's frame stays: it seeds the next build's first normal
+    release(r.packed);
 }
 
 template <class T>
@@ -494,6 +495,7 @@ void rings_system(Registry& registry, WireContext& ctx) {
         if (rings.seen_curve == curve->generation && rings.seen_lod == lod->generation && rings.generation != 0) continue;
         jobs.push_back(RingJob{curve, lod, &rings});
     }
+    const bool gpu = ctx.path == UploadPath::gpu_rings;
     parallel_over(jobs.size(), [&](std::size_t i) {
         RingJob& job = jobs[i];
         WireRings& r = *job.rings;
@@ -512,6 +514,17 @@ void rings_system(Registry& registry, WireContext& ctx) {
         r.frame_settings = settings.frames;
         r.motion = motion_reference(nodes);
         keep_rings(scratch, r);
+        {
+            const std::vector<Ring>& built = r.rings.rings;
+            r.radius_varies = std::any_of(built.begin(), built.end(),
+                                          [&](const Ring& g) { return g.radius_m != built.front().radius_m; });
+        }
+        if (gpu) {  // the renderer's form, here on the worker threads: the render thread only copies
+            r.packed.resize(r.rings.rings.size());
+            pack_rings(r.rings.rings, r.packed.data());
+        } else if (!r.packed.empty()) {
+            release(r.packed);
+        }
         ++r.generation;
         r.seen_curve = job.curve->generation;
         r.seen_lod = job.lod->generation;
@@ -611,6 +624,8 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         item.material = style->material;
         item.wire_id = engine::ecs::to_integral(e);
         item.rings = rs.rings;
+        if (ctx.path == UploadPath::gpu_rings && rings->packed.size() == rs.rings.size()) item.packed = rings->packed;
+        item.radius_varies = rings->radius_varies;
         item.rings_generation = rings->generation;
         // Tube sides (>= 3), or 2 for a camera-facing strip, 1 for a phone-wire line.
         item.sides = lod->lod.drawn_sides <= 2 && lod->lod.drawn_sides >= 1 ? lod->lod.drawn_sides
@@ -677,7 +692,7 @@ void add_wire_memory(Registry& registry, Entity e, const WireCurve& c, WireMemor
         visible = l->lod.visible;
     }
     if (const WireRings* r = registry.try_get<WireRings>(e)) {
-        rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
+        rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings) + bytes_of(r->packed);
     }
     if (const WireMesh* w = registry.try_get<WireMesh>(e)) {
         mesh = sizeof(WireMesh) + bytes_of(w->mesh.vertices) + bytes_of(w->mesh.indices);

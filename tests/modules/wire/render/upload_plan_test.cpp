@@ -209,4 +209,32 @@ TEST(UploadPlanTest, ResidencyUploadsOnlyChangedWires) {
     EXPECT_EQ(residency.resident_wires(), 2u);
 }
 
+// A wire whose rings change in two frames running is streamed (no range kept), and stored again the first
+// frame it stays still; a wire that changes once in a while is re-uploaded into a range each time.
+TEST(UploadPlanTest, ResidencyStreamsWiresThatKeepChanging) {
+    std::vector<wire::Ring> rings(10);
+    wire::DrawItem d;
+    d.wire_id = 7;
+    d.rings = rings;
+    d.sides = 8;
+    wire::render::RingResidency residency;
+    auto touch = [&](uint64_t generation) {
+        residency.begin_frame();
+        d.rings_generation = generation;
+        const wire::render::RingResidency::Touch t = residency.touch(d);
+        if (t.upload) t.entry->size_bytes = rings.size() * sizeof(PackedRing);  // as the renderer stores it
+        return std::pair<bool, bool>{t.upload, t.stream};
+    };
+    EXPECT_EQ(touch(1), std::make_pair(true, false)) << "new: stored";
+    EXPECT_EQ(touch(2), std::make_pair(false, true)) << "changed right after: moving, streamed";
+    EXPECT_EQ(touch(3), std::make_pair(false, true));
+    EXPECT_EQ(residency.find(7)->size_bytes, 0u) << "no range while streamed";
+    EXPECT_EQ(touch(3), std::make_pair(true, false)) << "still: stored once";
+    EXPECT_EQ(touch(3), std::make_pair(false, false));
+    EXPECT_EQ(touch(4), std::make_pair(true, false)) << "a change after a still frame: stored";
+    EXPECT_EQ(touch(4), std::make_pair(false, false));
+    EXPECT_EQ(touch(0), std::make_pair(true, false)) << "generation 0 (unknown) after a still frame";
+    EXPECT_EQ(touch(0), std::make_pair(false, true)) << "generation 0 every frame: streamed";
+}
+
 }  // namespace

@@ -916,6 +916,64 @@ TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
     EXPECT_EQ(retained.live_ring_buffers(), 1u);
 }
 
+// Wires whose rings change every frame (a simulation moving them) are streamed with the frame on the retained
+// path, not allocated and freed in the ring storage each frame: from their second change on they are drawn from
+// the frame's region, the storage holds only the still wires, and the picture is the streamed renderer's bit for
+// bit; the first frame they stay still they are stored once, and then nothing moves.
+TEST(WireRendererTest, MovingWiresAreStreamedNotReallocated) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer retained = make_renderer();
+    WireRenderer streamed = make_renderer({.retain_rings = false});
+    wire::render::RingResidency model;
+    const Scene scene = test_scene();
+    const DrawList base = scene.list(UploadPath::gpu_rings);
+    ASSERT_GE(base.items.size(), 4u);
+    const std::size_t moving = base.items.size() / 2;  // items [0, moving) move while `frame < stop`
+    std::size_t still_bytes = 0;
+    std::size_t smallest_moving = SIZE_MAX;
+    for (std::size_t i = moving; i < base.items.size(); ++i) still_bytes += base.items[i].rings.size() * sizeof(wire::PackedRing);
+    for (std::size_t i = 0; i < moving; ++i)
+        smallest_moving = std::min(smallest_moving, base.items[i].rings.size() * sizeof(wire::PackedRing));
+    ASSERT_GT(smallest_moving, 256u * (base.items.size() - moving)) << "the bound below must tell them apart";
+    constexpr int kStop = 8;
+    for (int frame = 0; frame < kStop + 3; ++frame) {
+        DrawList list = base;
+        for (std::size_t i = 0; i < moving; ++i)
+            list.items[i].rings_generation = 100 + static_cast<uint64_t>(std::min(frame, kStop));
+        DrawStats rs, ss;
+        const platform::Image a = render(*ctx, retained, list, scene_camera(), {}, &rs);
+        const platform::Image b = render(*ctx, streamed, list, scene_camera(), {}, &ss);
+        ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        EXPECT_TRUE(a.rgba == b.rgba) << "frame " << frame << ": retained (with streamed wires) and streamed differ";
+        const wire::render::RetainedFrame plan = wire::render::plan_retained_frame(list, model);
+        EXPECT_EQ(rs.bytes_uploaded, plan.bytes) << "frame " << frame;
+        EXPECT_EQ(rs.wires_uploaded, plan.wires_uploaded) << "frame " << frame;
+        glFinish();
+        if (frame == 0) {
+            EXPECT_EQ(rs.wires_streamed, 0u);
+            EXPECT_EQ(rs.wires_uploaded, list.items.size());
+        } else if (frame <= kStop) {  // moving: streamed, the storage holds the still wires only
+            EXPECT_EQ(rs.wires_streamed, moving) << "frame " << frame;
+            EXPECT_EQ(rs.wires_uploaded, moving) << "frame " << frame;
+            // Ranges are rounded up to the storage's alignment (< 256 B each): the still wires' ranges only.
+            EXPECT_GE(retained.ring_storage_live_bytes(), still_bytes) << "frame " << frame;
+            EXPECT_LT(retained.ring_storage_live_bytes(), still_bytes + 256 * (base.items.size() - moving))
+                << "frame " << frame;
+        } else if (frame == kStop + 1) {  // still again: stored once
+            EXPECT_EQ(rs.wires_streamed, 0u);
+            EXPECT_EQ(rs.wires_uploaded, moving);
+        } else {
+            EXPECT_EQ(rs.wires_uploaded, 0u) << "frame " << frame;
+            EXPECT_EQ(rs.bytes_uploaded, list.items.size() * wire::render::kDrawRecordBytes +
+                                             rs.chunks * wire::render::kChunkRecordBytes +
+                                             rs.indirect_commands * wire::render::kCommandBytes);
+        }
+    }
+    EXPECT_EQ(retained.resident_wires(), base.items.size());
+    EXPECT_EQ(retained.allocated_ring_buffers().size(), 1u);
+}
+
 // Turning the camera away and back: wires culled for fewer than retain_frames frames come back without
 // uploading a ring; culled for longer, they were evicted and upload again. Only draw records and commands move.
 TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {

@@ -301,6 +301,36 @@ TEST(WireSystems, GpuRingsPathBuildsNoMeshes) {
     EXPECT_FALSE(w.ctx.draw_list.items[0].vertices.empty());
 }
 
+// On the gpu-rings path the rings system hands the renderer its ring records already packed (on its worker
+// threads), equal to packing them on the render thread, and says whether the radius varies; the cpu-mesh path
+// keeps no packed copy.
+TEST(WireSystems, GpuRingsPathPacksRingsInTheRingsSystem) {
+    World w;
+    w.ctx.path = UploadPath::gpu_rings;
+    WireNodes thick = cable(14, {-2, 0.5, 0}, 4.0, 0.4);
+    thick.radius_m.assign(thick.positions.size(), 0.02f);
+    thick.radius_m[7] = 0.05f;  // a bulge: the radius varies
+    spawn_wire(w.registry, cable(16, {-2, 0, 0}, 4.0, 0.5), {.radius_m = 0.02f});
+    spawn_wire(w.registry, thick, {.radius_m = 0.02f});
+    for (int frame = 0; frame < 2; ++frame) {
+        w.run();
+        ASSERT_EQ(w.ctx.draw_list.items.size(), 2u);
+        for (const DrawItem& item : w.ctx.draw_list.items) {
+            ASSERT_EQ(item.packed.size(), item.rings.size());
+            std::vector<wire::PackedRing> here(item.rings.size());
+            wire::pack_rings(item.rings, here.data());
+            EXPECT_EQ(std::memcmp(here.data(), item.packed.data(), item.packed.size_bytes()), 0);
+            ASSERT_TRUE(item.radius_varies.has_value());
+        }
+        EXPECT_FALSE(*w.ctx.draw_list.items[0].radius_varies);
+        EXPECT_TRUE(*w.ctx.draw_list.items[1].radius_varies);
+    }
+    w.ctx.path = UploadPath::cpu_mesh;
+    w.ctx.camera.position.x += 0.5;  // new counts: the rings are rebuilt on the cpu-mesh path
+    w.run();
+    for (const DrawItem& item : w.ctx.draw_list.items) EXPECT_TRUE(item.packed.empty());
+}
+
 TEST(WireSystems, TessellationMeetsTheScreenTolerance) {
     World w;
     for (int i = 0; i < 20; ++i) spawn_wire(w.registry, cable(32, {-3, 0.2 * i - 2, -0.5 * i}, 6.0, 0.8, i));

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wire/draw.hpp"
+#include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
 
 #include <glm/vec3.hpp>
@@ -18,29 +19,14 @@
 
 namespace wire::render {
 
-/// The ring record as the GPU reads it: 28 bytes (seven 32-bit words) instead of wire::Ring's 48. Centre,
-/// radius and u stay float (the same values as wire::Ring); the frame (normal r, binormal s, tangent t = r x s)
-/// is a unit quaternion in "smallest three" form: the index of the largest component (2 bits) and the other
-/// three in [-1/sqrt 2, 1/sqrt 2] as 20-bit fixed point (step 1.35e-6), the largest made positive and rebuilt
-/// as sqrt(1 - a^2 - b^2 - c^2). Measured in upload_plan_test: frame angle error <= ~2e-6 rad, so the rim
-/// moves < 0.01 px for tubes up to thousands of pixels in radius.
-struct PackedRing {
-    float centre_m[3];
-    float radius_m;
-    float u;
-    uint32_t frame[2];
-};
-static_assert(sizeof(PackedRing) == 28, "PackedRing is the 28-byte GPU ring record");
-inline constexpr uint32_t kPackedRingWords = sizeof(PackedRing) / 4;
-
-[[nodiscard]] PackedRing pack_ring(const Ring& ring);
-void pack_rings(std::span<const Ring> rings, PackedRing* out);
-
-/// The frame a PackedRing decodes to, computed as the vertex shader does (float).
-struct DecodedFrame {
-    glm::vec3 normal{}, binormal{}, tangent{};
-};
-[[nodiscard]] DecodedFrame unpack_frame(const PackedRing& ring);
+// The ring record as the GPU reads it (PackedRing, pack_ring, pack_rings, unpack_frame) lives in the wire core,
+// wire/packed_ring.hpp, so the (parallel) rings system can produce it; these names keep the renderer's.
+using wire::DecodedFrame;
+using wire::kPackedRingWords;
+using wire::pack_ring;
+using wire::pack_rings;
+using wire::PackedRing;
+using wire::unpack_frame;
 
 // ---- indexed expansion --------------------------------------------------------------------------------------
 // A wire of R rings and n sides has rows of n + 1 vertices (the seam is duplicated for u = 1), one row per ring
@@ -101,12 +87,17 @@ struct Residency {
     uint32_t rings = 0;
     uint64_t last_frame = 0;   ///< frame it was last drawn in
     std::size_t offset_bytes = 0;  ///< where the renderer put them (unused by the bench's model)
-    std::size_t size_bytes = 0;
+    std::size_t size_bytes = 0;    ///< 0 while the wire is streamed (no range)
+    uint64_t changed_frame = 0;    ///< the frame its rings last changed (or it appeared)
+    bool streamed = false;         ///< its rings are streamed each frame (it keeps changing), not stored
 };
 
-/// Which wires' ring records are resident. A frame touches each drawn item: a new wire, a changed
-/// rings_generation (or 0) means upload (and the replaced residency's range is returned to be freed). Wires
-/// not drawn for more than `retain_frames` frames are evicted (culled wires keep their range a while: turning
+/// Which wires' ring records are resident. A frame touches each drawn item: a new wire, or a changed
+/// rings_generation (or 0) after a frame without change, means upload into a range (and the replaced residency's
+/// range is returned to be freed). A wire whose rings change in two frames running is moving: its rings are
+/// streamed with the frame (`stream`) instead of allocated and freed in the retained buffer every frame, its
+/// range (if any) freed; the first frame it stays unchanged it is uploaded into a range again. Wires not drawn
+/// for more than `retain_frames` frames are evicted (culled wires keep their range a while: turning
 /// the camera back costs nothing; a destroyed wire's range is freed then and reused, never drawn, since only
 /// drawn items are bound to records).
 class RingResidency {
@@ -116,6 +107,7 @@ public:
     struct Touch {
         Residency* entry = nullptr;
         bool upload = false;                 ///< the item's rings must be written (entry's range to be set)
+        bool stream = false;                 ///< the item's rings go into this frame's stream region instead
         std::optional<Residency> replaced;   ///< the previous residency whose range is now unused
     };
     void begin_frame() { ++frame_; }

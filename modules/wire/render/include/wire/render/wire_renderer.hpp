@@ -101,6 +101,7 @@ struct DrawStats {
     std::size_t bytes_uploaded = 0;
     std::size_t ring_bytes_uploaded = 0;  ///< gpu-rings: the packed ring records among them
     std::size_t wires_uploaded = 0;       ///< gpu-rings: wires whose rings were written this frame
+    std::size_t wires_streamed = 0;  ///< gpu-rings retained: of those, moving wires streamed with the frame
     std::size_t wires_evicted = 0;        ///< gpu-rings retained: ranges freed (wires not drawn for a while)
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
     std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
