@@ -20,6 +20,7 @@ struct SystemsReport {
     std::string memory_lines;  ///< per scene and path: memory table rows
     std::string scene_bytes;   ///< per scene: gpu-rings streamed and retained bytes, cpu-mesh bytes, ratios
     std::string thread_lines;  ///< per scene: 1 vs 2 threads
+    std::string decision_lines;  ///< per scene: adaptive vs uniform CPU, lod share (issue 29's decisions)
     std::string gl_note;       ///< why --gl did not run ("" when it ran or was not asked for)
     // The figures section (`standard`, `offscreen`, `far`; negative: the scene did not run).
     double standard_cpu_ms = 0.0, offscreen_cpu_ms = -1.0, far_cpu_ms = -1.0;
