@@ -31,6 +31,7 @@ void set_up_view(wire::systems::WireContext& ctx, const RunSpec& spec) {
     ctx.viewport_height_px = spec.height_px;
     ctx.camera.aspect = static_cast<float>(spec.width_px) / static_cast<float>(spec.height_px);
     if (!spec.thin_wires) ctx.lod.strip_radius_px = ctx.lod.line_radius_px = -1.0;
+    ctx.fused_stages = spec.fused_stages;
     ctx.camera.far_m = spec.kind == SceneKind::far ? 3000.0f : 500.0f;
     ctx.lod.tolerance_px = kTolerancePx;
 }

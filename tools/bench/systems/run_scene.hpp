@@ -13,6 +13,8 @@
 #include <wire/systems/systems.hpp>
 
 #include <array>
+#include <cstdlib>
+#include <string>
 #include <cstddef>
 #include <functional>
 #include <vector>
@@ -63,6 +65,7 @@ struct RunSpec {
                                     wire::SplineKind::automatic};  ///< the wires' Style::spline (--spline)
     int width_px = 1920, height_px = 1080;  ///< the viewport the LOD sees (the aspect follows)
     bool thin_wires = true;  ///< false: no camera-facing strips or phone-wire lines (every wire a tube)
+    bool fused_stages = true;  ///< WireContext::fused_stages (false: stage by stage, for per-system times)
 };
 
 /// Runs the scene for spec.frames frames under a tbb::global_control of spec.threads.

@@ -36,9 +36,11 @@ struct SystemsReport {
     /// gpu-retained) and bytes uploaded.
     void add_adaptive(const std::string& scene, const std::string& method, int wires, const SceneRun& cpu_run,
                       const SceneRun& gpu_run);
-    /// The uniform baseline's bench.csv row and note, and the scene's per-system CPU row.
+    /// The uniform baseline's bench.csv row and note, and the scene's per-system CPU row. `staged`: the
+    /// per-system medians of a cpu-mesh run stage by stage (WireContext::fused_stages off), so that each system's
+    /// column is its own work and the uniform baseline gets the curve stage alone.
     void add_uniform(const std::string& scene, const std::string& method, int wires, const SceneRun& cpu_run,
-                     const Uniform& u);
+                     const Uniform& u, const std::array<double, kSystems>& staged);
     /// A scene's 1 vs 2 threads row (median wall ms per frame).
     void add_threads(const std::string& scene, double wall_1, double wall_2);
 

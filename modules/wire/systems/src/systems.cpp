@@ -56,6 +56,12 @@ struct CurveJob {
     bool changed = false;
     bool restored = false;  // a released curve rebuilt because the nodes are invalid
     bool kept_released = false;  // a released curve rebuilt in the thread's buffer only (still outside the view)
+    // Fused stages (WireContext::fused_stages): the wire's later components, and what ran right after its curve.
+    WireLodState* lod = nullptr;
+    WireRings* rings = nullptr;
+    WireMesh* mesh = nullptr;
+    unsigned char fused = 0;        // 1: lod updated, 2: rings built, 4: mesh built
+    unsigned char lod_outcome = 0;  // lod_one's
 };
 
 struct LodJob {
@@ -192,6 +198,136 @@ std::size_t bytes_of(const RingSet& r) {
            bytes_of(r.arc_length_m) + bytes_of(r.u) + bytes_of(r.tangent_scratch);
 }
 
+/// The camera as the LOD sees it: `view_generation` moves on when the view or the LOD settings changed (called
+/// by the curve stage, for the stages it runs on, and by the lod stage; the second call changes nothing unless the
+/// camera was moved in between).
+void refresh_view(WireContext& ctx) {
+    const LodView view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
+    if (!ctx.has_view || !(view == ctx.view) || ctx.lod != ctx.seen_lod) {
+        ctx.view = view;
+        ctx.seen_lod = ctx.lod;
+        ctx.has_view = true;
+        ++ctx.view_generation;
+    }
+}
+
+/// One wire's LOD update for `view` (the lod stage's work on one wire, also run right after a changed curve).
+/// Returns 1 when it released the wire's curve (culled while moving), 2 when it restored a released one, else 0.
+unsigned char lod_one(LodJob& job, const LodView& view, const LodSettings& base, uint64_t view_generation) {
+    unsigned char outcome = 0;
+    LodSettings settings = base;
+    settings.max_sides = job.style->max_sides ? job.style->max_sides : kDefaultMaxSides;
+    if (base.max_sides != 0) settings.max_sides = std::min(settings.max_sides, base.max_sides);
+    WireLodState& s = *job.lod;
+    WireCurve& c = *job.curve;
+    // A released curve comes back when its sphere is not outside the view (the view turned to it).
+    if (c.released && !sphere_outside_view(c.bounds, view) && restore_curve(c, c.spline)) {
+        ++c.generation;
+        outcome = 2;
+    }
+    const bool curve_changed = s.seen_curve != c.generation;  // since the last LOD update of this wire
+    const bool kept_bounds = !curve_changed && c.lod_bounds_generation == c.generation;
+    bool changed = false;
+    if (kept_bounds) {
+        // Same curve, new camera: update_lod starts with the sphere test itself; the kept bounds let
+        // WireLod::Coherence answer the camera move.
+        changed = update_lod(c.curve, view, settings, s.lod, c.lod_bounds);
+    } else if (c.released || sphere_outside_view(c.bounds, view)) {
+        // What update_lod gives a wire its sphere culls, without computing the LodBounds.
+        changed = cull_lod(s.lod);
+    } else if (curve_changed && c.bounds_generation == c.generation) {
+        // Moving (or new): this frame's LOD is the only reader of the bounds (not kept, partly built).
+        changed = update_lod_once(c.curve, c.bounds, view, settings, s.lod);
+    } else if (curve_changed) {
+        // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
+        thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
+        scratch.transient = true;        // so none is made
+        bounds_of(c, scratch);
+        changed = update_lod(c.curve, view, settings, s.lod, scratch);
+    } else {
+        // Same curve as the last LOD update, new camera: keep the bounds for the next camera.
+        bounds_of(c, c.lod_bounds);
+        c.lod_bounds_generation = c.generation;
+        changed = update_lod(c.curve, view, settings, s.lod, c.lod_bounds);
+    }
+    if ((curve_changed || !s.lod.visible) && c.lod_bounds.data.capacity() != 0) {
+        // Bounds of an older curve, or of a culled wire (recomputed, in O(segments), when it is in view again).
+        release(c.lod_bounds.data);
+        c.lod_bounds_generation = 0;
+    }
+    if (changed) ++s.generation;
+    ++s.updates;
+    s.seen_curve = c.generation;
+    s.seen_view = view_generation;
+    if (!s.lod.visible) {
+        // Culled: the counts are rebuilt from scratch when it comes back (hysteresis restarts either way).
+        if (s.lod.counts.capacity() != 0) release(s.lod.counts);
+        if (s.lod.required.capacity() != 0) release(s.lod.required);
+        // Culled while moving: the next frame rebuilds the curve anyway (WireCurve).
+        if (curve_changed && !c.released && c.pop_free_stale && !c.blending && !c.curve.segments.empty()) {
+            release_curve(c);
+            outcome = 1;
+        }
+    }
+    return outcome;
+}
+
+/// One wire's rings for its current curve and counts (the rings stage's work on one wire); `gpu`: also packed.
+void rings_one(RingJob& job, bool gpu) {
+    WireRings& r = *job.rings;
+    place_rings(job.curve->curve, job.lod->lod.counts, r.params);
+    RingSettings settings;
+    const WireNodes& nodes = job.curve->previous_nodes;  // the last valid nodes: what the curve shows
+    settings.frames = carried_frames(FrameMethod::double_reflection,
+                                     r.rings.frames.empty() ? nullptr : &r.rings.frames.front(), r.motion, nodes);
+    thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
+    // The float records are built straight into the wire's own buffer (lent to the scratch set for the build,
+    // taken back in keep_rings): each wire's and the thread's buffers keep their capacity, so a frame
+    // allocates only where a wire needs more rings than it ever had (a swap would pass buffers from wire
+    // to wire and keep reallocating).
+    std::swap(scratch.rings, r.rings.rings);
+    build_rings(job.curve->curve, r.params, settings, scratch);
+    r.frame_settings = settings.frames;
+    r.motion = motion_reference(nodes);
+    keep_rings(scratch, r);
+    {
+        const std::vector<Ring>& built = r.rings.rings;
+        r.radius_varies = std::any_of(built.begin(), built.end(),
+                                      [&](const Ring& g) { return g.radius_m != built.front().radius_m; });
+    }
+    if (gpu) {  // the renderer's form, here on the worker threads: the render thread only copies
+        r.packed.resize(r.rings.rings.size());
+        pack_rings(r.rings.rings, r.packed.data());
+    } else if (!r.packed.empty()) {
+        release(r.packed);
+    }
+    ++r.generation;
+    r.seen_curve = job.curve->generation;
+    r.seen_lod = job.lod->generation;
+}
+
+/// One wire's mesh from its rings (the mesh stage's work on one wire).
+void mesh_one(MeshJob& job) {
+    WireMesh& m = *job.mesh;
+    m.sides = job.lod->lod.drawn_sides;
+    m.caps = caps_of(*job.style);
+    const RingSet& rs = job.rings->rings;
+    const TubeSettings ts{.sides = m.sides, .caps = m.caps};
+    // Strip or phone-wire line (drawn_sides 2 or 1): 2 vertices a ring (wire::write_strip); else the tube.
+    const TubeCounts counts = m.sides <= 2 ? strip_counts(rs.rings.size(), rs.closed)
+                                           : tube_counts(rs.rings.size(), rs.closed, ts);
+    m.mesh.origin_m = rs.origin_m;
+    m.mesh.vertices.resize(counts.vertices);
+    m.mesh.indices.resize(counts.indices);
+    if (m.sides <= 2) {
+        write_strip(rs.rings, rs.closed, job.rings->u_close, m.mesh.vertices, m.mesh.indices);
+    } else {
+        write_tube(rs.rings, rs.closed, job.rings->u_close, ts, m.mesh.vertices, m.mesh.indices);
+    }
+    ++m.generation;
+    m.seen_rings = job.rings->generation;
+}
+
 }  // namespace
 
 void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
@@ -208,6 +344,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     for (const Entity e : ctx.blending) work.push_back(e);
     sort_unique(work);
 
+    const bool fused = ctx.fused_stages;
     std::vector<CurveJob>& jobs = reused<CurveJob, 0>();
     jobs.reserve(work.size());
     for (const Entity e : work) {
@@ -217,12 +354,37 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         WireCurve* curve = registry.try_get<WireCurve>(e);
         if (nodes == nullptr || style == nullptr || curve == nullptr) continue;
         jobs.push_back(CurveJob{e, nodes, style, curve, Status::success()});
+        if (fused) {
+            jobs.back().lod = registry.try_get<WireLodState>(e);
+            jobs.back().rings = registry.try_get<WireRings>(e);
+            jobs.back().mesh = registry.try_get<WireMesh>(e);
+        }
     }
 
     const bool pop_free = ctx.pop_free;
     // The view the LOD stage will see (unless the camera changes in between: the LOD stage then restores what
     // needs restoring). A released wire that moved and is still outside it stays released (below).
-    const LodView cull_view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
+    refresh_view(ctx);
+    const LodView& cull_view = ctx.view;
+    const LodSettings lod_base = ctx.lod;
+    const uint64_t view_generation = ctx.view_generation;
+    const bool gpu = ctx.path == UploadPath::gpu_rings;
+    // A wire whose curve changed goes on through lod, rings and mesh here, on this thread, while its curve is in
+    // cache: exactly what the later stages would do for it (they then find it up to date and skip it).
+    const auto go_on = [&](CurveJob& job) {
+        if (!fused || !job.status.ok() || !job.changed || job.lod == nullptr) return;
+        LodJob lod_job{job.style, job.curve, job.lod};
+        job.lod_outcome = lod_one(lod_job, cull_view, lod_base, view_generation);
+        job.fused |= 1;
+        if (job.rings == nullptr || !job.lod->lod.visible) return;
+        RingJob ring_job{job.curve, job.lod, job.rings};
+        rings_one(ring_job, gpu);
+        job.fused |= 2;
+        if (gpu || job.mesh == nullptr) return;
+        MeshJob mesh_job{job.rings, job.lod, job.style, job.mesh, nullptr, 0, nullptr, 0};
+        mesh_one(mesh_job);
+        job.fused |= 4;
+    };
     // One wire's update in two steps around its build, so that up to four wires building their exact curves share
     // build_curves (their tridiagonal solves, a serial chain of divisions each, run side by side).
     struct Step {
@@ -346,6 +508,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         build_curves(std::span(builds, exact));
         for (std::size_t e = 0; e < exact; ++e) job[built[e]].status = std::move(builds[e].status);
         for (std::size_t k = 0; k < count; ++k) finish(job[k], step[k], scratch[k]);
+        for (std::size_t k = 0; k < count; ++k) go_on(job[k]);
     });
 
     // Serial, in entity order: errors (reported once per distinct message), work lists.
@@ -370,20 +533,22 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     for (const CurveJob& job : jobs) {
         ctx.stats.curves_restored += job.restored ? 1u : 0u;
         ctx.stats.curves_released += job.kept_released ? 1u : 0u;
+        ctx.stats.lod_updates += (job.fused & 1) ? 1u : 0u;
+        ctx.stats.rings_built += (job.fused & 2) ? 1u : 0u;
+        ctx.stats.meshes_built += (job.fused & 4) ? 1u : 0u;
+        ctx.stats.curves_released += job.lod_outcome == 1 ? 1u : 0u;
+        ctx.stats.curves_restored += job.lod_outcome == 2 ? 1u : 0u;
     }
     ctx.stats.wires = registry.storage<WireCurve>().size();
     ctx.stats.errors = registry.storage<WireError>().size();
 }
 
 void lod_system(Registry& registry, WireContext& ctx) {
-    const LodView view = lod_view(ctx.camera, ctx.viewport_width_px, ctx.viewport_height_px);
-    const bool view_changed = !ctx.has_view || !(view == ctx.view) || ctx.lod != ctx.seen_lod;
-    if (view_changed) {
-        ctx.view = view;
-        ctx.seen_lod = ctx.lod;
-        ctx.has_view = true;
-        ++ctx.view_generation;
-    }
+    refresh_view(ctx);
+    // The view moved on since the LOD last visited every wire (this frame's curve stage may have updated the
+    // wires it rebuilt for the new view already: they are skipped below as up to date).
+    const bool view_changed = ctx.lod_pass_generation != ctx.view_generation;
+    ctx.lod_pass_generation = ctx.view_generation;
 
     std::vector<LodJob>& jobs = reused<LodJob, 0>();
     auto consider = [&](Entity e, const Style* style, WireCurve* curve, WireLodState* lod) {
@@ -412,64 +577,8 @@ void lod_system(Registry& registry, WireContext& ctx) {
     const LodSettings base = ctx.lod;
     std::vector<unsigned char>& outcome = reused<unsigned char, 0>();  // 1: curve released, 2: curve restored
     outcome.assign(jobs.size(), 0);
-    parallel_over(jobs.size(), [&](std::size_t i) {
-        LodJob& job = jobs[i];
-        LodSettings settings = base;
-        settings.max_sides = job.style->max_sides ? job.style->max_sides : kDefaultMaxSides;
-        if (base.max_sides != 0) settings.max_sides = std::min(settings.max_sides, base.max_sides);
-        WireLodState& s = *job.lod;
-        WireCurve& c = *job.curve;
-        // A released curve comes back when its sphere is not outside the view (the view turned to it).
-        if (c.released && !sphere_outside_view(c.bounds, ctx.view) && restore_curve(c, c.spline)) {
-            ++c.generation;
-            outcome[i] = 2;
-        }
-        const bool curve_changed = s.seen_curve != c.generation;  // since the last LOD update of this wire
-        const bool kept_bounds = !curve_changed && c.lod_bounds_generation == c.generation;
-        bool changed = false;
-        if (kept_bounds) {
-            // Same curve, new camera: update_lod starts with the sphere test itself; the kept bounds let
-            // WireLod::Coherence answer the camera move.
-            changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
-        } else if (c.released || sphere_outside_view(c.bounds, ctx.view)) {
-            // What update_lod gives a wire its sphere culls, without computing the LodBounds.
-            changed = cull_lod(s.lod);
-        } else if (curve_changed && c.bounds_generation == c.generation) {
-            // Moving (or new): this frame's LOD is the only reader of the bounds (not kept, partly built).
-            changed = update_lod_once(c.curve, c.bounds, ctx.view, settings, s.lod);
-        } else if (curve_changed) {
-            // Moving (or new): this frame's LOD is the only reader of the bounds; they are not kept.
-            thread_local LodBounds scratch;  // a new version each compute: a Coherence made with it never matches
-            scratch.transient = true;        // so none is made
-            bounds_of(c, scratch);
-            changed = update_lod(c.curve, ctx.view, settings, s.lod, scratch);
-        } else {
-            // Same curve as the last LOD update, new camera: keep the bounds for the next camera.
-            bounds_of(c, c.lod_bounds);
-            c.lod_bounds_generation = c.generation;
-            changed = update_lod(c.curve, ctx.view, settings, s.lod, c.lod_bounds);
-        }
-        if ((curve_changed || !s.lod.visible) && c.lod_bounds.data.capacity() != 0) {
-            // Bounds of an older curve, or of a culled wire (recomputed, in O(segments), when it is in view again).
-            release(c.lod_bounds.data);
-            c.lod_bounds_generation = 0;
-        }
-        if (changed) ++s.generation;
-        ++s.updates;
-        s.seen_curve = c.generation;
-        s.seen_view = view_generation;
-        if (!s.lod.visible) {
-            // Culled: the counts are rebuilt from scratch when it comes back (hysteresis restarts either way).
-            if (s.lod.counts.capacity() != 0) release(s.lod.counts);
-            if (s.lod.required.capacity() != 0) release(s.lod.required);
-            // Culled while moving: the next frame rebuilds the curve anyway (WireCurve).
-            if (curve_changed && !c.released && c.pop_free_stale && !c.blending && !c.curve.segments.empty()) {
-                release_curve(c);
-                outcome[i] = 1;
-            }
-        }
-    });
-    ctx.stats.lod_updates = jobs.size();
+    parallel_over(jobs.size(), [&](std::size_t i) { outcome[i] = lod_one(jobs[i], ctx.view, base, view_generation); });
+    ctx.stats.lod_updates += jobs.size();
     for (const unsigned char o : outcome) {
         ctx.stats.curves_released += o == 1 ? 1u : 0u;
         ctx.stats.curves_restored += o == 2 ? 1u : 0u;
@@ -496,40 +605,8 @@ void rings_system(Registry& registry, WireContext& ctx) {
         jobs.push_back(RingJob{curve, lod, &rings});
     }
     const bool gpu = ctx.path == UploadPath::gpu_rings;
-    parallel_over(jobs.size(), [&](std::size_t i) {
-        RingJob& job = jobs[i];
-        WireRings& r = *job.rings;
-        place_rings(job.curve->curve, job.lod->lod.counts, r.params);
-        RingSettings settings;
-        const WireNodes& nodes = job.curve->previous_nodes;  // the last valid nodes: what the curve shows
-        settings.frames = carried_frames(FrameMethod::double_reflection,
-                                         r.rings.frames.empty() ? nullptr : &r.rings.frames.front(), r.motion, nodes);
-        thread_local RingSet scratch;  // the double per-ring arrays: per thread, not kept per wire
-        // The float records are built straight into the wire's own buffer (lent to the scratch set for the build,
-        // taken back in keep_rings): each wire's and the thread's buffers keep their capacity, so a frame
-        // allocates only where a wire needs more rings than it ever had (a swap would pass buffers from wire
-        // to wire and keep reallocating).
-        std::swap(scratch.rings, r.rings.rings);
-        build_rings(job.curve->curve, r.params, settings, scratch);
-        r.frame_settings = settings.frames;
-        r.motion = motion_reference(nodes);
-        keep_rings(scratch, r);
-        {
-            const std::vector<Ring>& built = r.rings.rings;
-            r.radius_varies = std::any_of(built.begin(), built.end(),
-                                          [&](const Ring& g) { return g.radius_m != built.front().radius_m; });
-        }
-        if (gpu) {  // the renderer's form, here on the worker threads: the render thread only copies
-            r.packed.resize(r.rings.rings.size());
-            pack_rings(r.rings.rings, r.packed.data());
-        } else if (!r.packed.empty()) {
-            release(r.packed);
-        }
-        ++r.generation;
-        r.seen_curve = job.curve->generation;
-        r.seen_lod = job.lod->generation;
-    });
-    ctx.stats.rings_built = jobs.size();
+    parallel_over(jobs.size(), [&](std::size_t i) { rings_one(jobs[i], gpu); });
+    ctx.stats.rings_built += jobs.size();
 }
 
 void mesh_system(Registry& registry, WireContext& ctx) {
@@ -569,27 +646,9 @@ void mesh_system(Registry& registry, WireContext& ctx) {
             prefetch_lines<true>(next.vertices, next.vertex_count * sizeof(TubeVertex));
             prefetch_lines<true>(next.indices, next.index_count * sizeof(uint32_t));
         }
-        MeshJob& job = jobs[i];
-        WireMesh& m = *job.mesh;
-        m.sides = job.lod->lod.drawn_sides;
-        m.caps = caps_of(*job.style);
-        const RingSet& rs = job.rings->rings;
-        const TubeSettings ts{.sides = m.sides, .caps = m.caps};
-        // Strip or phone-wire line (drawn_sides 2 or 1): 2 vertices a ring (wire::write_strip); else the tube.
-        const TubeCounts counts = m.sides <= 2 ? strip_counts(rs.rings.size(), rs.closed)
-                                               : tube_counts(rs.rings.size(), rs.closed, ts);
-        m.mesh.origin_m = rs.origin_m;
-        m.mesh.vertices.resize(counts.vertices);
-        m.mesh.indices.resize(counts.indices);
-        if (m.sides <= 2) {
-            write_strip(rs.rings, rs.closed, job.rings->u_close, m.mesh.vertices, m.mesh.indices);
-        } else {
-            write_tube(rs.rings, rs.closed, job.rings->u_close, ts, m.mesh.vertices, m.mesh.indices);
-        }
-        ++m.generation;
-        m.seen_rings = job.rings->generation;
+        mesh_one(jobs[i]);
     });
-    ctx.stats.meshes_built = jobs.size();
+    ctx.stats.meshes_built += jobs.size();
 }
 
 void draw_list_system(Registry& registry, WireContext& ctx) {

@@ -226,10 +226,12 @@ std::vector<unsigned char> bytes_of(const DrawList& list) {
     return out;
 }
 
-std::vector<std::vector<unsigned char>> run_scene(int threads, UploadPath path) {
+std::vector<std::vector<unsigned char>> run_scene(int threads, UploadPath path, bool fused = true,
+                                                  std::vector<RunStats>* stats = nullptr, bool turn_away = false) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     World w;
     w.ctx.path = path;
+    w.ctx.fused_stages = fused;
     std::vector<Entity> wires;
     for (int i = 0; i < 150; ++i) {
         wires.push_back(spawn_wire(w.registry, cable(24, {-3.0 + 0.02 * i, 0.05 * (i % 40) - 1, -0.3 * i}, 6.0, 0.6, i),
@@ -245,8 +247,12 @@ std::vector<std::vector<unsigned char>> run_scene(int threads, UploadPath path) 
         if (frame == 4) insert_node(w.registry, wires[10], 6, glm::dvec3(0.0, 0.0, -3.0));
         if (frame == 6) w.registry.destroy(wires[20]);
         if (frame == 7) spawn_wire(w.registry, cable(8, {0, 0, -2}, 1.0, 0.2));  // reuses slot 20
+        // Turned away: moving wires culled (their curves released), and back: restored.
+        if (turn_away && frame == 9) w.ctx.camera.target = {0.0f, 0.0f, 20.0f};
+        if (turn_away && frame == 10) w.ctx.camera.target = {0.0f, 0.0f, 0.0f};
         w.run();
         frames.push_back(bytes_of(w.ctx.draw_list));
+        if (stats) stats->push_back(w.ctx.stats);
     }
     return frames;
 }
@@ -259,6 +265,32 @@ TEST(WireSystems, DrawListIsByteEqualForOneAndTwoThreads) {
         for (std::size_t f = 0; f < one.size(); ++f) {
             EXPECT_GT(one[f].size(), 1000u);
             EXPECT_TRUE(one[f] == two[f]) << "frame " << f << " path " << static_cast<int>(path);
+        }
+    }
+}
+
+// A wire whose curve changed goes on through lod, rings and mesh right after its curve (WireContext::fused_stages):
+// the same draw lists, bit for bit, as stage by stage, on both paths and thread counts, with moving, inserted,
+// destroyed, culled and restored wires; the same work counted (each wire's lod, rings and mesh once).
+TEST(WireSystems, FusedStagesGiveTheSameDrawListsAsStageByStage) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+        for (int threads : {1, 2}) {
+            std::vector<RunStats> fused_stats, staged_stats;
+            const auto fused = run_scene(threads, path, true, &fused_stats, true);
+            const auto staged = run_scene(threads, path, false, &staged_stats, true);
+            ASSERT_EQ(fused.size(), staged.size());
+            for (std::size_t f = 0; f < fused.size(); ++f) {
+                EXPECT_TRUE(fused[f] == staged[f]) << "frame " << f << " path " << static_cast<int>(path);
+                const RunStats &a = fused_stats[f], &b = staged_stats[f];
+                EXPECT_EQ(a.lod_updates, b.lod_updates) << "frame " << f;
+                EXPECT_EQ(a.rings_built, b.rings_built) << "frame " << f;
+                EXPECT_EQ(a.meshes_built, b.meshes_built) << "frame " << f;
+                EXPECT_EQ(a.curves_released, b.curves_released) << "frame " << f;
+                EXPECT_EQ(a.curves_restored, b.curves_restored) << "frame " << f;
+                EXPECT_EQ(a.visible_wires, b.visible_wires) << "frame " << f;
+            }
+            EXPECT_EQ(fused[9].size(), sizeof(UploadPath)) << "turned away: nothing drawn";
+            EXPECT_GT(fused_stats[9].curves_released + fused_stats[10].curves_restored, 0u);
         }
     }
 }

@@ -54,6 +54,10 @@ struct WireContext {
     LodSettings lod{};                           ///< tolerance (px), max rings per segment, hysteresis
     UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_rings stops at ring records
     bool pop_free = true;                        ///< blend when node ids appear or vanish (pop_free.hpp)
+    /// A wire whose curve changed goes on through lod, rings and mesh right after its curve, on the same thread,
+    /// while its curve and rings are still in cache (a moving wire's intermediates are not written out and read
+    /// back by the next pass over all wires). Same results either way; false: stage by stage (to compare).
+    bool fused_stages = true;
     /// Called once per new error (after the curve system, in entity order). Empty: nothing is called.
     std::function<void(const ErrorReport&)> on_error;
 
@@ -67,6 +71,7 @@ struct WireContext {
     uint64_t view_generation = 0;                ///< +1 whenever `view` or the LOD settings change
     LodSettings seen_lod{};                      ///< the LOD settings `view_generation` was taken with
     bool has_view = false;                       ///< `view` was computed at least once
+    uint64_t lod_pass_generation = 0;            ///< view_generation the LOD last visited every wire for
     std::vector<engine::ecs::Entity> curve_changed;  ///< wires whose curve changed this frame
     std::vector<engine::ecs::Entity> blending;       ///< wires in a blend (their curve changes next frame)
 };
