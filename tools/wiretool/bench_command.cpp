@@ -56,9 +56,8 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
     cmd->add_flag(
         "--gl", o->gl,
-        "Draw with the real WireRenderer (headless EGL: llvmpipe, or a GPU's EGL device): every frame of "
-        "`standard` in the systems rows (bench.md), and `standard`, `swaying` and `far` at --size with --wires "
-        "wires on cpu-mesh, gpu-rings streamed and retained at 1, 2 and all threads, plus strips and lines off "
+        "Draw with the real WireRenderer (headless EGL: llvmpipe, or a GPU's EGL device): `standard`, `swaying` "
+        "and `far` at --size with --wires wires on cpu-mesh, gpu-rings streamed and retained at 1, 2 and all threads, plus strips and lines off "
         "with the one-draw baseline (bench_gl.csv, bench_gl.md): systems, draw() and GPU ms, draw commands, "
         "bytes, memory");
     cmd->add_option_function<std::string>(

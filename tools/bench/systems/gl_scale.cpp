@@ -207,6 +207,8 @@ int run_gl_scale_bench(const Options& o) {
     GlScale gl;
     if (scenes.empty()) return exit_ok;
     if (!gl.init(o)) {
+        std::fprintf(stderr, "wiretool bench: --gl: no headless GL context (%s): bench_gl.md says so, no rows\n",
+                     gl.error().c_str());
         md += "No headless GL context (" + gl.error() + "): no rows.\n";
         return write_text(o.out_dir / "bench_gl.md", md) ? exit_ok : exit_failure;
     }

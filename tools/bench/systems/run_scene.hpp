@@ -13,8 +13,6 @@
 #include <wire/systems/systems.hpp>
 
 #include <array>
-#include <cstdlib>
-#include <string>
 #include <cstddef>
 #include <functional>
 #include <vector>

@@ -3,10 +3,9 @@
 // measured screen error, and a uniform tessellation with the same maximum screen error as the baseline.
 // Writes bench.csv and bench.md. The steps: resolve the spline, then per scene the adaptive runs on both
 // upload paths (run_scene.hpp), the uniform baseline (uniform_baseline.hpp) and the thread scaling; then the
-// report (systems_report.hpp). --gl: gl_check.hpp.
+// report (systems_report.hpp). --gl's rows: gl_scale.hpp.
 #include "bench/common.hpp"
 #include "bench/scenes/field_scenes.hpp"
-#include "bench/systems/gl_check.hpp"
 #include "bench/systems/run_scene.hpp"
 #include "bench/systems/systems_report.hpp"
 #include "bench/systems/uniform_baseline.hpp"
@@ -48,9 +47,8 @@ int scene_frames(const Options& o, const SystemsPlan& plan, SceneKind kind) {
     return kind == SceneKind::swaying && o.quick ? 8 : plan.frames;
 }
 
-// The scene on one upload path with the bench's thread count; with --gl, `standard` is also drawn.
-SceneRun run_adaptive(const Options& o, const SystemsPlan& plan, SceneKind kind, wire::UploadPath path,
-                      GlCheck* gl) {
+// The scene on one upload path with the bench's thread count.
+SceneRun run_adaptive(const Options& o, const SystemsPlan& plan, SceneKind kind, wire::UploadPath path) {
     const std::string name = scene_name(kind);
     const bool cpu = path == wire::UploadPath::cpu_mesh;
     const int wires = scene_wire_count(kind);
@@ -66,12 +64,6 @@ SceneRun run_adaptive(const Options& o, const SystemsPlan& plan, SceneKind kind,
                  .error_samples = plan.error_samples,
                  .after_frame = {},
                  .spline = plan.spline};
-    if (gl && kind == SceneKind::standard) {
-        const std::filesystem::path dir = o.out_dir;
-        spec.after_frame = [gl, dir, frames](const wire::systems::WireContext& c, int f) {
-            gl->draw(c, f, frames, dir);
-        };
-    }
     return run_scene(spec);
 }
 
@@ -125,16 +117,12 @@ void note_scene_figures(SystemsReport& report, SceneKind kind, const SceneRun& c
 }
 
 // One scene: adaptive on both paths, the uniform baseline at the cpu-mesh run's sampled frames, the threads.
-void bench_scene(const Options& o, const SystemsPlan& plan, SceneKind kind, GlCheck* gl,
+void bench_scene(const Options& o, const SystemsPlan& plan, SceneKind kind,
                  SystemsReport& report) {
     const std::string name = scene_name(kind);
     const int wires = scene_wire_count(kind);
-    const SceneRun cpu_run = run_adaptive(o, plan, kind, wire::UploadPath::cpu_mesh, gl);
-    const SceneRun gpu_run = run_adaptive(o, plan, kind, wire::UploadPath::gpu_rings, gl);
-    if (gl && kind == SceneKind::standard) {
-        report.standard_systems_wall_cpu = median(cpu_run.frame_wall_ms);
-        report.standard_systems_wall_gpu = median(gpu_run.frame_wall_ms);
-    }
+    const SceneRun cpu_run = run_adaptive(o, plan, kind, wire::UploadPath::cpu_mesh);
+    const SceneRun gpu_run = run_adaptive(o, plan, kind, wire::UploadPath::gpu_rings);
     report.add_adaptive(name, o.spline, wires, cpu_run, gpu_run);
     const Uniform u = search_uniform(cpu_run);
     // Stage by stage, for the per-system columns and the uniform baseline's curve stage (the adaptive rows run
@@ -168,22 +156,16 @@ int run_systems_bench(const Options& o) {
     plan.error_samples = o.quick ? 2 : 3;
 
     SystemsReport report;
-    GlCheck gl_check;
-    if (o.gl && !gl_check.init())
-        report.gl_note =
-            "- --gl: no headless GL context (" + gl_check.error + "); bytes are computed only.\n";
-    GlCheck* gl = o.gl && report.gl_note.empty() ? &gl_check : nullptr;
 
     for (SceneKind kind : {SceneKind::standard, SceneKind::offscreen, SceneKind::swaying, SceneKind::far}) {
-        if (selected(o, scene_name(kind))) bench_scene(o, plan, kind, gl, report);
+        if (selected(o, scene_name(kind))) bench_scene(o, plan, kind, report);
     }
 
     if (!report.csv.write_csv(o.out_dir / "bench.csv")) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench.csv").c_str());
         return exit_failure;
     }
-    if (gl) gl->finish();
-    if (!write_text(o.out_dir / "bench.md", report.markdown(o, plan.frames, gl))) {
+    if (!write_text(o.out_dir / "bench.md", report.markdown(o, plan.frames))) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench.md").c_str());
         return exit_failure;
     }

@@ -117,7 +117,7 @@ void SystemsReport::add_threads(const std::string& scene, double wall_1, double 
     thread_lines += buf;
 }
 
-std::string SystemsReport::markdown(const Options& o, int frames, const GlCheck* gl) const {
+std::string SystemsReport::markdown(const Options& o, int frames) const {
     char buf[2048];
     std::string md = "# wiretool bench: wire systems\n\n";
     std::snprintf(
@@ -240,28 +240,7 @@ std::string SystemsReport::markdown(const Options& o, int frames, const GlCheck*
             md += buf;
         }
     }
-    if (gl) {
-        md += "\n## --gl: WireRenderer on " + gl->context->gl_renderer() +
-              ", `standard`, 480x270, every frame (medians over frames 1..N)\n\n"
-              "| path | frames | bytes matched | bytes/frame (renderer) | systems wall ms | draw() wall ms | "
-              "GPU ms (timer) | draw + glFinish wall ms | end to end ms (systems + draw + finish) |\n"
-              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
-        for (const GlPath& p : gl->paths) {
-            const double systems =
-                &p == &gl->paths[0] ? standard_systems_wall_cpu : standard_systems_wall_gpu;
-            std::snprintf(buf, sizeof buf, "| %s | %zu | %zu | %.0f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
-                          p.name.c_str(), p.frames, p.frames - p.mismatches, median(p.renderer_bytes),
-                          systems, median(p.draw_ms), median(p.gpu_ms), median(p.finish_ms),
-                          systems + median(p.finish_ms));
-            md += buf;
-        }
-        md +=
-            "\nGPU ms: GL_TIME_ELAPSED around the wire pass, read back without stalling "
-            "(engine::gfx::GpuTimer); "
-            "systems wall ms: the five wire systems (the retained path runs the same systems as gpu-rings). "
-            "bench_gl_*.png: the last frame of each path.\n";
-    }
-    md += gl_note;
+    if (o.gl) md += "\n`--gl`: the renderer's rows at scale are in bench_gl.md (systems/gl_scale.hpp).\n";
     if (!thread_lines.empty()) {
         std::string load = "unknown";
         if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {  // other work on the machine skews wall times

@@ -3,7 +3,6 @@
 #pragma once
 
 #include "bench/common.hpp"
-#include "bench/systems/gl_check.hpp"
 #include "bench/systems/run_scene.hpp"
 #include "bench/systems/uniform_baseline.hpp"
 
@@ -21,14 +20,12 @@ struct SystemsReport {
     std::string scene_bytes;   ///< per scene: gpu-rings streamed and retained bytes, cpu-mesh bytes, ratios
     std::string thread_lines;  ///< per scene: 1 vs 2 threads
     std::string decision_lines;  ///< per scene: adaptive vs uniform CPU, lod share (issue 29's decisions)
-    std::string gl_note;       ///< why --gl did not run ("" when it ran or was not asked for)
     // The figures section (`standard`, `offscreen`, `far`; negative: the scene did not run).
     double standard_cpu_ms = 0.0, offscreen_cpu_ms = -1.0, far_cpu_ms = -1.0;
     double bytes_cpu = 0.0, bytes_gpu = 0.0;
     double adaptive_vertices_at_samples = 0.0, uniform_vertices_at_samples = 0.0;
     double far_adaptive_vertices = 0.0, far_uniform_vertices = 0.0;
     std::array<double, kSystems> standard_systems{}, far_systems{};
-    double standard_systems_wall_cpu = 0.0, standard_systems_wall_gpu = 0.0;  ///< --gl's systems wall ms
 
     SystemsReport();
 
@@ -44,8 +41,8 @@ struct SystemsReport {
     /// A scene's 1 vs 2 threads row (median wall ms per frame).
     void add_threads(const std::string& scene, double wall_1, double wall_2);
 
-    /// bench.md. `gl`: the finished --gl check, or null. `frames`: frames per scene run.
-    [[nodiscard]] std::string markdown(const Options& o, int frames, const GlCheck* gl) const;
+    /// bench.md. `frames`: frames per scene run.
+    [[nodiscard]] std::string markdown(const Options& o, int frames) const;
 };
 
 }  // namespace wiretool::bench

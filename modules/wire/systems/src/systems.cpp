@@ -290,14 +290,12 @@ void rings_one(RingJob& job, bool gpu) {
     r.frame_settings = settings.frames;
     r.motion = motion_reference(nodes);
     keep_rings(scratch, r);
-    {
+    if (gpu) {  // the renderer's form, here on the worker threads: the render thread only copies
         const std::vector<Ring>& built = r.rings.rings;
+        r.packed.resize(built.size());
+        pack_rings(built, r.packed.data());
         r.radius_varies = std::any_of(built.begin(), built.end(),
                                       [&](const Ring& g) { return g.radius_m != built.front().radius_m; });
-    }
-    if (gpu) {  // the renderer's form, here on the worker threads: the render thread only copies
-        r.packed.resize(r.rings.rings.size());
-        pack_rings(r.rings.rings, r.packed.data());
     } else if (!r.packed.empty()) {
         release(r.packed);
     }
@@ -683,8 +681,10 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         item.material = style->material;
         item.wire_id = engine::ecs::to_integral(e);
         item.rings = rs.rings;
-        if (ctx.path == UploadPath::gpu_rings && rings->packed.size() == rs.rings.size()) item.packed = rings->packed;
-        item.radius_varies = rings->radius_varies;
+        if (ctx.path == UploadPath::gpu_rings && rings->packed.size() == rs.rings.size()) {
+            item.packed = rings->packed;
+            item.radius_varies = rings->radius_varies;  // computed with `packed`
+        }
         item.rings_generation = rings->generation;
         // Tube sides (>= 3), or 2 for a camera-facing strip, 1 for a phone-wire line.
         item.sides = lod->lod.drawn_sides <= 2 && lod->lod.drawn_sides >= 1 ? lod->lod.drawn_sides

@@ -360,7 +360,10 @@ TEST(WireSystems, GpuRingsPathPacksRingsInTheRingsSystem) {
     w.ctx.path = UploadPath::cpu_mesh;
     w.ctx.camera.position.x += 0.5;  // new counts: the rings are rebuilt on the cpu-mesh path
     w.run();
-    for (const DrawItem& item : w.ctx.draw_list.items) EXPECT_TRUE(item.packed.empty());
+    for (const DrawItem& item : w.ctx.draw_list.items) {
+        EXPECT_TRUE(item.packed.empty());
+        EXPECT_FALSE(item.radius_varies.has_value());
+    }
 }
 
 TEST(WireSystems, TessellationMeetsTheScreenTolerance) {

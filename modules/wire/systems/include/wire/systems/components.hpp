@@ -100,7 +100,7 @@ struct WireRings {
     /// gpu_rings path: rings.rings in the renderer's 28-byte form, packed here in the parallel rings system so
     /// the render thread only copies them (empty on the cpu_mesh path).
     std::vector<PackedRing> packed;
-    bool radius_varies = false;        ///< some ring's radius differs from ring 0's (set by every build)
+    bool radius_varies = false;        ///< with `packed`: some ring's radius differs from ring 0's
     float u_close = 0.0f;              ///< closed wires: texture u where the loop closes (0 for open wires)
     FrameSettings frame_settings{};    ///< what the last build seeded its first normal with (wire_ring_set redoes it)
     MotionReference motion{};          ///< the nodes ring 0's frame was built from: their motion carries it on
