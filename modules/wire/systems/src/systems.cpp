@@ -35,8 +35,15 @@ void parallel_over(std::size_t n, Fn&& fn) {
 
 bool by_index(Entity a, Entity b) { return engine::ecs::to_index(a) < engine::ecs::to_index(b); }
 
+/// Sorted in entity order and each handle once. The order is total (index, then version): a handle destroyed while
+/// blending and the new wire that reuses its slot share an index, and sorting by index alone could leave the new
+/// wire's two copies apart, around the stale handle, where std::unique cannot see them (the same wire then built by
+/// two threads at once).
 void sort_unique(std::vector<Entity>& v) {
-    std::sort(v.begin(), v.end(), by_index);
+    std::sort(v.begin(), v.end(), [](Entity a, Entity b) {
+        const auto ia = engine::ecs::to_index(a), ib = engine::ecs::to_index(b);
+        return ia != ib ? ia < ib : engine::ecs::to_version(a) < engine::ecs::to_version(b);
+    });
     v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 

@@ -466,6 +466,39 @@ TEST(WireSystems, BlendTimeIsSetPerWire) {
     EXPECT_EQ(frames[1], 60);
 }
 
+// Regression (churn_soak under ASan): wires destroyed while blending stay on the blend list for one frame; new
+// wires that reuse their slots (same index, newer version) were sorted by index only among them, so the same new
+// wire could come out twice around its stale handle, be built by two threads at once (use after free in
+// place_rings) and be counted twice. Every valid wire is worked on exactly once.
+TEST(WireSystems, WiresReusingTheSlotsOfBlendingWiresAreBuiltOnce) {
+    World w;
+    constexpr int kWires = 300;
+    std::vector<Entity> old;
+    for (int i = 0; i < kWires; ++i) old.push_back(spawn_wire(w.registry, cable(8, {-2, 0.003 * i, 0}, 4.0, 0.5)));
+    w.run();
+    for (const Entity e : old) {
+        const auto& p = w.registry.get<Nodes>(e).positions;
+        insert_node(w.registry, e, 4, 0.5 * (p[3] + p[4]) + glm::dvec3(0, 0.02, 0));
+    }
+    w.run();
+    std::size_t blending = 0;
+    for (const Entity e : old) blending += w.registry.get<WireCurve>(e).blending ? 1 : 0;
+    ASSERT_EQ(blending, static_cast<std::size_t>(kWires));
+    for (const Entity e : old) w.registry.destroy(e);
+    std::size_t reused_slots = 0;
+    for (int i = 0; i < kWires; ++i) {
+        const Entity e = spawn_wire(w.registry, cable(8, {-2, 0.003 * i, 1}, 4.0, 0.4));
+        for (const Entity o : old) reused_slots += engine::ecs::to_index(o) == engine::ecs::to_index(e) ? 1 : 0;
+    }
+    ASSERT_EQ(reused_slots, static_cast<std::size_t>(kWires));
+    for (int repeat = 0; repeat < 2; ++repeat) {
+        w.run();
+        EXPECT_EQ(w.ctx.stats.curves_built, repeat == 0 ? static_cast<std::size_t>(kWires) : 0u);
+        EXPECT_EQ(w.ctx.stats.errors, 0u);
+    }
+    EXPECT_EQ(w.ctx.draw_list.items.size(), static_cast<std::size_t>(kWires));
+}
+
 TEST(WireSystems, InsertAndRemoveNodeKeepArraysAndIds) {
     World w;
     WireNodes n = cable(6, {-1, 0, 0}, 2.0, 0.2);
