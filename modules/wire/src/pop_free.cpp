@@ -43,6 +43,48 @@ double max_displacement(const CubicBezier& d) {
     }
     return std::max({worst, f1, f2});
 }
+// How far one frame of an event can move the drawn curve (not its points), for a piece drawn as T + k D while the
+// weight k runs from 1 to 0 over N frames (|dk| <= 1.5 / N a frame: smoothstep's peak slope). The drawn piece at
+// weight k is C = T + k D = (1 - k) T + k Q with Q = T + D, so its tangent C' = (1 - k) T' + k Q' lies between T'
+// and Q': a point moved by dk D(u) leaves the curve by at most dk |D x c| with c the unit tangent of C at u, and
+// |D x c| <= |D x t_T| + |D| |t_Q - t_T| (c on the arc between t_T and t_Q). That is the first-order part
+// `across`; sliding along C by dk |D| costs the second-order part dk^2 |D|^2 kappa / 2, with kappa <= max(|T''|,
+// |Q''|) / (min(|T'|, |Q'|) cos(theta / 2))^2 the curvature of C (theta: the angle between T' and Q').
+// A slide along the curve (D along the tangent: both curves pass through the same points at different
+// parameters, as across unequal elements of centripetal or uniform Catmull-Rom) is not a motion of the curve:
+// the event is as long as its motion across needs, not as long as the slide. Sampled (65 points; the caller
+// keeps a margin). Where a tangent vanishes (a tension-1 end) the point's own travel |D| is used.
+struct FrameMotion {
+    double across = 0.0;  // max over u of |D x t_T| + |D| |t_Q - t_T|
+    double curl = 0.0;    // max over u of |D|^2 kappa
+};
+FrameMotion frame_motion(const CubicBezier& t, const CubicBezier& d) {
+    FrameMotion m;
+    const CubicBezier q{t.b0 + d.b0, t.b1 + d.b1, t.b2 + d.b2, t.b3 + d.b3};
+    for (int i = 0; i <= 64; ++i) {
+        const double u = i / 64.0;
+        const dvec3 dv = position(d, u), tv = derivative(t, u), qv = derivative(q, u);
+        const double dl = glm::length(dv), tl = glm::length(tv), ql = glm::length(qv);
+        const double scale = std::max({glm::length(t.b3 - t.b0), glm::length(t.b1 - t.b0), glm::length(t.b2 - t.b3), 1e-300});
+        if (!(tl > 1e-9 * scale) || !(ql > 1e-9 * scale)) {
+            m.across = std::max(m.across, dl);
+            continue;
+        }
+        const dvec3 tt = tv / tl, tq = qv / ql;
+        const double cos_theta = glm::dot(tt, tq);
+        if (!(cos_theta > 0.0)) {  // tangents 90 degrees or more apart: no useful cone
+            m.across = std::max(m.across, dl);
+            continue;
+        }
+        m.across = std::max(m.across, glm::length(glm::cross(dv, tt)) + dl * glm::length(tq - tt));
+        const double cos_half = std::sqrt(0.5 * (1.0 + cos_theta));
+        const double speed = std::min(tl, ql) * cos_half;
+        const double kappa = std::max(glm::length(second_derivative(t, u)), glm::length(second_derivative(q, u))) / (speed * speed);
+        m.curl = std::max(m.curl, dl * dl * kappa);
+    }
+    return m;
+}
+
 double smoothstep(double s) {
     s = std::clamp(s, 0.0, 1.0);
     return s * s * (3.0 - 2.0 * s);
@@ -344,6 +386,9 @@ void PopFreeCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
         std::vector<double> keep(layers);
         for (std::size_t e = 0; e < layers; ++e) keep[e] = 1.0 - smoothstep(static_cast<double>(events_[e].elapsed) / events_[e].frames);
         max_d = 0.0;
+        FrameMotion motion;
+        double gap = 0.0;
+        const Chain whole_t{&T, 0, ts};
         for (Piece& p : pieces_) {
             CubicBezier c = p.offset.back();
             for (std::size_t e = 0; e < layers; ++e) {
@@ -352,10 +397,51 @@ void PopFreeCurve::remap(const Curve& T, const std::vector<uint32_t>& tid) {
             }
             p.offset.assign(1, c);
             max_d = std::max(max_d, max_displacement(c));
+            const FrameMotion pm = frame_motion(sub_segment(T.segments[p.segment], p.u0, p.u1), c);
+            motion.across = std::max(motion.across, pm.across), motion.curl = std::max(motion.curl, pm.curl);
+            // An open wire's end moving along its tangent lengthens or shortens the curve: that is motion.
+            if (!closed && p.segment == 0 && p.u0 == 0.0) motion.across = std::max(motion.across, glm::length(c.b0));
+            if (!closed && p.segment + 1 == ts && p.u1 == 1.0) motion.across = std::max(motion.across, glm::length(c.b3));
         }
-        const double need = 1.5 * max_d / settings_.max_step_m;
+        // How far the curve drawn now (Q, this frame: the event's weight is still 1) is from T, both ways, at the
+        // pieces' samples: a lower bound of the switch's lag (the distance is exact at each sample). The length
+        // below keeps each frame under 0.15 of it, as N >= 15 keeps each frame under 1/10 of max|D| when D runs
+        // point to nearest point: a slide that hardly moves the curve is not blended faster than the curve's
+        // own change allows (uniform Catmull-Rom across unequal elements: points travel far along a curve that
+        // barely changes, and the drawn curve cuts its bends meanwhile).
+        events_.assign(1, Event{0, 1, max_d, 0.0});
+        Curve shown;
+        assemble(T, shown);
+        const Chain whole_q{&shown, 0, shown.segment_count()};
+        const auto distance_to = [](const Chain& chain, const dvec3& x) {
+            const double at = chain.project(x);
+            std::size_t k = 0;
+            double u0 = 0, u1 = 0;
+            locate(at, at, chain.count, k, u0, u1);
+            return glm::length(position(chain.seg(k), u0) - x);
+        };
+        for (const Piece& p : pieces_) {
+            const CubicBezier tp = sub_segment(T.segments[p.segment], p.u0, p.u1);
+            for (int i = 0; i <= 16; ++i) {
+                const dvec3 t = position(tp, i / 16.0);
+                gap = std::max({gap, distance_to(whole_t, t + position(p.offset.back(), i / 16.0)), distance_to(whole_q, t)});
+            }
+        }
+        // The per-frame bound of N frames (see frame_motion): a point moves by at most 1.5 max|D| / N; the curve by
+        // at most 1.5 across / N + 1.125 curl / N^2 (with a 10% margin for the sampling). The shortest N that
+        // keeps either under max_step_m, within [min_frames_, max_frames_].
+        const double step = settings_.max_step_m;
+        const double across = 1.1 * std::min(motion.across, max_d), curl = 1.1 * motion.curl;
+        const auto bound = [&](double n) { return std::min(1.5 * max_d / n, 1.5 * across / n + 1.125 * curl / (n * n)); };
+        // The shortest N whose bound is at most `limit`.
+        const auto need_for = [&](double limit) {
+            return std::min(1.5 * max_d / limit,
+                            (1.5 * across + std::sqrt(2.25 * across * across + 4.5 * limit * curl)) / (2.0 * limit));
+        };
+        // Under max_step_m, and under 0.15 of how far the drawn curve is from T (above).
+        const double need = gap > 0.0 ? std::max(need_for(step), need_for(0.15 * gap)) : need_for(step);
         const int frames = need >= static_cast<double>(max_frames_) ? max_frames_ : std::max(min_frames_, static_cast<int>(std::ceil(need)));
-        events_.assign(1, Event{0, frames, max_d});
+        events_.assign(1, Event{0, frames, max_d, bound(frames)});
         last_frames_ = frames;
         ++started_;
     } else {

@@ -69,14 +69,17 @@ TEST(PopFree, InsertingOnTheCurveAndRemovingDoNotPop) {
         }
     }
     // The pop-free blend must matter: for the default (centripetal) spline the raw jumps exceed 1 mm and the
-    // blend cuts them by more than 20x.
+    // blend cuts them by the design's 10x (the shortest blend, 15 frames, at smoothstep's peak slope 1.5:
+    // 1.5 / 15 of the pop per frame; measured 9.96x for the insertion), asserted with a margin at 8x. (It was
+    // 20x while the parameter slide of centripetal's neighbouring segments stretched this 6.1 mm insertion over
+    // 2.5 s; the event's length now follows how far the curve moves, not how far its parameters slide.)
     const SplineSettings centripetal{};
     const PopNumbers ins = measure_pop(centripetal, base, cable_with_inserted_node(cable, centripetal));
     const PopNumbers rem = measure_pop(centripetal, base, removed);
     EXPECT_GT(ins.unblended_m, 1e-3);
     EXPECT_GT(rem.unblended_m, 1e-3);
-    EXPECT_LT(ins.blended_max_m * 20.0, ins.unblended_m);
-    EXPECT_LT(rem.blended_max_m * 20.0, rem.unblended_m);
+    EXPECT_LT(ins.blended_max_m * 8.0, ins.unblended_m);
+    EXPECT_LT(rem.blended_max_m * 8.0, rem.unblended_m);
     // And without the blend the object shows the raw jump.
     PopFreeCurve raw({.enabled = false});
     Curve r0, r1;

@@ -20,28 +20,40 @@
 //   * no step: at an event's frame w = 0, so the switch shows the previous curve exactly; w is C1 with w' = 0
 //     at both ends, and when an event ends its offset is exactly 0, so the end and the dropping of the ghost
 //     junctions (sub-pieces of T that rejoin) change nothing;
-//   * per-frame jump <= max over the frame of |w(k/N) - w((k-1)/N)| * max_t |D(t)| <= 1.5 max|D| / N;
+//   * per-frame point travel <= max over the frame of |w(k/N) - w((k-1)/N)| * max_t |D(t)| <= 1.5 max|D| / N;
+//     the curve itself moves less where D runs along it (below);
 //   * lag: |rendered - T| <= (1 - w) max|D|; at the switch it is the instant pop itself (P drawn exactly);
 //   * settles: after N frames the event's offset is gone; with no event running the curve drawn is T, bit for
 //     bit (to far better than 1e-6 m).
-// Length of an event: N = blend_s / frame_s (0.25 s: 15 frames at 60 Hz), so that each frame moves the curve by
-// at most 1.5/15 = 1/10 of max|D| (which is the instant pop where D runs point to nearest point), lengthened to
-// 1.5 max|D| / max_step_m frames when that is longer, so that each frame stays under max_step_m (1 mm), and
-// at most max_blend_s (4 s). The bound and its reason: a change of size P cannot move by at most s per frame
-// in fewer than 1.5 P / s frames (smoothstep's peak speed is 1.5x its mean), so "<= 2 mm a frame" and "done in
-// bounded time" meet only up to a size; with the defaults, 1 mm a frame holds up to max|D| = 16 cm, 2 mm up
-// to 32 cm (events in flight add up, hence 1 mm for one event), and a larger change takes 4 s at max|D|/160
-// a frame. A wire held more than 4 s away from its physics is no longer a smoothing.
+// How far a frame moves the drawn curve (not its points): between junctions D pairs points by parameter, and
+// where the two curves' parameter speeds differ (a node inserted or removed changes its neighbours' tangent
+// lengths: centripetal and uniform Catmull-Rom across unequal elements, auto, end-dense spacing) D runs mostly
+// along the curve: on end-dense centripetal cables max|D| was up to 20x the distance between the curves, and
+// 99% of it along the tangent. A point sliding along the curve does not move the curve. The drawn piece at
+// weight k is T + k D = (1 - k) T + k Q (Q = T + D), whose tangent lies between T's and Q's, so one frame moves
+// it by at most 1.5 / N * max(|D x t_T| + |D| |t_Q - t_T|) to first order, plus 1.125 / N^2 * max(|D|^2 kappa)
+// for the slide along a bend (kappa: the curvature bound of the pieces in between); an open wire's end moving
+// along its tangent counts in full (the wire lengthens). Sampled (65 points a piece) with a 10% margin;
+// last_frame_bound_m() is the smaller of this bound and 1.5 max|D| / N.
+// Length of an event: the shortest N >= blend_s / frame_s (0.25 s: 15 frames at 60 Hz) whose frame bound is
+// at most max_step_m (1 mm) and at most 0.15 of how far the drawn curve is from T at the switch (sampled both
+// ways at the pieces, a lower bound of that distance, so a slide with little motion across is not blended
+// faster than that small change allows: uniform's drawn curve cuts bends while it slides), and at most
+// max_blend_s (4 s). For a change without slide the bound is 1.5 max|D| / N: each frame then moves the curve
+// by at most 1/10 of the pop at 15 frames. A change of size P cannot move by at most s per frame in fewer
+// than 1.5 P / s frames (smoothstep's peak speed is 1.5x its mean), so "<= 1 mm a frame" and "done in bounded
+// time" meet only up to a size: with the defaults 1 mm a frame holds up to a motion of 16 cm, and a larger
+// change takes 4 s at 1/160 of it a frame. A wire held more than 4 s away from its physics is no longer a
+// smoothing.
 // Events overlap: the running one is folded into the new one, so the per-frame bound holds for the frame, not
-// per event: the switch frame moves as the folded event would have (<= its bound), later frames by at most
-// 1.5 max|D| / N of the folded event (<= max_step_m up to max|D| = 16 cm). Events arriving faster than one
-// blend restart it; the curve then settles at most max_blend_s after the last event.
-// Known limit: between junctions D pairs points by parameter; where the two curves' parameter speeds differ
-// strongly (uniform Catmull-Rom across very unequal elements) D slides along the curve, max|D| can exceed the
-// pop many times, and the drawn curve can cut a bend by up to ~2x a tiny pop (docs/speed_vs_error.md). It is
-// not only uniform: on end-dense cables max|D| reaches 120x the pop for centripetal and 220x for auto, so their
-// events are lengthened for a slide that barely shows (centripetal end-dense: settles 2 s median, 4 s p90;
-// docs/issue31_popfree.md has the figures and the refinement that was tried).
+// per event: the switch frame moves as the folded event would have (<= its bound), later frames by at most the
+// folded event's frame bound (<= max_step_m up to 16 cm). Events arriving faster than one blend restart it;
+// the curve then settles at most max_blend_s after the last event.
+// Where this stops holding: the sampled bounds are estimates between samples (the 10% margin covers the
+// families in tests/modules/wire/pop_free_family_test.cpp, whose every frame is checked against the bound);
+// points slide along the wire, so the rings placed by parameter move along it by up to 1.5 max|D| / N a
+// frame (the surface stays within the LOD tolerance; a texture seam slides with them); uniform Catmull-Rom's
+// slides still make its blends long (docs/issue31_popfree.md has the figures).
 // Not blended (the new curve is shown at once, counted in unblended()): a node count change when
 // WireNodes::ids is empty (nodes are then named by index), or a change between open and closed.
 // A duplicate id in one state is an error (Status naming the node and the id); the previous curve stays.
@@ -96,6 +108,9 @@ public:
     /// max over the wire of |D| of the newest event, metres (its frames move the curve by at most
     /// 1.5 * that / last_blend_frames()).
     [[nodiscard]] double last_max_offset_m() const { return events_.empty() ? 0.0 : events_.back().max_d; }
+    /// The newest event's bound on how far one of its frames moves the drawn curve, metres (<= max_step_m unless
+    /// the event is too large for max_blend_s); see "Blend length" above.
+    [[nodiscard]] double last_frame_bound_m() const { return events_.empty() ? 0.0 : events_.back().frame_bound_m; }
     /// Geomorphs started so far (an id change that moved nothing starts none).
     [[nodiscard]] std::size_t events_started() const { return started_; }
     /// States that changed topology but were shown without a blend (see above), and the code of the last.
@@ -106,6 +121,7 @@ public:
         int elapsed = 0;     ///< frames since the event's switch frame
         int frames = 1;      ///< its length N
         double max_d = 0.0;  ///< max over the wire of |D|, metres
+        double frame_bound_m = 0.0;  ///< how far one frame moves the drawn curve at most, metres
     };
     struct Piece {           ///< a part [u0, u1] of target segment `segment` carrying offsets
         uint32_t segment = 0;

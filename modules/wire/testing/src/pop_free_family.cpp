@@ -198,7 +198,7 @@ PopFreeFamilyResult run_pop_free_family(const PopFreeFamilySettings& settings) {
         struct Running {
             std::size_t event;
             std::size_t end_frame;
-            double pop, speed;  // speed: the design's per-frame bound 1.5 max|D| / N
+            double pop, speed;  // speed: the design's per-frame bound (PopFreeCurve::last_frame_bound_m)
             std::size_t folded_after = std::numeric_limits<std::size_t>::max();  // folded into a later event
         };
         std::vector<Running> running;
@@ -223,13 +223,14 @@ PopFreeFamilyResult run_pop_free_family(const PopFreeFamilySettings& settings) {
                 out.max_frames = std::max(out.max_frames, e.frames);
                 out.unremedied += m.unremedied() - unremedied;
                 e.offset_m = e.frames > 0 ? m.last_max_offset_m() : 0.0;
-                out.large_events += e.offset_m > out.large_offset_m;
+                e.frame_bound_m = e.frames > 0 ? m.last_frame_bound_m() : 0.0;
+                out.large_events += e.frame_bound_m > settings.jump_bound_m;
                 out.events.push_back(e);
                 if (e.frames > 0) {
                     // The pop-free blend folds the running events into the new one (pop_free.hpp): what is left of them
                     // ends with it, and from the next frame on the new event's speed is the design's bound.
                     for (Running& r : running) r.end_frame = frame + static_cast<std::size_t>(e.frames), r.folded_after = std::min(r.folded_after, frame);
-                    running.push_back({out.events.size() - 1, frame + static_cast<std::size_t>(e.frames), e.pop_m, 1.5 * e.offset_m / e.frames});
+                    running.push_back({out.events.size() - 1, frame + static_cast<std::size_t>(e.frames), e.pop_m, e.frame_bound_m});
                 }
                 if (running.size() > 1) for (const Running& r : running) out.events[r.event].overlapped = true;
             }
@@ -238,7 +239,7 @@ PopFreeFamilyResult run_pop_free_family(const PopFreeFamilySettings& settings) {
             double speed = 0.0;
             bool any_off = false, large = false;
             for (const Running& r : running) {
-                pops += r.pop, speed += frame <= r.folded_after ? r.speed : 0.0, large = large || out.events[r.event].offset_m > out.large_offset_m;
+                pops += r.pop, speed += frame <= r.folded_after ? r.speed : 0.0, large = large || out.events[r.event].frame_bound_m > settings.jump_bound_m;
                 if (r.end_frame > frame) lag_pops += r.pop, any_off = true;
             }
             if (m.blending() != any_off) ++out.state_mismatch;

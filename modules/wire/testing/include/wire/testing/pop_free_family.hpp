@@ -37,6 +37,7 @@ struct PopFreeEvent {
     double length_m = 0.0;    ///< the cable's length
     double pop_m = 0.0;       ///< instant pop: distance between the exact curves before and after
     double offset_m = 0.0;    ///< max|D|: the largest distance a point travels over the blend
+    double frame_bound_m = 0.0;  ///< the event's bound on one frame's motion of the drawn curve
     int frames = 0;           ///< the blend's length (0: nothing to morph)
     double jump_m = 0.0;      ///< largest per-frame jump of the drawn curve while the event ran
     double lag_m = 0.0;       ///< largest distance between the drawn and the exact curve while it ran
@@ -49,13 +50,13 @@ struct PopFreeFamilyResult {
     std::vector<PopFreeEvent> events;
     std::size_t frames = 0;             ///< frames drawn
     double max_jump_m = 0.0;            ///< over every frame while no "large" event runs (below)
-    /// A change too large for jump_bound_m within the longest blend: max|D| above jump_bound_m * N_max / 1.5
-    /// (smoothstep's peak speed is 1.5x its mean; D the event's offset, point to corresponding point). Such
-    /// events still keep the 1/5 ratio, the lag and the settling; their frames move by up to 1.5 max|D| / N_max.
-    double large_offset_m = 0.0;
+    /// A change too large for jump_bound_m within the longest blend: its frame bound
+    /// (PopFreeCurve::last_frame_bound_m) above jump_bound_m even at N_max frames. Such events still keep the
+    /// 1/5 ratio, the lag and the settling; their frames move by up to their frame bound.
+    double large_offset_m = 0.0;  ///< max|D| above which the frame bound 1.5 max|D| / N_max alone exceeds jump_bound_m
     std::size_t large_events = 0;
-    double max_jump_over_design = 0.0;  ///< largest jump / (sum over running events of 1.5 max|D| / N; an event folded
-                                        ///< into a later one counts up to that one's switch frame), large or not
+    double max_jump_over_design = 0.0;  ///< largest jump / (sum over running events of their frame bound; an event
+                                        ///< folded into a later one counts up to that one's switch frame), large or not
     double max_jump_large_m = 0.0;      ///< largest jump in frames where a large event runs
     double max_jump_ratio = 0.0;        ///< per frame: jump / sum of the running events' pops (jump > 1e-9 m)
     double max_lag_ratio = 0.0;         ///< per frame: lag / the same sum (lag > 1e-9 m)
