@@ -4,6 +4,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <vector>
 #include <cassert>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -151,7 +152,7 @@ std::string program_log(GLuint program) {
 }
 
 Expected<GLuint> compile(GLenum stage, std::string_view source, std::string_view label) {
-    const char* stage_name = stage == GL_VERTEX_SHADER ? "vertex" : "fragment";
+    const char* stage_name = stage == GL_VERTEX_SHADER ? "vertex" : stage == GL_COMPUTE_SHADER ? "compute" : "fragment";
     if (source.empty())
         return Error{std::string(stage_name) + " shader of " + quoted_label(label) + " has no source"};
     GLuint shader = glCreateShader(stage);
@@ -173,23 +174,32 @@ Expected<GLuint> compile(GLenum stage, std::string_view source, std::string_view
 }  // namespace
 
 Expected<Program> make_program(const ProgramDesc& desc) {
-    Expected<GLuint> vs = compile(GL_VERTEX_SHADER, desc.vertex, desc.label);
-    if (!vs) return vs.error();
-    Expected<GLuint> fs = compile(GL_FRAGMENT_SHADER, desc.fragment, desc.label);
-    if (!fs) {
-        glDeleteShader(*vs);
-        return fs.error();
+    std::vector<GLuint> shaders;
+    const auto fail = [&](Status error) -> Expected<Program> {
+        for (const GLuint shader : shaders) glDeleteShader(shader);
+        return error;
+    };
+    if (!desc.compute.empty()) {
+        if (!desc.vertex.empty() || !desc.fragment.empty())
+            return Error{"program " + quoted_label(desc.label) + " has a compute shader and a vertex or fragment shader"};
+        Expected<GLuint> cs = compile(GL_COMPUTE_SHADER, desc.compute, desc.label);
+        if (!cs) return cs.error();
+        shaders.push_back(*cs);
+    } else {
+        Expected<GLuint> vs = compile(GL_VERTEX_SHADER, desc.vertex, desc.label);
+        if (!vs) return vs.error();
+        shaders.push_back(*vs);
+        Expected<GLuint> fs = compile(GL_FRAGMENT_SHADER, desc.fragment, desc.label);
+        if (!fs) return fail(fs.error());
+        shaders.push_back(*fs);
     }
     GLuint id = glCreateProgram();
     Program program;
     program.name_ = detail::GlName<detail::delete_program>(id);
-    glAttachShader(id, *vs);
-    glAttachShader(id, *fs);
+    for (const GLuint shader : shaders) glAttachShader(id, shader);
     glLinkProgram(id);
-    glDetachShader(id, *vs);
-    glDetachShader(id, *fs);
-    glDeleteShader(*vs);
-    glDeleteShader(*fs);
+    for (const GLuint shader : shaders) glDetachShader(id, shader);
+    for (const GLuint shader : shaders) glDeleteShader(shader);
     GLint ok = GL_FALSE;
     glGetProgramiv(id, GL_LINK_STATUS, &ok);
     if (ok != GL_TRUE)

@@ -139,6 +139,7 @@ struct ProgramDesc {
     std::string_view vertex{};  // GLSL source, "#version 450 core" first
     std::string_view fragment{};
     std::string_view label{};  // names the program in error messages
+    std::string_view compute{};  // set: a compute program (vertex and fragment must then be empty)
 };
 
 class Program {

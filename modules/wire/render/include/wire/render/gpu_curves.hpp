@@ -1,0 +1,87 @@
+// The curve stage on the GPU (issue 30, step 1 of docs/issue30_plan.md): a compute pass that turns many wires'
+// nodes into their Bezier segments in one dispatch, one invocation per wire, the way wire::build_curve does on the
+// CPU, which stays the reference (tests/modules/wire/render/gpu_curves_test.cpp compares the two).
+//
+//   auto pass = wire::render::GpuCurvePass::create();   // needs a current GL 4.5 context
+//   std::vector<wire::render::GpuCurveWire> wires = ...; // nodes + settings per wire
+//   pass->build(wires);                                   // uploads, dispatches
+//   pass->read_segments(out);                             // (tests, tools) the segments back, per wire
+//
+// Kinds so far: linear; Catmull-Rom / Kochanek-Bartels with any alpha and the wire-wide tension, bias and
+// continuity; c2 (its tangent system solved by one invocation, Thomas in float; closed loops cyclic). Not yet
+// (supported() says so, build() refuses them by name): automatic (its concentrated-turn tension), per-node
+// tension/bias/continuity and curvature-driven tension.
+// Precision: nodes go to the GPU in float relative to the wire's own origin (the centre of its nodes' box,
+// kept in double), so a wire far from the world origin keeps its float precision; the segments come back
+// relative to that origin. Coincident nodes are merged on the CPU by build_curve's own rule
+// (wire::curve_nodes), so both sides build the same curve nodes.
+// Longest wire: bounded by buffer sizes only (one invocation walks its wire; no shared-memory tile).
+#pragma once
+
+#include "wire/curve.hpp"
+#include "wire/nodes.hpp"
+#include "wire/status.hpp"
+
+#include "engine/core/expected.hpp"
+#include "engine/gfx/resources.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace wire::render {
+
+/// One wire's input: its nodes and the settings build_curve would take.
+struct GpuCurveWire {
+    const WireNodes* nodes = nullptr;
+    SplineSettings spline{};
+};
+
+/// The per-wire record the pass reads (std430, 32 bytes).
+struct GpuCurveHeader {
+    uint32_t node_first = 0;     ///< first node in the node buffer
+    uint32_t node_count = 0;     ///< curve nodes (merged)
+    uint32_t segment_first = 0;  ///< first segment in the segment buffer
+    uint32_t flags = 0;          ///< bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2)
+    float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
+};
+static_assert(sizeof(GpuCurveHeader) == 32, "GpuCurveHeader is the 32-byte std430 record");
+
+/// One wire's segments read back: control points relative to `origin_m`.
+struct GpuCurveResult {
+    glm::dvec3 origin_m{};
+    std::vector<CubicBezier> segments;  ///< relative to origin_m (float values, widened)
+    bool closed = false;
+};
+
+class GpuCurvePass {
+public:
+    /// Compiles the compute program. Fails (with the driver's log) without GL 4.3 compute.
+    static engine::Expected<GpuCurvePass> create();
+
+    /// Whether this pass builds `spline` (see the file comment for what it does not yet).
+    [[nodiscard]] static bool supported(const SplineSettings& spline, const WireNodes& nodes);
+
+    /// Builds every wire's segments on the GPU (one dispatch). A wire this pass cannot build (a kind it does not
+    /// support yet, or fewer than 2 distinct nodes, 3 closed) fails the call with a message naming the wire and
+    /// why; nothing is dispatched then. Validate nodes first (build_curve's checks): NaN is not looked for here.
+    [[nodiscard]] Status build(std::span<const GpuCurveWire> wires);
+
+    /// The last build's segments, one result per wire (waits for the GPU).
+    void read_segments(std::vector<GpuCurveResult>& out) const;
+
+    [[nodiscard]] std::size_t node_bytes() const { return node_bytes_; }      ///< uploaded by the last build
+    [[nodiscard]] std::size_t header_bytes() const { return header_bytes_; }  ///< uploaded by the last build
+
+private:
+    engine::gfx::Program program_;
+    engine::gfx::Buffer headers_, nodes_, segments_, scratch_;
+    std::vector<GpuCurveHeader> header_data_;
+    std::vector<glm::dvec3> origins_;
+    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0;
+};
+
+}  // namespace wire::render

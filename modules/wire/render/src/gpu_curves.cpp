@@ -1,0 +1,325 @@
+// The curve stage on the GPU (see gpu_curves.hpp).
+#include "wire/render/gpu_curves.hpp"
+
+#include "wire/spline.hpp"
+
+#include <epoxy/gl.h>
+#include <glm/common.hpp>
+
+#include <algorithm>
+#include <string>
+
+namespace wire::render {
+namespace {
+
+constexpr uint32_t kClosed = 1u;
+constexpr uint32_t kKindShift = 1u;
+constexpr uint32_t kLinear = 0u, kCatmullRom = 1u, kC2 = 2u;
+
+// One invocation per wire. Per curve node j: its incoming and outgoing chords (an open end reflects the missing
+// neighbour: the missing chord equals the other), the knot ratio rho = (l_out / l_in)^alpha, and the
+// Kochanek-Bartels tangents at j; node j writes the start of its outgoing segment (B0, B1 = P + t0 / 3) and the
+// end of its incoming one (B2 = P - t1 / 3, B3), so no segment tangent is stored apart. The same formulas as
+// catmull_rom_tangents in modules/wire/src/spline/build.cpp, in float.
+constexpr const char* kCurveSource = R"glsl(#version 450 core
+layout(local_size_x = 64) in;
+struct Header {
+    uint node_first;
+    uint node_count;
+    uint segment_first;
+    uint flags;
+    vec4 kb;  // alpha, tension, bias, continuity
+};
+layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
+layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };
+layout(std430, binding = 2) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: B0..B3
+layout(std430, binding = 3) buffer Scratch { vec4 scratch[]; };  // c2: 2 per node (solve state, then D)
+uniform uint u_wires;
+
+vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
+
+// c2 (kind 2): node tangents per unit chord D from the C2 spline's tangent system with chordal knots (rows
+// a D[j-1] + 2 D[j] + c D[j+1] = 3 (a e_in + c e_out), a = h_out / (h_in + h_out), c = h_in / (h_in + h_out));
+// open ends not-a-knot (3 nodes: the parabola; 2: the chord), closed loops cyclic (Sherman-Morrison). As
+// start_tangents / finish_tangents in modules/wire/src/spline/build.cpp with no node tensed; Thomas in float
+// (the system is diagonally dominant: b = 2 >= a + c = 1). D[j] goes to scratch[2 (first + j)].xyz.
+uint sidx(Header h, uint j) { return 2u * (h.node_first + j); }
+vec3 chord(Header h, uint k) { uint n = h.node_count; return node(h, (k + 1u) % n) - node(h, k % n); }
+float hlen(Header h, uint k) { return length(chord(h, k)); }
+vec3 unit_chord(Header h, uint k) { return chord(h, k) / hlen(h, k); }
+
+// Row j of the interior system: (a, b, c) and its right-hand side.
+void row(Header h, uint j, out vec3 abc, out vec3 rhs) {
+    uint n = h.node_count;
+    uint kin = (j + n - 1u) % n, kout = j % n;
+    float hin = hlen(h, kin), hout = hlen(h, kout), sum = hin + hout;
+    float a = hout / sum, c = hin / sum;
+    abc = vec3(a, 2.0, c);
+    rhs = 3.0 * (a * unit_chord(h, kin) + c * unit_chord(h, kout));
+}
+
+void c2_tangents(Header h, bool closed) {
+    uint n = h.node_count;
+    if (closed) {
+        // Rows 0 .. n-1 (row j is node j's, wrapping); Thomas on the modified matrix for x (rhs) and z (u) at once.
+        vec3 abc0, r0, abcl, rl;
+        row(h, 0u, abc0, r0);
+        row(h, n - 1u, abcl, rl);
+        float alpha = abcl.z, beta = abc0.x, gamma = -abc0.y;
+        float cp = 0.0;
+        vec4 dp = vec4(0.0);
+        for (uint j = 0u; j < n; ++j) {
+            vec3 abc, rhs;
+            row(h, j, abc, rhs);
+            float b = abc.y;
+            if (j == 0u) b -= gamma;
+            if (j == n - 1u) b -= alpha * beta / gamma;
+            vec4 d = vec4(rhs, j == 0u ? gamma : (j == n - 1u ? alpha : 0.0));
+            float a = j == 0u ? 0.0 : abc.x;
+            float pivot = b - a * cp;
+            cp = abc.z / pivot;
+            dp = (d - a * dp) / pivot;
+            scratch[sidx(h, j)] = dp;
+            scratch[sidx(h, j) + 1u] = vec4(cp, 0.0, 0.0, 0.0);
+        }
+        vec4 x = dp;
+        for (uint i = n - 1u; i-- > 0u;) {
+            x = scratch[sidx(h, i)] - scratch[sidx(h, i) + 1u].x * x;
+            scratch[sidx(h, i)] = x;
+        }
+        vec4 x0 = scratch[sidx(h, 0u)], xl = scratch[sidx(h, n - 1u)];
+        float den = 1.0 + x0.w + beta * xl.w / gamma;
+        vec3 fact = (x0.xyz + beta * xl.xyz / gamma) / den;
+        for (uint i = 0u; i < n; ++i) {
+            vec4 v = scratch[sidx(h, i)];
+            scratch[sidx(h, i)] = vec4(v.xyz - fact * v.w, 0.0);
+        }
+        return;
+    }
+    if (n == 2u) {
+        vec3 e = unit_chord(h, 0u);
+        scratch[sidx(h, 0u)] = vec4(e, 0.0);
+        scratch[sidx(h, 1u)] = vec4(e, 0.0);
+        return;
+    }
+    uint segs = n - 1u;
+    float h0 = hlen(h, 0u), h1 = hlen(h, 1u), hl = hlen(h, segs - 1u), hp = hlen(h, segs - 2u);
+    vec3 s0 = unit_chord(h, 0u), s1 = unit_chord(h, 1u), sl = unit_chord(h, segs - 1u), sp = unit_chord(h, segs - 2u);
+    if (n == 3u) {
+        scratch[sidx(h, 0u)] = vec4(s0 - h0 * (s1 - s0) / (h0 + h1), 0.0);
+        scratch[sidx(h, 1u)] = vec4((h1 * s0 + h0 * s1) / (h0 + h1), 0.0);
+        scratch[sidx(h, 2u)] = vec4(s1 + h1 * (s1 - s0) / (h0 + h1), 0.0);
+        return;
+    }
+    // End rows beta D0 + D1 = r (not-a-knot), eliminated into the first and last interior rows.
+    vec3 r0 = (s0 * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s1) / ((h0 + h1) * (h0 + h1));
+    vec3 rl = (sl * (hp * (3.0 * hl + 2.0 * hp)) + (hl * hl) * sp) / ((hp + hl) * (hp + hl));
+    float beta0 = h1 / (h0 + h1), betal = hp / (hp + hl);
+    uint m = n - 2u;
+    float cp = 0.0;
+    vec3 dp = vec3(0.0);
+    for (uint r = 0u; r < m; ++r) {
+        vec3 abc, rhs;
+        row(h, r + 1u, abc, rhs);
+        float a = abc.x, b = abc.y, c = abc.z;
+        if (r == 0u) { rhs -= (a / beta0) * r0; b -= a / beta0; a = 0.0; }
+        if (r == m - 1u) { rhs -= (c / betal) * rl; b -= c / betal; c = 0.0; }
+        float pivot = b - a * cp;
+        cp = c / pivot;
+        dp = (rhs - a * dp) / pivot;
+        scratch[sidx(h, r + 1u)] = vec4(dp, 0.0);
+        scratch[sidx(h, r + 1u) + 1u] = vec4(cp, 0.0, 0.0, 0.0);
+    }
+    vec3 x = dp;
+    for (uint r = m - 1u; r-- > 0u;) {
+        x = scratch[sidx(h, r + 1u)].xyz - scratch[sidx(h, r + 1u) + 1u].x * x;
+        scratch[sidx(h, r + 1u)] = vec4(x, 0.0);
+    }
+    scratch[sidx(h, 0u)] = vec4((r0 - scratch[sidx(h, 1u)].xyz) / beta0, 0.0);
+    scratch[sidx(h, n - 1u)] = vec4((rl - scratch[sidx(h, n - 2u)].xyz) / betal, 0.0);
+}
+
+void main() {
+    uint w = gl_GlobalInvocationID.x;
+    if (w >= u_wires) return;
+    Header h = headers[w];
+    uint n = h.node_count;
+    bool closed = (h.flags & 1u) != 0u;
+    uint kind = (h.flags >> 1u) & 3u;
+    uint segs = closed ? n : n - 1u;
+    if (kind == 2u) {
+        c2_tangents(h, closed);
+        for (uint k = 0u; k < segs; ++k) {
+            vec3 p0 = node(h, k), p1 = node(h, (k + 1u) % n);
+            float len = hlen(h, k);
+            vec3 t0 = scratch[sidx(h, k)].xyz * len, t1 = scratch[sidx(h, (k + 1u) % n)].xyz * len;
+            uint s = 4u * (h.segment_first + k);
+            segments[s] = vec4(p0, 1.0);
+            segments[s + 1u] = vec4(p0 + t0 / 3.0, 1.0);
+            segments[s + 2u] = vec4(p1 - t1 / 3.0, 1.0);
+            segments[s + 3u] = vec4(p1, 1.0);
+        }
+        return;
+    }
+    float alpha = h.kb.x, keep = 1.0 - h.kb.y, b = h.kb.z, c = h.kb.w;
+    for (uint j = 0u; j < n; ++j) {
+        bool has_in = closed || j > 0u, has_out = closed || j + 1u < n;
+        uint kin = has_in ? (j == 0u ? segs - 1u : j - 1u) : 0u;
+        uint kout = has_out ? (j == segs ? 0u : j) : segs - 1u;
+        vec3 p = node(h, j);
+        vec3 cin = node(h, (kin + 1u) % n) - node(h, kin);
+        vec3 cout = node(h, (kout + 1u) % n) - node(h, kout);
+        vec3 din = has_in ? cin : cout;
+        vec3 dout = has_out ? cout : cin;
+        vec3 t0, t1;
+        if (kind == 0u) {
+            t0 = dout;
+            t1 = din;
+        } else {
+            float lin = length(din), lout = length(dout);
+            float rho;
+            if (alpha == 1.0) rho = lout / lin;
+            else if (alpha == 0.5) rho = sqrt(lout / lin);
+            else rho = exp(clamp(alpha * (log(lout) - log(lin)), -80.0, 80.0));
+            rho = clamp(rho, 1e-30, 1e30);
+            float wt = rho / (1.0 + rho), iw = 1.0 / (1.0 + rho);
+            t0 = keep * (((1.0 + b) * (1.0 + c) * rho * wt) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
+            t1 = keep * (((1.0 + b) * (1.0 - c) * wt) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
+        }
+        if (has_out) {
+            uint s = 4u * (h.segment_first + kout);
+            segments[s] = vec4(p, 1.0);
+            segments[s + 1u] = vec4(p + t0 / 3.0, 1.0);
+        }
+        if (has_in) {
+            uint s = 4u * (h.segment_first + kin);
+            segments[s + 2u] = vec4(p - t1 / 3.0, 1.0);
+            segments[s + 3u] = vec4(p, 1.0);
+        }
+    }
+}
+)glsl";
+
+bool per_node_kb(const WireNodes& nodes) {
+    return !nodes.kb_tension.empty() || !nodes.kb_bias.empty() || !nodes.kb_continuity.empty();
+}
+
+bool physics(const SplineSettings& spline, const WireNodes& nodes) {
+    return spline.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
+           !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
+}
+
+}  // namespace
+
+engine::Expected<GpuCurvePass> GpuCurvePass::create() {
+    engine::Expected<engine::gfx::Program> program =
+        engine::gfx::make_program({.label = "wire gpu curves", .compute = kCurveSource});
+    if (!program) return program.error();
+    GpuCurvePass pass;
+    pass.program_ = std::move(*program);
+    return pass;
+}
+
+bool GpuCurvePass::supported(const SplineSettings& spline, const WireNodes& nodes) {
+    switch (spline.kind) {
+    case SplineKind::linear:
+    case SplineKind::c2:
+        return true;  // no tension (c2: none applies; build_curve reads none)
+    case SplineKind::catmull_rom:
+        return !per_node_kb(nodes) && !physics(spline, nodes);
+    default:
+        return false;
+    }
+}
+
+Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
+    header_data_.clear();
+    origins_.clear();
+    std::vector<glm::vec4> node_data;
+    std::vector<glm::dvec3> curve;
+    uint32_t segment_first = 0;
+    for (std::size_t w = 0; w < wires.size(); ++w) {
+        const GpuCurveWire& wire = wires[w];
+        const std::string name = "wire " + std::to_string(w) + ": ";
+        if (wire.nodes == nullptr) return Status::error(name + "no nodes");
+        if (!supported(wire.spline, *wire.nodes)) {
+            return Status::error(name + "the GPU curve pass builds linear, c2 and Catmull-Rom wires with "
+                                        "wire-wide settings only (automatic, and Catmull-Rom with per-node "
+                                        "tension/bias/continuity or curvature-driven tension, stay on the CPU "
+                                        "path for now)");
+        }
+        const std::size_t n = curve_nodes(*wire.nodes, wire.spline, curve);
+        if (n < (wire.spline.closed ? 3u : 2u)) {
+            return Status::error(name + "a wire needs at least " + std::string(wire.spline.closed ? "3" : "2") +
+                                 " distinct nodes, got " + std::to_string(n) + " after merging coincident ones");
+        }
+        // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
+        glm::dvec3 lo = curve.front(), hi = curve.front();
+        for (const glm::dvec3& p : curve) lo = glm::min(lo, p), hi = glm::max(hi, p);
+        const glm::dvec3 origin = 0.5 * (lo + hi);
+        origins_.push_back(origin);
+        GpuCurveHeader h;
+        h.node_first = static_cast<uint32_t>(node_data.size());
+        h.node_count = static_cast<uint32_t>(n);
+        h.segment_first = segment_first;
+        const uint32_t kind = wire.spline.kind == SplineKind::linear ? kLinear
+                              : wire.spline.kind == SplineKind::c2 ? kC2
+                                                                   : kCatmullRom;
+        h.flags = (wire.spline.closed ? kClosed : 0u) | (kind << kKindShift);
+        h.alpha = static_cast<float>(wire.spline.alpha);
+        h.tension = static_cast<float>(wire.spline.tension);
+        h.bias = static_cast<float>(wire.spline.bias);
+        h.continuity = static_cast<float>(wire.spline.continuity);
+        header_data_.push_back(h);
+        for (const glm::dvec3& p : curve) node_data.emplace_back(glm::vec3(p - origin), 0.0f);
+        segment_first += static_cast<uint32_t>(wire.spline.closed ? n : n - 1);
+    }
+    segment_total_ = segment_first;
+    node_bytes_ = node_data.size() * sizeof(glm::vec4);
+    header_bytes_ = header_data_.size() * sizeof(GpuCurveHeader);
+    if (wires.empty()) return Status::success();
+
+    auto headers = engine::gfx::make_buffer(std::span<const GpuCurveHeader>(header_data_), "wire gpu curve headers");
+    auto nodes = engine::gfx::make_buffer(std::span<const glm::vec4>(node_data), "wire gpu curve nodes");
+    auto segments = engine::gfx::make_buffer({.size_bytes = segment_total_ * 4 * sizeof(glm::vec4),
+                                              .dynamic = true, .label = "wire gpu curve segments"});
+    auto scratch = engine::gfx::make_buffer({.size_bytes = node_data.size() * 2 * sizeof(glm::vec4),
+                                             .label = "wire gpu curve scratch"});
+    for (const auto* b : {&headers, &nodes, &segments, &scratch}) {
+        if (!*b) return Status::error(b->error().message);
+    }
+    headers_ = std::move(*headers), nodes_ = std::move(*nodes), segments_ = std::move(*segments);
+    scratch_ = std::move(*scratch);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
+    program_.use();
+    glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(wires.size()));
+    glDispatchCompute(static_cast<GLuint>((wires.size() + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    return Status::success();
+}
+
+void GpuCurvePass::read_segments(std::vector<GpuCurveResult>& out) const {
+    out.clear();
+    if (header_data_.empty()) return;
+    std::vector<glm::vec4> data(segment_total_ * 4);
+    glGetNamedBufferSubData(segments_.id(), 0, static_cast<GLsizeiptr>(data.size() * sizeof(glm::vec4)), data.data());
+    out.resize(header_data_.size());
+    for (std::size_t w = 0; w < header_data_.size(); ++w) {
+        const GpuCurveHeader& h = header_data_[w];
+        GpuCurveResult& r = out[w];
+        r.origin_m = origins_[w];
+        r.closed = (h.flags & kClosed) != 0;
+        const std::size_t segs = r.closed ? h.node_count : h.node_count - 1;
+        r.segments.resize(segs);
+        for (std::size_t k = 0; k < segs; ++k) {
+            const glm::vec4* s = &data[4 * (h.segment_first + k)];
+            r.segments[k] = CubicBezier{glm::dvec3(s[0]), glm::dvec3(s[1]), glm::dvec3(s[2]), glm::dvec3(s[3])};
+        }
+    }
+}
+
+}  // namespace wire::render
