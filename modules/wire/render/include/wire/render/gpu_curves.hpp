@@ -36,8 +36,8 @@ namespace wire::render {
 
 /// One wire's input: its nodes and the settings build_curve would take.
 struct GpuCurveWire {
-    const WireNodes* nodes = nullptr;
-    SplineSettings spline{};
+    const WireNodes* nodes = nullptr;  ///< validated nodes (build_curve's checks), kept alive through build()
+    SplineSettings spline{};           ///< its kind and settings, closed included
 };
 
 /// The per-wire record the pass reads (std430, 32 bytes).
@@ -54,9 +54,10 @@ static_assert(sizeof(GpuCurveHeader) == 32, "GpuCurveHeader is the 32-byte std43
 struct GpuCurveResult {
     glm::dvec3 origin_m{};
     std::vector<CubicBezier> segments;  ///< relative to origin_m (float values, widened)
-    bool closed = false;
+    bool closed = false;                ///< a closed loop (one segment per node)
 };
 
+/// The compute pass (owns its GL program and buffers: create, use and destroy it with the same context current).
 class GpuCurvePass {
 public:
     /// Compiles the compute program. Fails (with the driver's log) without GL 4.3 compute.
