@@ -69,6 +69,7 @@ public:
     /// Builds every wire's segments on the GPU (one dispatch). A wire this pass cannot build (a kind it does not
     /// support yet, or fewer than 2 distinct nodes, 3 closed) fails the call with a message naming the wire and
     /// why; nothing is dispatched then. Validate nodes first (build_curve's checks): NaN is not looked for here.
+    /// Leaves shader storage bindings 0-3 pointing at its buffers and no program in use.
     [[nodiscard]] Status build(std::span<const GpuCurveWire> wires);
 
     /// The last build's segments, one result per wire (waits for the GPU).
