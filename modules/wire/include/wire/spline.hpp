@@ -84,8 +84,10 @@ void build_curves(std::span<CurveBuildJob> jobs);
 /// The curve nodes build_curve builds `nodes` through: coincident neighbours merged by its rule and epsilon
 /// (the first of a group kept; a closed loop's last node dropped where it coincides with its first). Positions
 /// only, no validation (build_curve's checks come first). Returns out.size(); fewer than 2 (3 closed) means
-/// build_curve fails on the wire.
-std::size_t curve_nodes(const WireNodes& nodes, const SplineSettings& settings, std::vector<glm::dvec3>& out);
+/// build_curve fails on the wire. `source` (optional): per curve node, the input node its per-node values come
+/// from (the first of its group, as build_curve reads them).
+std::size_t curve_nodes(const WireNodes& nodes, const SplineSettings& settings, std::vector<glm::dvec3>& out,
+                        std::vector<uint32_t>* source = nullptr);
 
 /// The thesis' curvature-driven tension for one node: R = theta*Iz*L / (A*dL^2); 0 if R > 100 (or dL = 0),
 /// else 1 - tanh(R/50). Non-finite or non-positive denominators give 0.

@@ -29,11 +29,14 @@ struct Header {
     uint segment_first;
     uint flags;
     vec4 kb;  // alpha, tension, bias, continuity
+    uint per_node_first;  // 0xffffffff: wire-wide kb
+    uint pad0, pad1, pad2;
 };
 layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
 layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };
 layout(std430, binding = 2) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: B0..B3
-layout(std430, binding = 3) buffer Scratch { vec4 scratch[]; };  // c2: 2 per node (solve state, then D)
+layout(std430, binding = 3) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
+layout(std430, binding = 4) readonly buffer PerNode { vec4 per_node[]; };  // tension, bias, continuity, 0
 uniform uint u_wires;
 
 vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
@@ -41,20 +44,23 @@ vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
 // c2 (kind 2): node tangents per unit chord D from the C2 spline's tangent system with chordal knots (rows
 // a D[j-1] + 2 D[j] + c D[j+1] = 3 (a e_in + c e_out), a = h_out / (h_in + h_out), c = h_in / (h_in + h_out));
 // open ends not-a-knot (3 nodes: the parabola; 2: the chord), closed loops cyclic (Sherman-Morrison). As
-// start_tangents / finish_tangents in modules/wire/src/spline/build.cpp with no node tensed; Thomas in float
-// (the system is diagonally dominant: b = 2 >= a + c = 1). D[j] goes to scratch[2 (first + j)].xyz.
+// start_tangents / finish_tangents in modules/wire/src/spline/build.cpp with no node tensed. In double: the
+// not-a-knot end D0 = (r0 - D1) / beta0 cancels by the ratio of the first two chords (beta0 = h1 / (h0 + h1)),
+// which in float moved a 4-node wire with 100:1 chords by 1e-4 of its extent; the float nodes' differences are
+// exact in double. D[j] goes to scratch[2 (first + j)].xyz.
 uint sidx(Header h, uint j) { return 2u * (h.node_first + j); }
-vec3 chord(Header h, uint k) { uint n = h.node_count; return node(h, (k + 1u) % n) - node(h, k % n); }
-float hlen(Header h, uint k) { return length(chord(h, k)); }
-vec3 unit_chord(Header h, uint k) { return chord(h, k) / hlen(h, k); }
+dvec3 dnode(Header h, uint j) { return dvec3(node(h, j % h.node_count)); }
+dvec3 chord(Header h, uint k) { return dnode(h, k + 1u) - dnode(h, k); }
+double hlen(Header h, uint k) { return length(chord(h, k)); }
+dvec3 unit_chord(Header h, uint k) { return chord(h, k) / hlen(h, k); }
 
 // Row j of the interior system: (a, b, c) and its right-hand side.
-void row(Header h, uint j, out vec3 abc, out vec3 rhs) {
+void row(Header h, uint j, out dvec3 abc, out dvec3 rhs) {
     uint n = h.node_count;
     uint kin = (j + n - 1u) % n, kout = j % n;
-    float hin = hlen(h, kin), hout = hlen(h, kout), sum = hin + hout;
-    float a = hout / sum, c = hin / sum;
-    abc = vec3(a, 2.0, c);
+    double hin = hlen(h, kin), hout = hlen(h, kout), sum = hin + hout;
+    double a = hout / sum, c = hin / sum;
+    abc = dvec3(a, 2.0, c);
     rhs = 3.0 * (a * unit_chord(h, kin) + c * unit_chord(h, kout));
 }
 
@@ -62,81 +68,81 @@ void c2_tangents(Header h, bool closed) {
     uint n = h.node_count;
     if (closed) {
         // Rows 0 .. n-1 (row j is node j's, wrapping); Thomas on the modified matrix for x (rhs) and z (u) at once.
-        vec3 abc0, r0, abcl, rl;
+        dvec3 abc0, r0, abcl, rl;
         row(h, 0u, abc0, r0);
         row(h, n - 1u, abcl, rl);
-        float alpha = abcl.z, beta = abc0.x, gamma = -abc0.y;
-        float cp = 0.0;
-        vec4 dp = vec4(0.0);
+        double alpha = abcl.z, beta = abc0.x, gamma = -abc0.y;
+        double cp = 0.0;
+        dvec4 dp = dvec4(0.0);
         for (uint j = 0u; j < n; ++j) {
-            vec3 abc, rhs;
+            dvec3 abc, rhs;
             row(h, j, abc, rhs);
-            float b = abc.y;
+            double b = abc.y;
             if (j == 0u) b -= gamma;
             if (j == n - 1u) b -= alpha * beta / gamma;
-            vec4 d = vec4(rhs, j == 0u ? gamma : (j == n - 1u ? alpha : 0.0));
-            float a = j == 0u ? 0.0 : abc.x;
-            float pivot = b - a * cp;
+            dvec4 d = dvec4(rhs, j == 0u ? gamma : (j == n - 1u ? alpha : 0.0));
+            double a = j == 0u ? 0.0 : abc.x;
+            double pivot = b - a * cp;
             cp = abc.z / pivot;
             dp = (d - a * dp) / pivot;
             scratch[sidx(h, j)] = dp;
-            scratch[sidx(h, j) + 1u] = vec4(cp, 0.0, 0.0, 0.0);
+            scratch[sidx(h, j) + 1u] = dvec4(cp, 0.0, 0.0, 0.0);
         }
-        vec4 x = dp;
+        dvec4 x = dp;
         for (uint i = n - 1u; i-- > 0u;) {
             x = scratch[sidx(h, i)] - scratch[sidx(h, i) + 1u].x * x;
             scratch[sidx(h, i)] = x;
         }
-        vec4 x0 = scratch[sidx(h, 0u)], xl = scratch[sidx(h, n - 1u)];
-        float den = 1.0 + x0.w + beta * xl.w / gamma;
-        vec3 fact = (x0.xyz + beta * xl.xyz / gamma) / den;
+        dvec4 x0 = scratch[sidx(h, 0u)], xl = scratch[sidx(h, n - 1u)];
+        double den = 1.0 + x0.w + beta * xl.w / gamma;
+        dvec3 fact = (x0.xyz + beta * xl.xyz / gamma) / den;
         for (uint i = 0u; i < n; ++i) {
-            vec4 v = scratch[sidx(h, i)];
-            scratch[sidx(h, i)] = vec4(v.xyz - fact * v.w, 0.0);
+            dvec4 v = scratch[sidx(h, i)];
+            scratch[sidx(h, i)] = dvec4(v.xyz - fact * v.w, 0.0);
         }
         return;
     }
     if (n == 2u) {
-        vec3 e = unit_chord(h, 0u);
-        scratch[sidx(h, 0u)] = vec4(e, 0.0);
-        scratch[sidx(h, 1u)] = vec4(e, 0.0);
+        dvec3 e = unit_chord(h, 0u);
+        scratch[sidx(h, 0u)] = dvec4(e, 0.0);
+        scratch[sidx(h, 1u)] = dvec4(e, 0.0);
         return;
     }
     uint segs = n - 1u;
-    float h0 = hlen(h, 0u), h1 = hlen(h, 1u), hl = hlen(h, segs - 1u), hp = hlen(h, segs - 2u);
-    vec3 s0 = unit_chord(h, 0u), s1 = unit_chord(h, 1u), sl = unit_chord(h, segs - 1u), sp = unit_chord(h, segs - 2u);
+    double h0 = hlen(h, 0u), h1 = hlen(h, 1u), hl = hlen(h, segs - 1u), hp = hlen(h, segs - 2u);
+    dvec3 s0 = unit_chord(h, 0u), s1 = unit_chord(h, 1u), sl = unit_chord(h, segs - 1u), sp = unit_chord(h, segs - 2u);
     if (n == 3u) {
-        scratch[sidx(h, 0u)] = vec4(s0 - h0 * (s1 - s0) / (h0 + h1), 0.0);
-        scratch[sidx(h, 1u)] = vec4((h1 * s0 + h0 * s1) / (h0 + h1), 0.0);
-        scratch[sidx(h, 2u)] = vec4(s1 + h1 * (s1 - s0) / (h0 + h1), 0.0);
+        scratch[sidx(h, 0u)] = dvec4(s0 - h0 * (s1 - s0) / (h0 + h1), 0.0);
+        scratch[sidx(h, 1u)] = dvec4((h1 * s0 + h0 * s1) / (h0 + h1), 0.0);
+        scratch[sidx(h, 2u)] = dvec4(s1 + h1 * (s1 - s0) / (h0 + h1), 0.0);
         return;
     }
     // End rows beta D0 + D1 = r (not-a-knot), eliminated into the first and last interior rows.
-    vec3 r0 = (s0 * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s1) / ((h0 + h1) * (h0 + h1));
-    vec3 rl = (sl * (hp * (3.0 * hl + 2.0 * hp)) + (hl * hl) * sp) / ((hp + hl) * (hp + hl));
-    float beta0 = h1 / (h0 + h1), betal = hp / (hp + hl);
+    dvec3 r0 = (s0 * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s1) / ((h0 + h1) * (h0 + h1));
+    dvec3 rl = (sl * (hp * (3.0 * hl + 2.0 * hp)) + (hl * hl) * sp) / ((hp + hl) * (hp + hl));
+    double beta0 = h1 / (h0 + h1), betal = hp / (hp + hl);
     uint m = n - 2u;
-    float cp = 0.0;
-    vec3 dp = vec3(0.0);
+    double cp = 0.0;
+    dvec3 dp = dvec3(0.0);
     for (uint r = 0u; r < m; ++r) {
-        vec3 abc, rhs;
+        dvec3 abc, rhs;
         row(h, r + 1u, abc, rhs);
-        float a = abc.x, b = abc.y, c = abc.z;
+        double a = abc.x, b = abc.y, c = abc.z;
         if (r == 0u) { rhs -= (a / beta0) * r0; b -= a / beta0; a = 0.0; }
         if (r == m - 1u) { rhs -= (c / betal) * rl; b -= c / betal; c = 0.0; }
-        float pivot = b - a * cp;
+        double pivot = b - a * cp;
         cp = c / pivot;
         dp = (rhs - a * dp) / pivot;
-        scratch[sidx(h, r + 1u)] = vec4(dp, 0.0);
-        scratch[sidx(h, r + 1u) + 1u] = vec4(cp, 0.0, 0.0, 0.0);
+        scratch[sidx(h, r + 1u)] = dvec4(dp, 0.0);
+        scratch[sidx(h, r + 1u) + 1u] = dvec4(cp, 0.0, 0.0, 0.0);
     }
-    vec3 x = dp;
+    dvec3 x = dp;
     for (uint r = m - 1u; r-- > 0u;) {
         x = scratch[sidx(h, r + 1u)].xyz - scratch[sidx(h, r + 1u) + 1u].x * x;
-        scratch[sidx(h, r + 1u)] = vec4(x, 0.0);
+        scratch[sidx(h, r + 1u)] = dvec4(x, 0.0);
     }
-    scratch[sidx(h, 0u)] = vec4((r0 - scratch[sidx(h, 1u)].xyz) / beta0, 0.0);
-    scratch[sidx(h, n - 1u)] = vec4((rl - scratch[sidx(h, n - 2u)].xyz) / betal, 0.0);
+    scratch[sidx(h, 0u)] = dvec4((r0 - scratch[sidx(h, 1u)].xyz) / beta0, 0.0);
+    scratch[sidx(h, n - 1u)] = dvec4((rl - scratch[sidx(h, n - 2u)].xyz) / betal, 0.0);
 }
 
 void main() {
@@ -150,14 +156,14 @@ void main() {
     if (kind == 2u) {
         c2_tangents(h, closed);
         for (uint k = 0u; k < segs; ++k) {
-            vec3 p0 = node(h, k), p1 = node(h, (k + 1u) % n);
-            float len = hlen(h, k);
-            vec3 t0 = scratch[sidx(h, k)].xyz * len, t1 = scratch[sidx(h, (k + 1u) % n)].xyz * len;
+            dvec3 p0 = dnode(h, k), p1 = dnode(h, k + 1u);
+            double len = hlen(h, k);
+            dvec3 t0 = scratch[sidx(h, k)].xyz * len, t1 = scratch[sidx(h, (k + 1u) % n)].xyz * len;
             uint s = 4u * (h.segment_first + k);
-            segments[s] = vec4(p0, 1.0);
-            segments[s + 1u] = vec4(p0 + t0 / 3.0, 1.0);
-            segments[s + 2u] = vec4(p1 - t1 / 3.0, 1.0);
-            segments[s + 3u] = vec4(p1, 1.0);
+            segments[s] = vec4(vec3(p0), 1.0);
+            segments[s + 1u] = vec4(vec3(p0 + t0 / 3.0), 1.0);
+            segments[s + 2u] = vec4(vec3(p1 - t1 / 3.0), 1.0);
+            segments[s + 3u] = vec4(vec3(p1), 1.0);
         }
         return;
     }
@@ -176,6 +182,12 @@ void main() {
             t0 = dout;
             t1 = din;
         } else {
+            if (h.per_node_first != 0xffffffffu) {
+                vec4 k = per_node[h.per_node_first + j];
+                keep = 1.0 - k.x;
+                b = k.y;
+                c = k.z;
+            }
             float lin = length(din), lout = length(dout);
             float rho;
             if (alpha == 1.0) rho = lout / lin;
@@ -221,15 +233,8 @@ engine::Expected<GpuCurvePass> GpuCurvePass::create() {
 }
 
 bool GpuCurvePass::supported(const SplineSettings& spline, const WireNodes& nodes) {
-    switch (spline.kind) {
-    case SplineKind::linear:
-    case SplineKind::c2:
-        return true;  // no tension (c2: none applies; build_curve reads none)
-    case SplineKind::catmull_rom:
-        return !per_node_kb(nodes) && !physics(spline, nodes);
-    default:
-        return false;
-    }
+    (void)nodes;
+    return spline.kind == SplineKind::linear || spline.kind == SplineKind::c2 || spline.kind == SplineKind::catmull_rom;
 }
 
 Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
@@ -237,18 +242,18 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     origins_.clear();
     std::vector<glm::vec4> node_data;
     std::vector<glm::dvec3> curve;
+    std::vector<uint32_t> source;
+    std::vector<glm::vec4> per_node;  // only wires with per-node tension, bias or continuity (or physics)
     uint32_t segment_first = 0;
     for (std::size_t w = 0; w < wires.size(); ++w) {
         const GpuCurveWire& wire = wires[w];
         const std::string name = "wire " + std::to_string(w) + ": ";
         if (wire.nodes == nullptr) return Status::error(name + "no nodes");
         if (!supported(wire.spline, *wire.nodes)) {
-            return Status::error(name + "the GPU curve pass builds linear, c2 and Catmull-Rom wires with "
-                                        "wire-wide settings only (automatic, and Catmull-Rom with per-node "
-                                        "tension/bias/continuity or curvature-driven tension, stay on the CPU "
-                                        "path for now)");
+            return Status::error(name + "the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic "
+                                        "wires stay on the CPU path for now)");
         }
-        const std::size_t n = curve_nodes(*wire.nodes, wire.spline, curve);
+        const std::size_t n = curve_nodes(*wire.nodes, wire.spline, curve, &source);
         if (n < (wire.spline.closed ? 3u : 2u)) {
             return Status::error(name + "a wire needs at least " + std::string(wire.spline.closed ? "3" : "2") +
                                  " distinct nodes, got " + std::to_string(n) + " after merging coincident ones");
@@ -270,6 +275,23 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
         h.tension = static_cast<float>(wire.spline.tension);
         h.bias = static_cast<float>(wire.spline.bias);
         h.continuity = static_cast<float>(wire.spline.continuity);
+        const WireNodes& wn = *wire.nodes;
+        if (kind == kCatmullRom && (per_node_kb(wn) || physics(wire.spline, wn))) {
+            // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
+            // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).
+            const bool phys = physics(wire.spline, wn);
+            h.per_node_first = static_cast<uint32_t>(per_node.size());
+            for (const uint32_t src : source) {
+                const double t_user = wn.kb_tension.empty() ? wire.spline.tension : wn.kb_tension[src];
+                const double b = wn.kb_bias.empty() ? wire.spline.bias : wn.kb_bias[src];
+                const double c = wn.kb_continuity.empty() ? wire.spline.continuity : wn.kb_continuity[src];
+                const double t_curv = phys ? curvature_tension(wn.theta_rad[src], wn.iz_m4[src], wn.length_m[src],
+                                                               wn.delta_length_m[src], wn.area_m2[src])
+                                           : 0.0;
+                const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
+                per_node.emplace_back(static_cast<float>(t), static_cast<float>(b), static_cast<float>(c), 0.0f);
+            }
+        }
         header_data_.push_back(h);
         for (const glm::dvec3& p : curve) node_data.emplace_back(glm::vec3(p - origin), 0.0f);
         segment_first += static_cast<uint32_t>(wire.spline.closed ? n : n - 1);
@@ -277,23 +299,27 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     segment_total_ = segment_first;
     node_bytes_ = node_data.size() * sizeof(glm::vec4);
     header_bytes_ = header_data_.size() * sizeof(GpuCurveHeader);
+    per_node_bytes_ = per_node.size() * sizeof(glm::vec4);
+    if (per_node.empty()) per_node.emplace_back(0.0f);  // a buffer of size 0 cannot be bound
     if (wires.empty()) return Status::success();
 
     auto headers = engine::gfx::make_buffer(std::span<const GpuCurveHeader>(header_data_), "wire gpu curve headers");
     auto nodes = engine::gfx::make_buffer(std::span<const glm::vec4>(node_data), "wire gpu curve nodes");
     auto segments = engine::gfx::make_buffer({.size_bytes = segment_total_ * 4 * sizeof(glm::vec4),
                                               .dynamic = true, .label = "wire gpu curve segments"});
-    auto scratch = engine::gfx::make_buffer({.size_bytes = node_data.size() * 2 * sizeof(glm::vec4),
+    auto scratch = engine::gfx::make_buffer({.size_bytes = node_data.size() * 2 * sizeof(glm::dvec4),
                                              .label = "wire gpu curve scratch"});
-    for (const auto* b : {&headers, &nodes, &segments, &scratch}) {
+    auto per_node_buffer = engine::gfx::make_buffer(std::span<const glm::vec4>(per_node), "wire gpu curve per-node kb");
+    for (const auto* b : {&headers, &nodes, &segments, &scratch, &per_node_buffer}) {
         if (!*b) return Status::error(b->error().message);
     }
     headers_ = std::move(*headers), nodes_ = std::move(*nodes), segments_ = std::move(*segments);
-    scratch_ = std::move(*scratch);
+    scratch_ = std::move(*scratch), per_node_ = std::move(*per_node_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, per_node_.id());
     program_.use();
     glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(wires.size()));
     glDispatchCompute(static_cast<GLuint>((wires.size() + 63) / 64), 1, 1);

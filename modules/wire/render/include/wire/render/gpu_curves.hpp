@@ -7,10 +7,12 @@
 //   pass->build(wires);                                   // uploads, dispatches
 //   pass->read_segments(out);                             // (tests, tools) the segments back, per wire
 //
-// Kinds so far: linear; Catmull-Rom / Kochanek-Bartels with any alpha and the wire-wide tension, bias and
-// continuity; c2 (its tangent system solved by one invocation, Thomas in float; closed loops cyclic). Not yet
-// (supported() says so, build() refuses them by name): automatic (its concentrated-turn tension), per-node
-// tension/bias/continuity and curvature-driven tension.
+// Kinds so far: linear; Catmull-Rom / Kochanek-Bartels with any alpha, wire-wide or per-node tension, bias and
+// continuity, and the curvature-driven tension of nodes that carry the physics arrays (computed on the CPU with
+// build_curve's formula and sent as 16 bytes a node, only for such wires); c2 (its tangent system solved by one
+// invocation in double, GLSL 4.00's fp64: the not-a-knot end cancels by the ratio of the first two chords, which
+// in float moved a 4-node wire with 100:1 chords by 1e-4 of its extent; closed loops cyclic). Not yet
+// (supported() says so, build() refuses it by name): automatic (its concentrated-turn tension).
 // Precision: nodes go to the GPU in float relative to the wire's own origin (the centre of its nodes' box,
 // kept in double), so a wire far from the world origin keeps its float precision; the segments come back
 // relative to that origin. Coincident nodes are merged on the CPU by build_curve's own rule
@@ -40,15 +42,20 @@ struct GpuCurveWire {
     SplineSettings spline{};           ///< its kind and settings, closed included
 };
 
-/// The per-wire record the pass reads (std430, 32 bytes).
+/// The per-wire record the pass reads (std430, 48 bytes).
 struct GpuCurveHeader {
     uint32_t node_first = 0;     ///< first node in the node buffer
     uint32_t node_count = 0;     ///< curve nodes (merged)
     uint32_t segment_first = 0;  ///< first segment in the segment buffer
     uint32_t flags = 0;          ///< bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2)
     float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
+    /// Catmull-Rom with per-node tension, bias or continuity, or curvature-driven tension: first of its
+    /// node_count (tension, bias, continuity, 0) records in the per-node buffer; kNoPerNode otherwise.
+    uint32_t per_node_first = 0xffffffffu;
+    uint32_t pad[3] = {0, 0, 0};  ///< std430 alignment of the record (unused)
 };
-static_assert(sizeof(GpuCurveHeader) == 32, "GpuCurveHeader is the 32-byte std430 record");
+static_assert(sizeof(GpuCurveHeader) == 48, "GpuCurveHeader is the 48-byte std430 record");
+inline constexpr uint32_t kNoPerNode = 0xffffffffu;  ///< GpuCurveHeader::per_node_first of a wire-wide wire
 
 /// One wire's segments read back: control points relative to `origin_m`.
 struct GpuCurveResult {
@@ -69,7 +76,7 @@ public:
     /// Builds every wire's segments on the GPU (one dispatch). A wire this pass cannot build (a kind it does not
     /// support yet, or fewer than 2 distinct nodes, 3 closed) fails the call with a message naming the wire and
     /// why; nothing is dispatched then. Validate nodes first (build_curve's checks): NaN is not looked for here.
-    /// Leaves shader storage bindings 0-3 pointing at its buffers and no program in use.
+    /// Leaves shader storage bindings 0-4 pointing at its buffers and no program in use.
     [[nodiscard]] Status build(std::span<const GpuCurveWire> wires);
 
     /// The last build's segments, one result per wire (waits for the GPU).
@@ -77,13 +84,14 @@ public:
 
     [[nodiscard]] std::size_t node_bytes() const { return node_bytes_; }      ///< uploaded by the last build
     [[nodiscard]] std::size_t header_bytes() const { return header_bytes_; }  ///< uploaded by the last build
+    [[nodiscard]] std::size_t per_node_bytes() const { return per_node_bytes_; }  ///< uploaded by the last build
 
 private:
     engine::gfx::Program program_;
-    engine::gfx::Buffer headers_, nodes_, segments_, scratch_;
+    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, per_node_;
     std::vector<GpuCurveHeader> header_data_;
     std::vector<glm::dvec3> origins_;
-    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0;
+    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, per_node_bytes_ = 0;
 };
 
 }  // namespace wire::render
