@@ -85,9 +85,10 @@ void build_curves(std::span<CurveBuildJob> jobs);
 /// (the first of a group kept; a closed loop's last node dropped where it coincides with its first). Positions
 /// only, no validation (build_curve's checks come first). Returns out.size(); fewer than 2 (3 closed) means
 /// build_curve fails on the wire. `source` (optional): per curve node, the input node its per-node values come
-/// from (the first of its group, as build_curve reads them).
+/// from (the first of its group, as build_curve reads them). `last` (optional): per curve node, the last input node
+/// of its group (a segment's stretch is that of the element starting there, as build_curve reads it).
 std::size_t curve_nodes(const WireNodes& nodes, const SplineSettings& settings, std::vector<glm::dvec3>& out,
-                        std::vector<uint32_t>* source = nullptr);
+                        std::vector<uint32_t>* source = nullptr, std::vector<uint32_t>* last = nullptr);
 
 /// The thesis' curvature-driven tension for one node: R = theta*Iz*L / (A*dL^2); 0 if R > 100 (or dL = 0),
 /// else 1 - tanh(R/50). Non-finite or non-positive denominators give 0.

@@ -18,9 +18,8 @@ constexpr uint32_t kLinear = 0u, kCatmullRom = 1u, kC2 = 2u;
 
 // One invocation per wire. Per curve node j: its incoming and outgoing chords (an open end reflects the missing
 // neighbour: the missing chord equals the other), the knot ratio rho = (l_out / l_in)^alpha, and the
-// Kochanek-Bartels tangents at j; node j writes the start of its outgoing segment (B0, B1 = P + t0 / 3) and the
-// end of its incoming one (B2 = P - t1 / 3, B3), so no segment tangent is stored apart. The same formulas as
-// catmull_rom_tangents in modules/wire/src/spline/build.cpp, in float.
+// Kochanek-Bartels tangents at j (the same formulas as catmull_rom_tangents in modules/wire/src/spline/build.cpp,
+// in float); node j writes its incoming segment (put_segment), holding its outgoing tangent for the next node.
 constexpr const char* kCurveSource = R"glsl(#version 450 core
 layout(local_size_x = 64) in;
 struct Header {
@@ -30,11 +29,12 @@ struct Header {
     uint flags;
     vec4 kb;  // alpha, tension, bias, continuity
     uint per_node_first;  // 0xffffffff: wire-wide kb
-    uint pad0, pad1, pad2;
+    uint stretch_first;   // 0xffffffff: stretch 1 on every segment
+    uint pad1, pad2;
 };
 layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
-layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };
-layout(std430, binding = 2) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: B0..B3
+layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };  // xyz: offset from the origin; w: radius
+layout(std430, binding = 2) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: see put_segment
 layout(std430, binding = 3) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
 layout(std430, binding = 4) readonly buffer PerNode { vec4 per_node[]; };  // tension, bias, continuity, 0
 uniform uint u_wires;
@@ -145,6 +145,19 @@ void c2_tangents(Header h, bool closed) {
     scratch[sidx(h, n - 1u)] = dvec4((rl - scratch[sidx(h, n - 2u)].xyz) / betal, 0.0);
 }
 
+// Segment k as b0 (relative to the wire's origin) and its control points' differences b1 - b0, b2 - b1, b3 - b2,
+// from the node tangents t0 (at its start) and t1 (at its end): b1 - b0 = t0 / 3, b2 - b1 = chord - (t0 + t1) / 3,
+// b3 - b2 = t1 / 3. The differences keep their own relative precision, so the ring pass's derivatives and chords
+// do not inherit the rounding of the offsets (2^-24 of the wire's extent, which on a 100 m wire of 5 cm segments is
+// 1e-4 of a segment).
+void put_segment(Header h, uint k, vec3 p0, vec3 t0, vec3 t1, vec3 chord_k) {
+    uint s = 4u * (h.segment_first + k);
+    segments[s] = vec4(p0, 1.0);
+    segments[s + 1u] = vec4(t0 / 3.0, 0.0);
+    segments[s + 2u] = vec4(chord_k - (t0 + t1) / 3.0, 0.0);
+    segments[s + 3u] = vec4(t1 / 3.0, 0.0);
+}
+
 void main() {
     uint w = gl_GlobalInvocationID.x;
     if (w >= u_wires) return;
@@ -161,18 +174,20 @@ void main() {
             dvec3 t0 = scratch[sidx(h, k)].xyz * len, t1 = scratch[sidx(h, (k + 1u) % n)].xyz * len;
             uint s = 4u * (h.segment_first + k);
             segments[s] = vec4(vec3(p0), 1.0);
-            segments[s + 1u] = vec4(vec3(p0 + t0 / 3.0), 1.0);
-            segments[s + 2u] = vec4(vec3(p1 - t1 / 3.0), 1.0);
-            segments[s + 3u] = vec4(vec3(p1), 1.0);
+            segments[s + 1u] = vec4(vec3(t0 / 3.0), 0.0);
+            segments[s + 2u] = vec4(vec3((p1 - p0) - (t0 + t1) / 3.0), 0.0);
+            segments[s + 3u] = vec4(vec3(t1 / 3.0), 0.0);
         }
         return;
     }
+    // Node j's tangents: t0 starts its outgoing segment j, t1 ends its incoming one (j - 1); segment j - 1 is
+    // written at node j from the previous node's t0, and a closed loop's last segment at the end from node 0's t1.
     float alpha = h.kb.x, keep = 1.0 - h.kb.y, b = h.kb.z, c = h.kb.w;
+    vec3 prev_t0 = vec3(0.0), first_t1 = vec3(0.0);
     for (uint j = 0u; j < n; ++j) {
         bool has_in = closed || j > 0u, has_out = closed || j + 1u < n;
         uint kin = has_in ? (j == 0u ? segs - 1u : j - 1u) : 0u;
         uint kout = has_out ? (j == segs ? 0u : j) : segs - 1u;
-        vec3 p = node(h, j);
         vec3 cin = node(h, (kin + 1u) % n) - node(h, kin);
         vec3 cout = node(h, (kout + 1u) % n) - node(h, kout);
         vec3 din = has_in ? cin : cout;
@@ -198,17 +213,11 @@ void main() {
             t0 = keep * (((1.0 + b) * (1.0 + c) * rho * wt) * din + ((1.0 - b) * (1.0 - c) * iw) * dout);
             t1 = keep * (((1.0 + b) * (1.0 - c) * wt) * din + ((1.0 - b) * (1.0 + c) * iw / rho) * dout);
         }
-        if (has_out) {
-            uint s = 4u * (h.segment_first + kout);
-            segments[s] = vec4(p, 1.0);
-            segments[s + 1u] = vec4(p + t0 / 3.0, 1.0);
-        }
-        if (has_in) {
-            uint s = 4u * (h.segment_first + kin);
-            segments[s + 2u] = vec4(p - t1 / 3.0, 1.0);
-            segments[s + 3u] = vec4(p, 1.0);
-        }
+        if (j == 0u) first_t1 = t1;
+        else put_segment(h, j - 1u, node(h, j - 1u), prev_t0, t1, cin);
+        prev_t0 = t0;
     }
+    if (closed) put_segment(h, n - 1u, node(h, n - 1u), prev_t0, first_t1, node(h, 0u) - node(h, n - 1u));
 }
 )glsl";
 
@@ -242,7 +251,8 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     origins_.clear();
     std::vector<glm::vec4> node_data;
     std::vector<glm::dvec3> curve;
-    std::vector<uint32_t> source;
+    std::vector<uint32_t> source, last;
+    std::vector<float> stretch;       // only wires whose nodes carry stretch
     std::vector<glm::vec4> per_node;  // only wires with per-node tension, bias or continuity (or physics)
     uint32_t segment_first = 0;
     for (std::size_t w = 0; w < wires.size(); ++w) {
@@ -253,7 +263,7 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
             return Status::error(name + "the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic "
                                         "wires stay on the CPU path for now)");
         }
-        const std::size_t n = curve_nodes(*wire.nodes, wire.spline, curve, &source);
+        const std::size_t n = curve_nodes(*wire.nodes, wire.spline, curve, &source, &last);
         if (n < (wire.spline.closed ? 3u : 2u)) {
             return Status::error(name + "a wire needs at least " + std::string(wire.spline.closed ? "3" : "2") +
                                  " distinct nodes, got " + std::to_string(n) + " after merging coincident ones");
@@ -292,15 +302,27 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
                 per_node.emplace_back(static_cast<float>(t), static_cast<float>(b), static_cast<float>(c), 0.0f);
             }
         }
+        const std::size_t segs = wire.spline.closed ? n : n - 1;
+        if (!wn.stretch.empty()) {  // build_curve's Curve::stretch: the element starting at a group's last node
+            h.stretch_first = static_cast<uint32_t>(stretch.size());
+            for (std::size_t k = 0; k < segs; ++k) stretch.push_back(wn.stretch[last[k]]);
+        }
         header_data_.push_back(h);
-        for (const glm::dvec3& p : curve) node_data.emplace_back(glm::vec3(p - origin), 0.0f);
-        segment_first += static_cast<uint32_t>(wire.spline.closed ? n : n - 1);
+        // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
+        const float wire_radius = wire.spline.radius_m > 0.0f ? wire.spline.radius_m : kDefaultWireRadius_m;
+        for (std::size_t j = 0; j < n; ++j) {
+            const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[source[j]];
+            node_data.emplace_back(glm::vec3(curve[j] - origin), r > 0.0f ? r : wire_radius);
+        }
+        segment_first += static_cast<uint32_t>(segs);
     }
     segment_total_ = segment_first;
     node_bytes_ = node_data.size() * sizeof(glm::vec4);
     header_bytes_ = header_data_.size() * sizeof(GpuCurveHeader);
     per_node_bytes_ = per_node.size() * sizeof(glm::vec4);
+    stretch_bytes_ = stretch.size() * sizeof(float);
     if (per_node.empty()) per_node.emplace_back(0.0f);  // a buffer of size 0 cannot be bound
+    if (stretch.empty()) stretch.push_back(1.0f);
     if (wires.empty()) return Status::success();
 
     auto headers = engine::gfx::make_buffer(std::span<const GpuCurveHeader>(header_data_), "wire gpu curve headers");
@@ -310,11 +332,12 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     auto scratch = engine::gfx::make_buffer({.size_bytes = node_data.size() * 2 * sizeof(glm::dvec4),
                                              .label = "wire gpu curve scratch"});
     auto per_node_buffer = engine::gfx::make_buffer(std::span<const glm::vec4>(per_node), "wire gpu curve per-node kb");
-    for (const auto* b : {&headers, &nodes, &segments, &scratch, &per_node_buffer}) {
+    auto stretch_buffer = engine::gfx::make_buffer(std::span<const float>(stretch), "wire gpu curve stretch");
+    for (const auto* b : {&headers, &nodes, &segments, &scratch, &per_node_buffer, &stretch_buffer}) {
         if (!*b) return Status::error(b->error().message);
     }
     headers_ = std::move(*headers), nodes_ = std::move(*nodes), segments_ = std::move(*segments);
-    scratch_ = std::move(*scratch), per_node_ = std::move(*per_node_buffer);
+    scratch_ = std::move(*scratch), per_node_ = std::move(*per_node_buffer), stretch_ = std::move(*stretch_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
@@ -343,7 +366,8 @@ void GpuCurvePass::read_segments(std::vector<GpuCurveResult>& out) const {
         r.segments.resize(segs);
         for (std::size_t k = 0; k < segs; ++k) {
             const glm::vec4* s = &data[4 * (h.segment_first + k)];
-            r.segments[k] = CubicBezier{glm::dvec3(s[0]), glm::dvec3(s[1]), glm::dvec3(s[2]), glm::dvec3(s[3])};
+            const glm::dvec3 b0(s[0]), b1 = b0 + glm::dvec3(s[1]), b2 = b1 + glm::dvec3(s[2]);
+            r.segments[k] = CubicBezier{b0, b1, b2, b2 + glm::dvec3(s[3])};
         }
     }
 }

@@ -137,13 +137,14 @@ const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m,
 namespace wire {
 
 std::size_t curve_nodes(const WireNodes& nodes, const SplineSettings& settings, std::vector<glm::dvec3>& out,
-                        std::vector<uint32_t>* source) {
+                        std::vector<uint32_t>* source, std::vector<uint32_t>* last) {
     thread_local curve_stage::Merged m;
     thread_local curve_stage::Chords ch;
     std::size_t count = 0;
     const glm::dvec3* p = curve_stage::merge_nodes(nodes, settings, m, ch, count);
     out.assign(p, p + count);
     if (source != nullptr) source->assign(m.first.begin(), m.first.begin() + static_cast<std::ptrdiff_t>(count));
+    if (last != nullptr) last->assign(m.last.begin(), m.last.begin() + static_cast<std::ptrdiff_t>(count));
     return count;
 }
 

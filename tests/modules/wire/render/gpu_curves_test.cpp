@@ -6,9 +6,15 @@
 // error is stated relative to the wire's extent (its largest node distance from that origin): float rounding of
 // an offset is 2^-24 of the extent (6e-8), and a control point is a short sum of such offsets and products.
 #include "wire/render/gpu_curves.hpp"
+#include "wire/render/gpu_rings.hpp"
+
+#include "wire/packed_ring.hpp"
+#include "wire/rings.hpp"
+#include "wire/tessellate.hpp"
 
 #include "wire/spline.hpp"
 #include "wire/testing/families.hpp"
+#include "wire/testing/float_round.hpp"
 #include "wire/testing/random.hpp"
 
 #include "engine/platform/context.hpp"
@@ -18,6 +24,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -165,7 +172,7 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
             // the curve is reported beside it: the c2 spline's not-a-knot ends amplify it by the ratio of the
             // first two chords (a 4-node wire with 100:1 chords moves 1e-4 of its extent), whatever computes it.
             WireNodes rounded = wires[i];
-            for (glm::dvec3& p : rounded.positions) p = gpu.origin_m + glm::dvec3(glm::vec3(p - gpu.origin_m));
+            for (glm::dvec3& p : rounded.positions) p = gpu.origin_m + wire::testing::float_rounded(p - gpu.origin_m);
             Curve cpu, exact;
             ASSERT_TRUE(build_curve(rounded, settings[i], cpu).ok()) << labels[i];
             ASSERT_TRUE(build_curve(wires[i], settings[i], exact).ok()) << labels[i];
@@ -220,6 +227,203 @@ TEST(GpuCurves, RefusesWhatItDoesNotBuildYetNamingTheWire) {
     const Status b = pass->build(merged);
     EXPECT_FALSE(b.ok());
     EXPECT_NE(b.message.find("wire 0: a wire needs at least 2 distinct nodes, got 1"), std::string::npos) << b.message;
+}
+
+// The ring pass (issue 30 step 3) against place_rings + build_rings (double) on the curve of the nodes the GPU
+// holds: every ring's centre, frame, radius and u over random families (catenaries, zig-zags, helices, wrapped,
+// closed loops, shortest wires; per-node radii and stretch), kinds (centripetal, chordal, c2, linear), scales
+// (0.05-20) and distances from the origin (up to 1e5 m), ring counts per segment as the LOD makes them (uniform
+// 1-16, Wang's count for a random tolerance, or sparse with empty segments whose boundaries an interval
+// crosses), with and without a carried first normal. Tolerances (issue 30's): centre within 1e-4 of the radius
+// + 1 um + 8 float roundings of the wire's extent (the record is a float offset from the wire's origin, as the
+// CPU's Ring; b0 + B(t) - b0 adds a few more roundings); frame within 1e-4 rad (the 20-bit quaternion's own step
+// is 1.35e-6); u within 1e-4 of a period + 8 float roundings of u (each interval's u is float, summed in
+// double); radius within 1e-5 of itself (the Hermite's float coefficients cancel where node radii differ 25:1);
+// length within 1e-5.
+TEST(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
+    const auto context = make_context();
+    ASSERT_TRUE(context);
+    auto curves = GpuCurvePass::create();
+    ASSERT_TRUE(curves) << curves.error().message;
+    auto rings = GpuRingPass::create();
+    ASSERT_TRUE(rings) << rings.error().message;
+
+    wire::testing::Random rng{4001};
+    std::vector<WireNodes> wires;
+    std::vector<std::string> labels;
+    std::vector<bool> closed;
+    const auto add = [&](const WireNodes& w, const std::string& label, bool is_closed) {
+        WireNodes moved = w;
+        const double scale = rng.log_uniform(0.05, 20.0);
+        const double far = rng.uniform(0.0, 1.0) < 0.3 ? 1e5 : rng.uniform(0.0, 100.0);
+        const glm::dvec3 shift = far * rng.unit();
+        for (glm::dvec3& p : moved.positions) p = scale * p + shift;
+        // A third of the wires vary their radius along their nodes (the monotone Hermite and u's 1 / R).
+        if (rng.uniform(0.0, 1.0) < 0.33) {
+            moved.radius_m.clear();
+            for (std::size_t i = 0; i < moved.size(); ++i) moved.radius_m.push_back(static_cast<float>(scale * rng.log_uniform(0.002, 0.05)));
+        }
+        wires.push_back(std::move(moved));
+        labels.push_back(label);
+        closed.push_back(is_closed);
+    };
+    for (const auto& c : families::catenaries(21, 30)) add(c.nodes, "catenary " + c.label, false);
+    for (const auto& c : families::zigzags(22, 20)) add(c.nodes, "zigzag " + c.label, false);
+    for (const auto& c : families::helices(23, 20)) add(c.nodes, "helix " + c.label, false);
+    for (const auto& c : families::wrapped(24, 20)) add(c.nodes, "wrapped " + c.label, false);
+    int loop_index = 0;
+    for (const auto& w : loops(25, 30)) add(w, "loop " + std::to_string(loop_index++), true);
+    for (int i = 0; i < 16; ++i) {
+        const bool is_closed = i % 2 == 1;
+        const int n = is_closed ? rng.integer(3, 4) : rng.integer(2, 4);
+        WireNodes w;
+        glm::dvec3 p(0.0);
+        for (int k = 0; k < n; ++k) w.positions.push_back(p), p += rng.log_uniform(0.1, 10.0) * rng.unit();
+        add(w, "short " + std::to_string(n) + (is_closed ? " closed" : " open"), is_closed);
+    }
+    const std::vector<Kind> kinds = {{"centripetal", {.alpha = 0.5}},
+                                     {"chordal", {.alpha = 1.0}},
+                                     {"c2", {.kind = SplineKind::c2}},
+                                     {"linear", {.kind = SplineKind::linear}}};
+
+    struct Worst {
+        double value = 0.0;
+        std::string where;
+        void take(double v, const std::string& w) {
+            if (v > value) value = v, where = w;
+        }
+    };
+    Worst centre, frame, u_err, radius, length;
+    std::vector<double> frame_errors, centre_errors;  // per wire: the largest, for the distribution
+    std::size_t ring_total = 0;
+    for (const Kind& kind : kinds) {
+        std::vector<SplineSettings> settings;
+        std::vector<GpuCurveWire> inputs;
+        for (std::size_t i = 0; i < wires.size(); ++i) {
+            SplineSettings s = kind.spline;
+            s.closed = closed[i];
+            s.radius_m = static_cast<float>(rng.log_uniform(0.002, 0.05));
+            settings.push_back(s);
+        }
+        for (std::size_t i = 0; i < wires.size(); ++i) inputs.push_back({&wires[i], settings[i]});
+        ASSERT_TRUE(curves->build(inputs).ok());
+        std::vector<GpuCurveResult> segs;
+        curves->read_segments(segs);
+        // The CPU reference on the nodes the GPU holds, and each wire's ring counts.
+        std::vector<Curve> cpu(wires.size());
+        std::vector<std::vector<uint32_t>> counts(wires.size());
+        std::vector<GpuRingJob> jobs(wires.size());
+        std::vector<std::string> how(wires.size());
+        for (std::size_t i = 0; i < wires.size(); ++i) {
+            WireNodes rounded = wires[i];
+            for (glm::dvec3& p : rounded.positions) p = segs[i].origin_m + wire::testing::float_rounded(p - segs[i].origin_m);
+            ASSERT_TRUE(build_curve(rounded, settings[i], cpu[i]).ok()) << labels[i];
+            const std::size_t n = cpu[i].segment_count();
+            const int mode = rng.integer(0, 2);
+            if (mode == 0) {
+                const uint32_t c = static_cast<uint32_t>(rng.integer(1, 16));
+                counts[i].assign(n, c);
+                how[i] = std::to_string(c) + " rings a segment";
+            } else if (mode == 1) {
+                double extent = 0.0;
+                for (const CubicBezier& c : cpu[i].segments) extent = std::max(extent, glm::length(c.b3 - c.b0));
+                const double tol = extent * rng.log_uniform(1e-4, 0.3);
+                segment_ring_counts(cpu[i], {.tolerance_m = tol, .max_rings_per_segment = 64}, counts[i]);
+                how[i] = "Wang's counts";
+            } else {
+                counts[i].assign(n, 0);
+                for (uint32_t& c : counts[i]) c = rng.uniform(0.0, 1.0) < 0.4 ? static_cast<uint32_t>(rng.integer(1, 4)) : 0u;
+                how[i] = "sparse counts";
+            }
+            jobs[i].counts = counts[i];
+            if (rng.uniform(0.0, 1.0) < 0.5) {
+                jobs[i].has_previous_normal = true;
+                jobs[i].previous_normal = glm::vec3(rng.unit());
+            }
+        }
+        ASSERT_TRUE(rings->build(*curves, jobs).ok());
+        std::vector<GpuRingResult> gpu;
+        rings->read(gpu);
+        ASSERT_EQ(gpu.size(), wires.size());
+        for (std::size_t i = 0; i < wires.size(); ++i) {
+            const std::string where = std::string(kind.name) + ", " + labels[i] + ", " + how[i];
+            std::vector<RingParam> params;
+            place_rings(cpu[i], counts[i], params);
+            RingSettings rs;
+            rs.frames.has_previous_normal = jobs[i].has_previous_normal;
+            rs.frames.previous_normal = glm::dvec3(jobs[i].previous_normal);
+            RingSet ref;
+            build_rings(cpu[i], params, rs, ref);
+            ASSERT_EQ(gpu[i].rings.size(), ref.rings.size()) << where;
+            double extent = 0.0;
+            for (const glm::dvec3& p : wires[i].positions) extent = std::max(extent, glm::length(p - segs[i].origin_m));
+            double wire_frame = 0.0, wire_centre = 0.0;
+            for (std::size_t r = 0; r < ref.rings.size(); ++r) {
+                const PackedRing& g = gpu[i].rings[r];
+                const glm::dvec3 cpu_centre = ref.origin_m + ref.centre_m[r];
+                const glm::dvec3 gpu_centre = segs[i].origin_m + glm::dvec3(g.centre_m[0], g.centre_m[1], g.centre_m[2]);
+                const double R = ref.rings[r].radius_m;
+                const double ce = glm::length(cpu_centre - gpu_centre) / (1e-4 * R + 1e-6 + 8.0 * std::ldexp(extent, -24));
+                centre.take(ce, where + ", ring " + std::to_string(r));
+                wire_centre = std::max(wire_centre, glm::length(cpu_centre - gpu_centre) / R);
+                const DecodedFrame f = unpack_frame(g);
+                const double fe = std::max({glm::length(glm::dvec3(f.normal) - ref.frames[r].r),
+                                            glm::length(glm::dvec3(f.binormal) - ref.frames[r].s),
+                                            glm::length(glm::dvec3(f.tangent) - ref.frames[r].t)});
+                frame.take(fe, where + ", ring " + std::to_string(r));
+                wire_frame = std::max(wire_frame, fe);
+                const double ue = std::abs(static_cast<double>(g.u) - ref.u[r]) / (1e-4 + 8.0 * std::ldexp(std::abs(ref.u[r]), -24));
+                u_err.take(ue, where + ", ring " + std::to_string(r));
+                radius.take(std::abs(g.radius_m - R) / R, where + ", ring " + std::to_string(r));
+            }
+            length.take(std::abs(gpu[i].length_m - ref.length_m) / std::max(ref.length_m, 1e-30), where);
+            if (closed[i]) {
+                const double ue = std::abs(gpu[i].u_close - ref.u.back()) / (1e-4 + 8.0 * std::ldexp(std::abs(ref.u.back()), -24));
+                u_err.take(ue, where + ", u where the loop closes");
+            }
+            frame_errors.push_back(wire_frame);
+            centre_errors.push_back(wire_centre);
+            ring_total += ref.rings.size();
+        }
+    }
+    const auto quantiles = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        const auto q = [&](double f) { return v[static_cast<std::size_t>(f * (v.size() - 1))]; };
+        return std::array<double, 3>{q(0.5), q(0.9), q(1.0)};
+    };
+    const auto fq = quantiles(frame_errors), cq = quantiles(centre_errors);
+    std::printf("gpu rings: %zu wires, %zu rings | frame error (rad) per wire: median %.3g, p90 %.3g, max %.3g | "
+                "centre error / radius per wire: median %.3g, p90 %.3g, max %.3g\n",
+                frame_errors.size(), ring_total, fq[0], fq[1], fq[2], cq[0], cq[1], cq[2]);
+    std::printf("  worst, against its tolerance: centre %.3g (%s)\n  frame %.3g rad (%s)\n  u %.3g (%s)\n"
+                "  radius %.3g (%s)\n  length %.3g (%s)\n",
+                centre.value, centre.where.c_str(), frame.value, frame.where.c_str(), u_err.value, u_err.where.c_str(),
+                radius.value, radius.where.c_str(), length.value, length.where.c_str());
+    EXPECT_LE(centre.value, 1.0) << centre.where;
+    EXPECT_LE(frame.value, 1e-4) << frame.where;
+    EXPECT_LE(u_err.value, 1.0) << u_err.where;
+    EXPECT_LE(radius.value, 1e-5) << radius.where;
+    EXPECT_LE(length.value, 1e-5) << length.where;
+}
+
+TEST(GpuRings, RefusesJobsThatDoNotMatchTheCurves) {
+    const auto context = make_context();
+    ASSERT_TRUE(context);
+    auto curves = GpuCurvePass::create();
+    ASSERT_TRUE(curves) << curves.error().message;
+    auto rings = GpuRingPass::create();
+    ASSERT_TRUE(rings) << rings.error().message;
+    WireNodes w;
+    w.positions = {{0, 0, 0}, {1, 0, 0}, {2, 1, 0}};
+    const GpuCurveWire inputs[] = {{&w, {}}, {&w, {}}};
+    ASSERT_TRUE(curves->build(inputs).ok());
+    const uint32_t two[] = {4, 4}, three[] = {4, 4, 4};
+    const GpuRingJob one_job[] = {{two}};
+    EXPECT_FALSE(rings->build(*curves, one_job).ok());
+    const GpuRingJob bad[] = {{two}, {three}};
+    const Status s = rings->build(*curves, bad);
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message.find("wire 1: 3 ring counts for its 2 segments"), std::string::npos) << s.message;
 }
 
 }  // namespace

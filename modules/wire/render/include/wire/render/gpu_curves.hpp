@@ -52,7 +52,10 @@ struct GpuCurveHeader {
     /// Catmull-Rom with per-node tension, bias or continuity, or curvature-driven tension: first of its
     /// node_count (tension, bias, continuity, 0) records in the per-node buffer; kNoPerNode otherwise.
     uint32_t per_node_first = 0xffffffffu;
-    uint32_t pad[3] = {0, 0, 0};  ///< std430 alignment of the record (unused)
+    /// Wires whose nodes carry stretch: first of its segment_count() floats in the stretch buffer (build_curve's
+    /// Curve::stretch); kNoPerNode: stretch 1 everywhere.
+    uint32_t stretch_first = 0xffffffffu;
+    uint32_t pad[2] = {0, 0};  ///< std430 alignment of the record (unused)
 };
 static_assert(sizeof(GpuCurveHeader) == 48, "GpuCurveHeader is the 48-byte std430 record");
 inline constexpr uint32_t kNoPerNode = 0xffffffffu;  ///< GpuCurveHeader::per_node_first of a wire-wide wire
@@ -85,13 +88,15 @@ public:
     [[nodiscard]] std::size_t node_bytes() const { return node_bytes_; }      ///< uploaded by the last build
     [[nodiscard]] std::size_t header_bytes() const { return header_bytes_; }  ///< uploaded by the last build
     [[nodiscard]] std::size_t per_node_bytes() const { return per_node_bytes_; }  ///< uploaded by the last build
+    [[nodiscard]] std::size_t stretch_bytes() const { return stretch_bytes_; }    ///< uploaded by the last build
 
 private:
+    friend class GpuRingPass;  // reads the headers, nodes, segments and stretch this pass keeps on the GPU
     engine::gfx::Program program_;
-    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, per_node_;
+    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, per_node_, stretch_;
     std::vector<GpuCurveHeader> header_data_;
     std::vector<glm::dvec3> origins_;
-    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, per_node_bytes_ = 0;
+    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, per_node_bytes_ = 0, stretch_bytes_ = 0;
 };
 
 }  // namespace wire::render

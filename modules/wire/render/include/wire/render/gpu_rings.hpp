@@ -1,0 +1,76 @@
+// The ring stage on the GPU (issue 30, step 3 of docs/issue30_plan.md): from the segments a GpuCurvePass built,
+// one compute dispatch writes every wire's ring records (wire::PackedRing, the 28-byte form the gpu-rings vertex
+// shader reads), one invocation per wire walking its rings in order, as wire::place_rings + wire::build_rings do
+// on the CPU, which stays the reference (tests/modules/wire/render/gpu_rings_test.cpp compares the two):
+//
+//   pass->build(wires);                        // GpuCurvePass: the segments
+//   auto rings = wire::render::GpuRingPass::create();
+//   rings->build(*pass, jobs);                 // per wire: rings per segment, the carried first normal
+//   rings->read(out);                          // (tests, tools) the records back
+//
+// What it computes, per ring (place_rings' placement from the per-segment counts, build_rings' quantities):
+// - centre and unit tangent from the segment (unit_tangent()'s one-sided limits where the derivative vanishes);
+// - the frame by double reflection (Wang et al. 2008) from the first normal (the carried previous normal
+//   projected onto the first tangent, else seed_normal()), through the start of every segment an interval crosses,
+//   with compute_frames' hairpin guard (a step with an ill-conditioned second reflection or a turn over 45 degrees
+//   is bisected, at most 10 deep; an explicit stack stands in for the recursion) and, on closed loops, the
+//   holonomy spread over arc length (the loop is walked twice: first for the twist, then to write);
+// - radius by the monotone Hermite of the node radii (radius_at()), texture u by 3-point Gauss-Legendre of
+//   |B'| / (2 pi R stretch) per ring interval, summed in double (one double add per ring).
+// Precision: float arithmetic on the segments' difference form (GpuCurvePass keeps b0 and the differences of the
+// control points), so derivatives, chords between rings and arc lengths keep float precision relative to a
+// segment, not to the wire's extent; centres are float offsets from the wire's origin (as the CPU's Ring).
+// Not here yet: the screen-space LOD (the counts come from the caller), the scan and draw arguments (steps 4-5).
+#pragma once
+
+#include "wire/packed_ring.hpp"
+#include "wire/render/gpu_curves.hpp"
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace wire::render {
+
+/// One wire's ring request, for the wire of the same index in the curve pass's last build.
+struct GpuRingJob {
+    std::span<const uint32_t> counts;  ///< rings per segment, place_rings' rule (segment 0 gets at least 1)
+    bool has_previous_normal = false;  ///< FrameSettings::has_previous_normal
+    glm::vec3 previous_normal{};       ///< FrameSettings::previous_normal (world direction)
+};
+
+/// One wire's rings read back.
+struct GpuRingResult {
+    std::vector<PackedRing> rings;  ///< centres relative to the curve pass's origin of the wire
+    glm::vec3 first_normal{};       ///< ring 0's normal r (the next frame's previous normal)
+    double u_close = 0.0;           ///< closed loops: u where the loop closes (RingSet::u.back())
+    double length_m = 0.0;          ///< RingSet::length_m
+    float holonomy_rad = 0.0f;      ///< closed loops: FrameStats::holonomy_rad
+};
+
+/// The ring compute pass (owns its GL program and buffers: create, use and destroy it with the same context
+/// current).
+class GpuRingPass {
+public:
+    /// Compiles the compute program. Fails (with the driver's log) without GL 4.3 compute.
+    static engine::Expected<GpuRingPass> create();
+
+    /// Every wire's rings from `curves`' last build (one dispatch). jobs.size() must equal the number of wires of
+    /// that build and each job's counts its wire's segment count; otherwise the call fails naming the wire.
+    [[nodiscard]] Status build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs);
+
+    /// The last build's rings, one result per wire (waits for the GPU).
+    void read(std::vector<GpuRingResult>& out) const;
+
+    [[nodiscard]] std::size_t ring_count() const { return ring_total_; }  ///< rings of the last build
+
+private:
+    engine::gfx::Program program_;
+    engine::gfx::Buffer jobs_, counts_, rings_;
+    std::vector<uint32_t> ring_first_, ring_counts_;
+    std::size_t ring_total_ = 0;
+};
+
+}  // namespace wire::render

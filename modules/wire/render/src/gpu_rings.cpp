@@ -1,0 +1,465 @@
+// The ring stage on the GPU (see gpu_rings.hpp).
+#include "wire/render/gpu_rings.hpp"
+
+#include <epoxy/gl.h>
+
+#include <string>
+
+namespace wire::render {
+namespace {
+
+// One invocation per wire. The CPU reference for every function named after one: modules/wire/src/rings.cpp
+// (build_rings, radius, u) and modules/wire/src/frames.cpp (compute_frames, mirrors, Transporter).
+constexpr const char* kRingSource = R"glsl(#version 450 core
+layout(local_size_x = 64) in;
+struct Header {
+    uint node_first;
+    uint node_count;
+    uint segment_first;
+    uint flags;
+    vec4 kb;
+    uint per_node_first;
+    uint stretch_first;  // 0xffffffff: stretch 1
+    uint pad1, pad2;
+};
+struct Job {
+    uint ring_first;     // first ring record
+    uint count_first;    // first per-segment ring count
+    uint flags;          // bit 0: previous_normal is valid
+    uint pad;
+    vec4 previous_normal;
+    vec4 first_normal;   // out: ring 0's r
+    vec4 totals;         // out: u where a closed loop closes, length, holonomy, ring count
+};
+layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
+layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };     // w: radius
+layout(std430, binding = 2) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2
+layout(std430, binding = 5) readonly buffer Stretch { float stretch[]; };
+layout(std430, binding = 6) buffer Jobs { Job jobs[]; };
+layout(std430, binding = 7) readonly buffer Counts { uint counts[]; };
+layout(std430, binding = 8) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
+uniform uint u_wires;
+
+const float kPi = 3.14159265358979;
+const float kSplitCos = 0.70710678;  // a step turning more than 45 degrees is split
+const uint kMaxDepth = 10u;          // FrameSettings::max_subdivision_depth's default
+
+Header H;
+uint N, SEGS;
+bool CLOSED;
+
+// ---- a segment: b0 and the differences of its control points ----
+struct Seg { vec3 b0; vec3 d0; vec3 d1; vec3 d2; };
+Seg load_seg(uint k) {
+    uint s = 4u * (H.segment_first + k);
+    return Seg(segments[s].xyz, segments[s + 1u].xyz, segments[s + 2u].xyz, segments[s + 3u].xyz);
+}
+// B(t) - b0: the Bezier of control points 0, d0, d0 + d1, d0 + d1 + d2.
+vec3 offset_at(Seg c, float t) {
+    float s = 1.0 - t;
+    vec3 e1 = c.d0, e2 = c.d0 + c.d1, e3 = e2 + c.d2;
+    if (t == 1.0) return e3;
+    return (3.0 * s * s * t) * e1 + (3.0 * s * t * t) * e2 + (t * t * t) * e3;
+}
+vec3 deriv(Seg c, float t) { float s = 1.0 - t; return 3.0 * ((s * s) * c.d0 + (2.0 * s * t) * c.d1 + (t * t) * c.d2); }
+vec3 second_deriv(Seg c, float t) { return 6.0 * ((1.0 - t) * (c.d1 - c.d0) + t * (c.d2 - c.d1)); }
+float max_abs(vec3 v) { return max(abs(v.x), max(abs(v.y), abs(v.z))); }
+
+// unit_tangent(): the derivative's direction, else its one-sided limits (B'', then B''', then the chord).
+vec3 unit_tangent(Seg c, float t) {
+    vec3 e2 = c.d0 + c.d1, e3 = e2 + c.d2;
+    float tiny = 1e-6 * max(max_abs(c.d0), max(max_abs(e2), max_abs(e3))) + 1e-30;
+    vec3 d1 = deriv(c, t);
+    float l1 = length(d1);
+    if (l1 > tiny) return d1 / l1;
+    vec3 d2 = (t >= 1.0 ? -1.0 : 1.0) * second_deriv(c, t);
+    float l2 = length(d2);
+    if (l2 > tiny) return d2 / l2;
+    vec3 d3 = 6.0 * (c.d2 - 2.0 * c.d1 + c.d0);
+    float l3 = length(d3);
+    if (l3 > tiny) return d3 / l3;
+    float lc = length(e3);
+    if (lc > tiny) return e3 / lc;
+    return vec3(0.0);
+}
+
+// ---- radius and u (SegmentCoeffs in rings.cpp) ----
+float node_radius(uint j) { return nodes[H.node_first + j].w; }
+float node_slope(uint k) {
+    bool has_left = CLOSED || k > 0u, has_right = CLOSED || k + 1u < N;
+    float rk = node_radius(k);
+    float dl = has_left ? rk - node_radius(k == 0u ? N - 1u : k - 1u) : 0.0;
+    float dr = has_right ? node_radius(k + 1u == N ? 0u : k + 1u) - rk : 0.0;
+    if (!has_left) return dr;
+    if (!has_right) return dl;
+    if (dl * dr <= 0.0) return 0.0;
+    float lim = 3.0 * min(abs(dl), abs(dr));
+    return clamp(0.5 * (dl + dr), -lim, lim);
+}
+struct Coeffs { Seg c; vec4 r; float u_per_m; float u_scale; bool constant; };
+Coeffs load(uint k) {
+    Coeffs o;
+    o.c = load_seg(k);
+    uint a = min(k, N - 1u);
+    uint b = CLOSED ? (a + 1u == N ? 0u : a + 1u) : min(a + 1u, N - 1u);
+    float ra = node_radius(a), rb = node_radius(b);
+    float ma = node_slope(a), mb = node_slope(b);
+    o.r = vec4(ra, ma, -3.0 * ra - 2.0 * ma + 3.0 * rb - mb, 2.0 * ra + ma - 2.0 * rb + mb);
+    float st = H.stretch_first == 0xffffffffu ? 1.0 : stretch[H.stretch_first + k];
+    if (!(st > 0.0)) st = 1.0;
+    o.constant = o.r.y == 0.0 && o.r.z == 0.0 && o.r.w == 0.0;
+    o.u_per_m = o.constant ? 1.0 / (2.0 * kPi * st * max(o.r.x, 1e-30)) : 0.0;
+    o.u_scale = o.constant ? 0.0 : 1.0 / (2.0 * kPi * st);
+    return o;
+}
+float radius_at(Coeffs o, float t) { return o.r.x + t * (o.r.y + t * (o.r.z + t * o.r.w)); }
+// Length and u from ta to tb (3-point Gauss-Legendre of |B'| and |B'| / R).
+vec2 integrate(Coeffs o, float ta, float tb) {
+    float h = tb - ta;
+    if (!(h > 0.0)) return vec2(0.0);
+    const float x[3] = float[3](0.1127016653792583, 0.5, 0.8872983346207417);
+    const float w[3] = float[3](0.2777777777777778, 0.4444444444444444, 0.2777777777777778);
+    float len = 0.0, u = 0.0;
+    for (int q = 0; q < 3; ++q) {
+        float t = ta + h * x[q];
+        float speed = length(deriv(o.c, t));
+        len += (h * w[q]) * speed;
+        if (!o.constant) u += (h * w[q]) * speed / max(radius_at(o, t), 1e-30);
+    }
+    return vec2(len, o.constant ? len * o.u_per_m : u * o.u_scale);
+}
+
+// ---- frames (frames.cpp) ----
+vec3 seed_normal(vec3 t) {
+    vec3 a = abs(t);
+    vec3 e = a.x <= a.y && a.x <= a.z ? vec3(1.0, 0.0, 0.0) : (a.y <= a.z ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0));
+    return normalize(e - dot(e, t) * t);
+}
+vec3 orthonormalize(vec3 r, vec3 t) {
+    vec3 p = r - dot(r, t) * t;
+    float len2 = dot(p, p);
+    return len2 > 1e-12 ? p * inversesqrt(len2) : seed_normal(t);
+}
+vec3 rotate_minimal(vec3 t0, vec3 t1, vec3 r0) {
+    float c = dot(t0, t1);
+    if (c < -1.0 + 1e-6) return orthonormalize(r0, t1);
+    vec3 v = cross(t0, t1);
+    return c * r0 + cross(v, r0) + v * (dot(v, r0) / (1.0 + c));
+}
+// B(tb) - B(ta) by Simpson's rule on B' (a quadratic: exact), so a short step's chord keeps float precision
+// relative to itself; the difference of two offsets would carry their rounding (2^-24 of the segment), which on
+// a hairpin sub-step of 2^-10 of a ring interval turned its chord by 1e-3 rad and the frame with it.
+vec3 chord(Seg c, float ta, float tb) {
+    return ((tb - ta) / 6.0) * (deriv(c, ta) + 4.0 * deriv(c, 0.5 * (ta + tb)) + deriv(c, tb));
+}
+// mirrors(): 0 ok, 1 split, 2 degenerate. v1 is the chord from a to b; `noise` the size below which it counts
+// as a repeated point (then the tangents' sum stands in for it, as on the CPU).
+const uint kOk = 0u, kSplit = 1u, kDegenerate = 2u;
+uint mirrors(vec3 chord_ab, float noise, vec3 at, vec3 bt, out vec3 v1, out vec3 v2, out float f1, out float f2) {
+    v1 = chord_ab;
+    float c1 = dot(v1, v1);
+    f1 = 0.0; v2 = vec3(0.0); f2 = 0.0;
+    if (c1 <= noise * noise * 64.0) {
+        v1 = at + bt;
+        c1 = dot(v1, v1);
+        if (c1 < 1e-12) return kDegenerate;
+    }
+    f1 = 2.0 / c1;
+    vec3 tl = at - (f1 * dot(v1, at)) * v1;
+    v2 = bt - tl;
+    float c2 = dot(v2, v2);
+    if (c2 < 1e-12) return kDegenerate;
+    f2 = 2.0 / c2;
+    return (c2 < 0.1 || dot(at, bt) < kSplitCos) ? kSplit : kOk;
+}
+// Transporter::step (double reflection, the hairpin guard's recursion as an explicit stack): r from (ta, tangent
+// at) to (tb, tangent bt) on segment c.
+vec3 reflect_step(Seg c, float ta, vec3 at, vec3 r, float tb, vec3 bt) {
+    float st_t[kMaxDepth + 1u];
+    vec3 st_tan[kMaxDepth + 1u];
+    uint st_d[kMaxDepth + 1u];
+    int top = 1;
+    st_t[0] = tb; st_tan[0] = bt; st_d[0] = 0u;
+    float tc = ta;
+    vec3 ct = at;
+    // The derivative's scale: a chord below 2^-23 of it times the parameter step is rounding.
+    float scale = 3.0 * (max_abs(c.d0) + max_abs(c.d1) + max_abs(c.d2)) * 1.2e-7;
+    while (top > 0) {
+        int i = top - 1;
+        vec3 v1, v2;
+        float f1, f2;
+        uint m = mirrors(chord(c, tc, st_t[i]), scale * (st_t[i] - tc), ct, st_tan[i], v1, v2, f1, f2);
+        if (m != kOk && st_d[i] < kMaxDepth && st_t[i] > tc) {
+            float tm = 0.5 * (tc + st_t[i]);
+            vec3 mt = unit_tangent(c, tm);
+            if (mt == vec3(0.0)) mt = ct;
+            st_d[i] += 1u;
+            st_t[top] = tm; st_tan[top] = mt; st_d[top] = st_d[i];
+            ++top;
+            continue;
+        }
+        if (m == kDegenerate) {
+            r = orthonormalize(rotate_minimal(ct, st_tan[i], r), st_tan[i]);
+        } else {
+            r -= (f1 * dot(v1, r)) * v1;
+            r -= (f2 * dot(v2, r)) * v2;
+            r = orthonormalize(r, st_tan[i]);
+        }
+        tc = st_t[i]; ct = st_tan[i];
+        --top;
+    }
+    return r;
+}
+// compute_frames' carry: from ring a (segment sa, ta, tangent at) to ring b, through the start of every segment
+// between (wrap: b is ring 0, reached at t = 1 of the last segment).
+vec3 carry(uint sa, float ta, vec3 at, vec3 r, uint sb, float tb, vec3 bt, bool wrap) {
+    uint end = wrap ? SEGS : sb + (tb > 0.0 ? 1u : 0u);
+    uint seg = sa;
+    float t = ta;
+    vec3 ct = at;
+    Seg c = load_seg(seg);
+    for (uint k = sa + 1u; k < end; ++k) {
+        Seg next = load_seg(k);
+        vec3 nt = unit_tangent(next, 0.0);
+        if (nt == vec3(0.0)) nt = ct;
+        r = reflect_step(c, t, ct, r, 1.0, nt);
+        seg = k; t = 0.0; ct = nt; c = next;
+    }
+    float te = !wrap && sb == seg ? tb : 1.0;
+    return reflect_step(c, t, ct, r, te, bt);
+}
+
+// ---- PackedRing (packed_ring.cpp) ----
+uint encode20(float v) { return uint(clamp((v * (0.5 / 0.70710678118654752) + 0.5) * 1048575.0, 0.0, 1048575.0) + 0.5); }
+uvec2 pack_frame(vec3 r, vec3 s) {
+    vec3 t = cross(r, s);
+    float m00 = r.x, m10 = r.y, m20 = r.z, m01 = s.x, m11 = s.y, m21 = s.z, m02 = t.x, m12 = t.y, m22 = t.z;
+    float q[4];  // x, y, z, w
+    float trace = m00 + m11 + m22;
+    if (trace > 0.0) {
+        float k = 2.0 * sqrt(trace + 1.0), inv = 1.0 / k;
+        q[3] = 0.25 * k; q[0] = (m21 - m12) * inv; q[1] = (m02 - m20) * inv; q[2] = (m10 - m01) * inv;
+    } else if (m00 > m11 && m00 > m22) {
+        float k = 2.0 * sqrt(max(1e-30, 1.0 + m00 - m11 - m22)), inv = 1.0 / k;
+        q[3] = (m21 - m12) * inv; q[0] = 0.25 * k; q[1] = (m01 + m10) * inv; q[2] = (m02 + m20) * inv;
+    } else if (m11 > m22) {
+        float k = 2.0 * sqrt(max(1e-30, 1.0 + m11 - m00 - m22)), inv = 1.0 / k;
+        q[3] = (m02 - m20) * inv; q[0] = (m01 + m10) * inv; q[1] = 0.25 * k; q[2] = (m12 + m21) * inv;
+    } else {
+        float k = 2.0 * sqrt(max(1e-30, 1.0 + m22 - m00 - m11)), inv = 1.0 / k;
+        q[3] = (m10 - m01) * inv; q[0] = (m02 + m20) * inv; q[1] = (m12 + m21) * inv; q[2] = 0.25 * k;
+    }
+    uint largest = 0u;
+    for (uint i = 1u; i < 4u; ++i) if (abs(q[i]) > abs(q[largest])) largest = i;
+    float sgn = q[largest] < 0.0 ? -1.0 : 1.0;
+    uint e[3];
+    uint j = 0u;
+    for (uint i = 0u; i < 4u; ++i) if (i != largest) e[j++] = encode20(sgn * q[i]);
+    return uvec2(largest | (e[0] << 2u) | (e[1] << 22u), (e[1] >> 10u) | (e[2] << 10u));
+}
+void put_ring(uint index, vec3 centre, float radius, float u, vec3 r, vec3 s) {
+    uint b = 7u * index;
+    ring_words[b] = floatBitsToUint(centre.x);
+    ring_words[b + 1u] = floatBitsToUint(centre.y);
+    ring_words[b + 2u] = floatBitsToUint(centre.z);
+    ring_words[b + 3u] = floatBitsToUint(radius);
+    ring_words[b + 4u] = floatBitsToUint(u);
+    uvec2 f = pack_frame(r, s);
+    ring_words[b + 5u] = f.x;
+    ring_words[b + 6u] = f.y;
+}
+
+// ---- the walk ----
+uint count_of(Job job, uint k) {
+    uint c = counts[job.count_first + k];
+    return k == 0u ? max(c, 1u) : c;
+}
+
+// Walks the rings in order: place_rings' parameters, build_rings' intervals, compute_frames' carry. With
+// `write`, rotates ring i's frame by -holonomy * s_i / total (closed loops) and writes it. Returns (u at the
+// close, length, holonomy, rings); r0 is ring 0's normal.
+vec4 walk(Job job, vec3 r0, bool write, float holonomy, double total) {
+    Coeffs a = load(0u);
+    uint sa = 0u;
+    float ta = 0.0;
+    vec3 at = unit_tangent(a.c, 0.0);
+    if (at == vec3(0.0)) at = vec3(0.0, 0.0, 1.0);
+    vec3 r = r0;
+    double s = 0.0, u = 0.0;
+    uint index = 0u;
+    if (write) put_ring(job.ring_first, a.c.b0, radius_at(a, 0.0), 0.0, r, cross(at, r));
+    uint k = 0u, j = 1u;  // the next ring: j-th of segment k
+    for (;;) {
+        // Next ring's parameter: (k, j / count), segments without rings skipped; an open wire's last at t = 1.
+        while (k < SEGS && j >= count_of(job, k)) { ++k; j = 0u; }
+        bool last_open = k == SEGS && !CLOSED;
+        if (k == SEGS && !last_open) break;
+        uint sb = last_open ? SEGS - 1u : k;
+        float tb = last_open ? 1.0 : float(j) / float(count_of(job, k));
+        Coeffs b = a;
+        if (sb != sa) b = load(sb);
+        // The interval's length and u: the rest of a's segment, the segments crossed, b's part of its own.
+        vec2 iv = integrate(a, ta, sb == sa ? tb : 1.0);
+        for (uint m = sa + 1u; m < sb; ++m) iv += integrate(load(m), 0.0, 1.0);
+        if (sb != sa && tb > 0.0) iv += integrate(b, 0.0, tb);
+        s += double(iv.x);
+        u += double(iv.y);
+        vec3 bt = unit_tangent(b.c, tb);
+        if (bt == vec3(0.0)) bt = at;
+        r = carry(sa, ta, at, r, sb, tb, bt, false);
+        ++index;
+        if (write) {
+            vec3 rr = r, ss = cross(bt, r);
+            if (holonomy != 0.0 && total > 0.0) {
+                float angle = float(-double(holonomy) * s / total);
+                float ca = cos(angle), sn = sin(angle);
+                rr = ca * r + sn * ss;
+                ss = ca * ss - sn * r;
+            }
+            put_ring(job.ring_first + index, b.c.b0 + offset_at(b.c, tb), radius_at(b, tb), float(u), rr, ss);
+        }
+        a = b; sa = sb; ta = tb; at = bt;
+        if (last_open) break;
+        ++j;
+    }
+    float hol = 0.0;
+    if (CLOSED) {
+        // Back to ring 0 (t = 1 of the last segment): the loop's length and u, and its twist.
+        vec2 iv = integrate(a, ta, 1.0);
+        for (uint m = sa + 1u; m < SEGS; ++m) iv += integrate(load(m), 0.0, 1.0);
+        s += double(iv.x);
+        u += double(iv.y);
+        Seg c0 = load_seg(0u);
+        vec3 t0 = unit_tangent(c0, 0.0);
+        vec3 r_end = carry(sa, ta, at, r, 0u, 0.0, t0, true);
+        hol = atan(dot(cross(r0, r_end), t0), dot(r0, r_end));
+    }
+    return vec4(float(u), float(s), hol, float(index + 1u));
+}
+
+void main() {
+    uint w = gl_GlobalInvocationID.x;
+    if (w >= u_wires) return;
+    H = headers[w];
+    N = H.node_count;
+    CLOSED = (H.flags & 1u) != 0u;
+    SEGS = CLOSED ? N : N - 1u;
+    Job job = jobs[w];
+    // The first normal: the carried previous one projected onto the first tangent, else seeded from an axis.
+    vec3 t0 = unit_tangent(load_seg(0u), 0.0);
+    if (t0 == vec3(0.0)) t0 = vec3(0.0, 0.0, 1.0);
+    vec3 r0 = seed_normal(t0);
+    if ((job.flags & 1u) != 0u) {
+        vec3 p = job.previous_normal.xyz - dot(job.previous_normal.xyz, t0) * t0;
+        float len = length(p);
+        if (len > 1e-6) r0 = p / len;
+    }
+    vec4 totals = vec4(0.0);
+    if (CLOSED) {
+        totals = walk(job, r0, false, 0.0, 0.0);
+        totals = walk(job, r0, true, totals.z, double(totals.y));
+    } else {
+        totals = walk(job, r0, true, 0.0, 0.0);
+    }
+    jobs[w].first_normal = vec4(r0, 1.0);
+    jobs[w].totals = totals;
+}
+)glsl";
+
+struct Job {
+    uint32_t ring_first = 0, count_first = 0, flags = 0, pad = 0;
+    float previous_normal[4] = {0, 0, 0, 0};
+    float first_normal[4] = {0, 0, 0, 0};
+    float totals[4] = {0, 0, 0, 0};
+};
+static_assert(sizeof(Job) == 64, "the ring pass's std430 job record");
+
+}  // namespace
+
+engine::Expected<GpuRingPass> GpuRingPass::create() {
+    engine::Expected<engine::gfx::Program> program =
+        engine::gfx::make_program({.label = "wire gpu rings", .compute = kRingSource});
+    if (!program) return program.error();
+    GpuRingPass pass;
+    pass.program_ = std::move(*program);
+    return pass;
+}
+
+Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs) {
+    const std::vector<GpuCurveHeader>& headers = curves.header_data_;
+    if (jobs.size() != headers.size()) {
+        return Status::error("the ring pass got " + std::to_string(jobs.size()) + " jobs for the curve pass's " +
+                             std::to_string(headers.size()) + " wires");
+    }
+    std::vector<Job> job_data(jobs.size());
+    std::vector<uint32_t> counts;
+    ring_first_.assign(jobs.size(), 0);
+    ring_counts_.assign(jobs.size(), 0);
+    std::size_t rings = 0;
+    for (std::size_t w = 0; w < jobs.size(); ++w) {
+        const GpuCurveHeader& h = headers[w];
+        const bool closed = (h.flags & 1u) != 0;
+        const std::size_t segs = closed ? h.node_count : h.node_count - 1;
+        if (jobs[w].counts.size() != segs) {
+            return Status::error("wire " + std::to_string(w) + ": " + std::to_string(jobs[w].counts.size()) +
+                                 " ring counts for its " + std::to_string(segs) + " segments");
+        }
+        // place_rings: counts[k] rings on segment k (segment 0 at least one), an open wire one more at the end.
+        std::size_t n = closed ? 0 : 1;
+        for (std::size_t k = 0; k < segs; ++k) n += k == 0 ? std::max<uint32_t>(jobs[w].counts[k], 1) : jobs[w].counts[k];
+        Job& j = job_data[w];
+        j.ring_first = static_cast<uint32_t>(rings);
+        j.count_first = static_cast<uint32_t>(counts.size());
+        j.flags = jobs[w].has_previous_normal ? 1u : 0u;
+        j.previous_normal[0] = jobs[w].previous_normal.x;
+        j.previous_normal[1] = jobs[w].previous_normal.y;
+        j.previous_normal[2] = jobs[w].previous_normal.z;
+        counts.insert(counts.end(), jobs[w].counts.begin(), jobs[w].counts.end());
+        ring_first_[w] = static_cast<uint32_t>(rings);
+        ring_counts_[w] = static_cast<uint32_t>(n);
+        rings += n;
+    }
+    ring_total_ = rings;
+    if (jobs.empty()) return Status::success();
+    auto job_buffer = engine::gfx::make_buffer(std::span<const Job>(job_data), "wire gpu ring jobs");
+    auto count_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(counts), "wire gpu ring counts");
+    auto ring_buffer = engine::gfx::make_buffer({.size_bytes = std::max<std::size_t>(rings, 1) * sizeof(PackedRing),
+                                                 .label = "wire gpu rings"});
+    for (const auto* b : {&job_buffer, &count_buffer, &ring_buffer}) {
+        if (!*b) return Status::error(b->error().message);
+    }
+    jobs_ = std::move(*job_buffer), counts_ = std::move(*count_buffer), rings_ = std::move(*ring_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, curves.headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, curves.nodes_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, curves.segments_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, curves.stretch_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, jobs_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, counts_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
+    program_.use();
+    glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(jobs.size()));
+    glDispatchCompute(static_cast<GLuint>((jobs.size() + 63) / 64), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    return Status::success();
+}
+
+void GpuRingPass::read(std::vector<GpuRingResult>& out) const {
+    out.clear();
+    if (ring_first_.empty()) return;
+    std::vector<PackedRing> rings(ring_total_);
+    glGetNamedBufferSubData(rings_.id(), 0, static_cast<GLsizeiptr>(rings.size() * sizeof(PackedRing)), rings.data());
+    std::vector<Job> jobs(ring_first_.size());
+    glGetNamedBufferSubData(jobs_.id(), 0, static_cast<GLsizeiptr>(jobs.size() * sizeof(Job)), jobs.data());
+    out.resize(ring_first_.size());
+    for (std::size_t w = 0; w < out.size(); ++w) {
+        GpuRingResult& r = out[w];
+        r.rings.assign(rings.begin() + ring_first_[w], rings.begin() + ring_first_[w] + ring_counts_[w]);
+        r.first_normal = glm::vec3(jobs[w].first_normal[0], jobs[w].first_normal[1], jobs[w].first_normal[2]);
+        r.u_close = jobs[w].totals[0];
+        r.length_m = jobs[w].totals[1];
+        r.holonomy_rad = jobs[w].totals[2];
+    }
+}
+
+}  // namespace wire::render
