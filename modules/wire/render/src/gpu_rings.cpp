@@ -3,6 +3,10 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 namespace wire::render {
@@ -23,29 +27,44 @@ struct Header {
     uint pad1, pad2;
 };
 struct Job {
-    uint ring_first;     // first ring record
+    uint ring_first;     // out: first ring record (allocated here)
     uint count_first;    // first per-segment ring count
-    uint flags;          // bit 0: previous_normal is valid
-    uint pad;
+    uint flags;          // bit 0: previous_normal is valid; bit 1: restart the LOD's hysteresis
+    uint ring_count;     // out: rings written (0: culled, or the ring buffer was full)
     vec4 previous_normal;
     vec4 first_normal;   // out: ring 0's r
-    vec4 totals;         // out: u where a closed loop closes, length, holonomy, ring count
+    vec4 totals;         // out: u where a closed loop closes, length, holonomy, projected radius (pixels)
+    dvec4 origin;        // the wire's origin (world metres): the LOD's view offset
 };
 layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
 layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };     // w: radius
 layout(std430, binding = 2) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2
 layout(std430, binding = 5) readonly buffer Stretch { float stretch[]; };
 layout(std430, binding = 6) buffer Jobs { Job jobs[]; };
-layout(std430, binding = 7) readonly buffer Counts { uint counts[]; };
+// Rings per segment: the caller's, or (u_lod) the LOD's, over the previous frame's (its hysteresis state).
+layout(std430, binding = 7) buffer Counts { uint counts[]; };
 layout(std430, binding = 8) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
+// Per wire (u_lod): sides, drawn sides (3.. a tube, 2 a strip, 1 a line), 1 where it holds the previous frame's
+// state, 1 where visible.
+layout(std430, binding = 9) buffer WireState { uvec4 wire_state[]; };
+layout(std430, binding = 10) buffer Counter { uint ring_counter; uint overflow; };
 uniform uint u_wires;
+uniform uint u_ring_capacity;
+// The LOD (wire/lod.hpp, per-segment evaluation at node resolution): the view and the settings' values.
+uniform bool u_lod;
+uniform mat3 u_view_rot;  // world -> view rotation (GL view space: looking down -z)
+uniform dvec3 u_eye;
+uniform float u_focal, u_tan_x, u_tan_y, u_near, u_far, u_eps, u_band, u_strip_px, u_line_px;
+uniform uint u_max_rings, u_max_sides;  // u_max_sides <= kMaxSides
+uniform bool u_coarse;
+uniform float u_sagitta[257];  // 1 - cos(pi / n), n <= 256
 
 const float kPi = 3.14159265358979;
 const float kSplitCos = 0.70710678;  // a step turning more than 45 degrees is split
 const uint kMaxDepth = 10u;          // FrameSettings::max_subdivision_depth's default
 
 Header H;
-uint N, SEGS;
+uint N, SEGS, RING_FIRST;
 bool CLOSED;
 
 // ---- a segment: b0 and the differences of its control points ----
@@ -269,6 +288,110 @@ void put_ring(uint index, vec3 centre, float radius, float u, vec3 r, vec3 s) {
     ring_words[b + 6u] = f.y;
 }
 
+
+// ---- the LOD (modules/wire/src/lod/update.cpp's per-segment pass, view.hpp's hull depth and plane test) ----
+uint hysteresis_count(uint old_count, uint raw, float band) {
+    if (old_count == 0u || raw >= old_count || band < 0.0) return raw;
+    if (float(old_count) <= float(raw) * (1.0 + band) + 1.0) return old_count;
+    return min(old_count, raw + 1u + raw / 8u);
+}
+// n = ceil(pi / acos(1 - x)) is the least n with x >= 1 - cos(pi / n) (the sagitta of an n-gon per unit
+// radius): found in a table of those, computed in double on the CPU, so no inverse cosine in float (GLSL leaves
+// its precision to the driver: llvmpipe's moved a 6 px tube from 4 to 5 sides).
+uint sides_for_radius(float radius, float z, float k) {
+    float r_px = radius * u_focal * k / max(z, u_near);
+    if (!(r_px > 0.0)) return 3u;
+    float x = u_eps / r_px;
+    if (x >= 0.5) return 3u;
+    for (uint n = 4u; n < u_max_sides; ++n) {
+        if (x >= u_sagitta[n]) return n;
+    }
+    return u_max_sides;
+}
+uint drawn_sides_for(float radius_px, uint sides, uint old_drawn) {
+    float keep = 1.0 + max(u_band, 0.0);
+    if (u_line_px > 0.0 && (radius_px < u_line_px || (old_drawn == 1u && radius_px < u_line_px * keep))) return 1u;
+    if (u_strip_px > 0.0 && (radius_px < u_strip_px || (old_drawn == 2u && radius_px < u_strip_px * keep))) return 2u;
+    return sides;
+}
+vec3 to_view(vec3 rel) { vec3 q = u_view_rot * rel; return vec3(q.x, q.y, -q.z); }
+uint outside(vec3 q, float rx, float ry, float r) {
+    uint m = 0u;
+    m |= (q.x + q.z * u_tan_x < -rx) ? 1u : 0u;
+    m |= (q.z * u_tan_x - q.x < -rx) ? 2u : 0u;
+    m |= (q.y + q.z * u_tan_y < -ry) ? 4u : 0u;
+    m |= (q.z * u_tan_y - q.y < -ry) ? 8u : 0u;
+    m |= (q.z - u_near < -r) ? 16u : 0u;
+    m |= (u_far - q.z < -r) ? 32u : 0u;
+    return m;
+}
+// Writes the wire's counts (over the previous ones unless restart) and state; returns its ring total, 0 when
+// culled. radius_px: the projected radius.
+uint lod(uint w, Job job, vec3 offset, bool restart, out float radius_px) {
+    float radius = 0.0;
+    for (uint j = 0u; j < N; ++j) radius = max(radius, node_radius(j));
+    float rx = radius * sqrt(1.0 + u_tan_x * u_tan_x), ry = radius * sqrt(1.0 + u_tan_y * u_tan_y);
+    uvec4 state = restart ? uvec4(0u) : wire_state[w];
+    bool fresh = state.z == 0u;
+    uint wire_outside = 63u, visible = 0u, total = CLOSED ? 0u : 1u;
+    float wire_z = 1.0 / 0.0, wire_k = 1.0;
+    float scale = u_eps / u_focal;
+    for (uint k = 0u; k < SEGS; ++k) {
+        Seg c = load_seg(k);
+        vec3 p[4];
+        p[0] = offset + c.b0; p[1] = p[0] + c.d0; p[2] = p[1] + c.d1; p[3] = p[2] + c.d2;
+        uint seg_out = 63u;
+        float z_min = 1.0 / 0.0, a = 0.0, b = 0.0;
+        bool in_front = true;
+        for (int i = 0; i < 4; ++i) {
+            vec3 q = to_view(p[i]);
+            seg_out &= outside(q, rx, ry, radius);
+            z_min = min(z_min, q.z);
+            if (q.z >= u_near) {
+                a = max(a, abs(q.x) / q.z);
+                b = max(b, abs(q.y) / q.z);
+            } else {
+                in_front = false;
+            }
+        }
+        if (!in_front) { a = u_tan_x; b = u_tan_y; }
+        a = min(a, u_tan_x);
+        b = min(b, u_tan_y);
+        z_min = max(z_min, u_near);
+        float hk = sqrt(1.0 + a * a + b * b);
+        wire_outside &= seg_out;
+        bool seg_visible = seg_out == 0u;
+        uint raw = 1u;
+        if (seg_visible || !u_coarse) {
+            float m = max(length(c.d1 - c.d0), length(c.d2 - c.d1));  // Wang's M: the second differences
+            float eps_world = scale * z_min / hk;
+            float cnt = ceil(sqrt((3.0 * m) / (4.0 * eps_world)));
+            bool ok = eps_world > 0.0 && !isinf(m) && !isnan(m);
+            raw = ok ? (cnt < float(u_max_rings) ? max(uint(cnt), 1u) : u_max_rings) : u_max_rings;
+            if (seg_visible) {
+                ++visible;
+                wire_z = min(wire_z, z_min);
+                wire_k = max(wire_k, hk);
+            }
+        }
+        uint old_count = fresh ? 0u : counts[job.count_first + k];
+        uint count = min(old_count > raw ? hysteresis_count(old_count, raw, u_band) : raw, u_max_rings);
+        counts[job.count_first + k] = count;
+        total += count;
+    }
+    radius_px = 0.0;
+    if (wire_outside != 0u) {
+        wire_state[w] = uvec4(0u);  // culled: the next frame starts afresh (cull_lod)
+        return 0u;
+    }
+    uint required_sides = visible == 0u ? 3u : sides_for_radius(radius, wire_z, wire_k);
+    uint sides = min(fresh ? required_sides : hysteresis_count(state.x, required_sides, u_band), u_max_sides);
+    radius_px = visible == 0u ? 0.0 : radius * u_focal * wire_k / max(wire_z, u_near);
+    uint drawn = drawn_sides_for(radius_px, sides, state.y);
+    wire_state[w] = uvec4(sides, drawn, 1u, 1u);
+    return total;
+}
+
 // ---- the walk ----
 uint count_of(Job job, uint k) {
     uint c = counts[job.count_first + k];
@@ -287,7 +410,7 @@ vec4 walk(Job job, vec3 r0, bool write, float holonomy, double total) {
     vec3 r = r0;
     double s = 0.0, u = 0.0;
     uint index = 0u;
-    if (write) put_ring(job.ring_first, a.c.b0, radius_at(a, 0.0), 0.0, r, cross(at, r));
+    if (write) put_ring(RING_FIRST, a.c.b0, radius_at(a, 0.0), 0.0, r, cross(at, r));
     uint k = 0u, j = 1u;  // the next ring: j-th of segment k
     for (;;) {
         // Next ring's parameter: (k, j / count), segments without rings skipped; an open wire's last at t = 1.
@@ -316,7 +439,7 @@ vec4 walk(Job job, vec3 r0, bool write, float holonomy, double total) {
                 rr = ca * r + sn * ss;
                 ss = ca * ss - sn * r;
             }
-            put_ring(job.ring_first + index, b.c.b0 + offset_at(b.c, tb), radius_at(b, tb), float(u), rr, ss);
+            put_ring(RING_FIRST + index, b.c.b0 + offset_at(b.c, tb), radius_at(b, tb), float(u), rr, ss);
         }
         a = b; sa = sb; ta = tb; at = bt;
         if (last_open) break;
@@ -345,6 +468,24 @@ void main() {
     CLOSED = (H.flags & 1u) != 0u;
     SEGS = CLOSED ? N : N - 1u;
     Job job = jobs[w];
+    // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
+    uint n = CLOSED ? 0u : 1u;
+    float radius_px = 0.0;
+    if (u_lod) {
+        vec3 offset = vec3(job.origin.xyz - u_eye);
+        n = lod(w, job, offset, (job.flags & 2u) != 0u, radius_px);
+    } else {
+        for (uint k = 0u; k < SEGS; ++k) n += count_of(job, k);
+    }
+    jobs[w].ring_count = 0u;
+    jobs[w].totals = vec4(0.0, 0.0, 0.0, radius_px);
+    if (n == 0u) return;  // culled
+    RING_FIRST = atomicAdd(ring_counter, n);
+    jobs[w].ring_first = RING_FIRST;
+    if (RING_FIRST + n > u_ring_capacity) {
+        atomicAdd(overflow, 1u);
+        return;
+    }
     // The first normal: the carried previous one projected onto the first tangent, else seeded from an axis.
     vec3 t0 = unit_tangent(load_seg(0u), 0.0);
     if (t0 == vec3(0.0)) t0 = vec3(0.0, 0.0, 1.0);
@@ -362,17 +503,19 @@ void main() {
         totals = walk(job, r0, true, 0.0, 0.0);
     }
     jobs[w].first_normal = vec4(r0, 1.0);
-    jobs[w].totals = totals;
+    jobs[w].totals = vec4(totals.xyz, radius_px);
+    jobs[w].ring_count = n;
 }
 )glsl";
 
 struct Job {
-    uint32_t ring_first = 0, count_first = 0, flags = 0, pad = 0;
+    uint32_t ring_first = 0, count_first = 0, flags = 0, ring_count = 0;
     float previous_normal[4] = {0, 0, 0, 0};
     float first_normal[4] = {0, 0, 0, 0};
     float totals[4] = {0, 0, 0, 0};
+    double origin[4] = {0, 0, 0, 0};
 };
-static_assert(sizeof(Job) == 64, "the ring pass's std430 job record");
+static_assert(sizeof(Job) == 96, "the ring pass's std430 job record");
 
 }  // namespace
 
@@ -385,50 +528,83 @@ engine::Expected<GpuRingPass> GpuRingPass::create() {
     return pass;
 }
 
-Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs) {
+Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs, const GpuLodFrame* lod) {
     const std::vector<GpuCurveHeader>& headers = curves.header_data_;
     if (jobs.size() != headers.size()) {
         return Status::error("the ring pass got " + std::to_string(jobs.size()) + " jobs for the curve pass's " +
                              std::to_string(headers.size()) + " wires");
     }
+    if (lod != nullptr && !lod->settings.keep_node_resolution) {
+        return Status::error("the GPU LOD evaluates at node resolution only (LodSettings::keep_node_resolution): "
+                             "spans below it are not on the GPU yet");
+    }
+    const uint32_t max_rings = lod == nullptr || lod->settings.max_rings_per_segment == 0
+                                   ? 256u
+                                   : lod->settings.max_rings_per_segment;
     std::vector<Job> job_data(jobs.size());
-    std::vector<uint32_t> counts;
-    ring_first_.assign(jobs.size(), 0);
-    ring_counts_.assign(jobs.size(), 0);
-    std::size_t rings = 0;
+    std::vector<uint32_t> counts, count_first(jobs.size()), segments(jobs.size());
+    std::size_t rings = 0, count_total = 0;
     for (std::size_t w = 0; w < jobs.size(); ++w) {
         const GpuCurveHeader& h = headers[w];
         const bool closed = (h.flags & 1u) != 0;
         const std::size_t segs = closed ? h.node_count : h.node_count - 1;
+        Job& j = job_data[w];
+        j.count_first = static_cast<uint32_t>(count_total);
+        count_first[w] = j.count_first;
+        segments[w] = static_cast<uint32_t>(segs);
+        count_total += segs;
+        j.flags = (jobs[w].has_previous_normal ? 1u : 0u) | (jobs[w].restart_lod ? 2u : 0u);
+        j.previous_normal[0] = jobs[w].previous_normal.x;
+        j.previous_normal[1] = jobs[w].previous_normal.y;
+        j.previous_normal[2] = jobs[w].previous_normal.z;
+        const glm::dvec3 origin = curves.origins_[w];
+        j.origin[0] = origin.x, j.origin[1] = origin.y, j.origin[2] = origin.z;
+        if (lod != nullptr) {
+            rings += (closed ? 0 : 1) + segs * max_rings;
+            continue;
+        }
         if (jobs[w].counts.size() != segs) {
             return Status::error("wire " + std::to_string(w) + ": " + std::to_string(jobs[w].counts.size()) +
                                  " ring counts for its " + std::to_string(segs) + " segments");
         }
         // place_rings: counts[k] rings on segment k (segment 0 at least one), an open wire one more at the end.
-        std::size_t n = closed ? 0 : 1;
-        for (std::size_t k = 0; k < segs; ++k) n += k == 0 ? std::max<uint32_t>(jobs[w].counts[k], 1) : jobs[w].counts[k];
-        Job& j = job_data[w];
-        j.ring_first = static_cast<uint32_t>(rings);
-        j.count_first = static_cast<uint32_t>(counts.size());
-        j.flags = jobs[w].has_previous_normal ? 1u : 0u;
-        j.previous_normal[0] = jobs[w].previous_normal.x;
-        j.previous_normal[1] = jobs[w].previous_normal.y;
-        j.previous_normal[2] = jobs[w].previous_normal.z;
+        rings += closed ? 0 : 1;
+        for (std::size_t k = 0; k < segs; ++k) rings += k == 0 ? std::max<uint32_t>(jobs[w].counts[k], 1) : jobs[w].counts[k];
         counts.insert(counts.end(), jobs[w].counts.begin(), jobs[w].counts.end());
-        ring_first_[w] = static_cast<uint32_t>(rings);
-        ring_counts_[w] = static_cast<uint32_t>(n);
-        rings += n;
     }
-    ring_total_ = rings;
-    if (jobs.empty()) return Status::success();
+    if (lod != nullptr && lod->ring_capacity != 0) rings = lod->ring_capacity;
+    if (jobs.empty()) {
+        count_first_.clear(), segments_.clear();
+        ring_total_ = 0;
+        return Status::success();
+    }
+    // The counts and the LOD's per-wire state stay on the GPU while the wires' layout does (the hysteresis).
+    const bool keep = lod != nullptr && lod_ && count_first == count_first_ && segments == segments_;
+    if (!keep) {
+        if (counts.empty()) counts.assign(count_total, 0);
+        auto count_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(counts), "wire gpu ring counts");
+        const std::vector<uint32_t> zeros(4 * jobs.size(), 0);
+        auto state_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(zeros), "wire gpu lod state");
+        if (!count_buffer) return Status::error(count_buffer.error().message);
+        if (!state_buffer) return Status::error(state_buffer.error().message);
+        counts_ = std::move(*count_buffer), state_ = std::move(*state_buffer);
+    }
     auto job_buffer = engine::gfx::make_buffer(std::span<const Job>(job_data), "wire gpu ring jobs");
-    auto count_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(counts), "wire gpu ring counts");
-    auto ring_buffer = engine::gfx::make_buffer({.size_bytes = std::max<std::size_t>(rings, 1) * sizeof(PackedRing),
-                                                 .label = "wire gpu rings"});
-    for (const auto* b : {&job_buffer, &count_buffer, &ring_buffer}) {
-        if (!*b) return Status::error(b->error().message);
+    const uint32_t zero_counter[2] = {0, 0};
+    auto counter = engine::gfx::make_buffer(std::span<const uint32_t>(zero_counter), "wire gpu ring counter");
+    if (!job_buffer) return Status::error(job_buffer.error().message);
+    if (!counter) return Status::error(counter.error().message);
+    jobs_ = std::move(*job_buffer), counter_ = std::move(*counter);
+    if (rings > ring_capacity_ || !rings_) {
+        auto ring_buffer = engine::gfx::make_buffer({.size_bytes = std::max<std::size_t>(rings, 1) * sizeof(PackedRing),
+                                                     .label = "wire gpu rings"});
+        if (!ring_buffer) return Status::error(ring_buffer.error().message);
+        rings_ = std::move(*ring_buffer);
+        ring_capacity_ = std::max<std::size_t>(rings, 1);
     }
-    jobs_ = std::move(*job_buffer), counts_ = std::move(*count_buffer), rings_ = std::move(*ring_buffer);
+    count_first_ = std::move(count_first), segments_ = std::move(segments);
+    count_total_ = count_total;
+    lod_ = lod != nullptr;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, curves.headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, curves.nodes_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, curves.segments_.id());
@@ -436,8 +612,40 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, jobs_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, counts_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, state_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
     program_.use();
-    glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(jobs.size()));
+    const auto at = [&](const char* name) { return program_.uniform_location(name); };
+    glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));
+    glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
+    glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);
+    if (lod != nullptr) {
+        const LodView& v = lod->view;
+        const LodSettings& st = lod->settings;
+        const glm::mat3 rotation(glm::dmat3(v.view_from_world));
+        glUniformMatrix3fv(at("u_view_rot"), 1, GL_FALSE, &rotation[0][0]);
+        glUniform3d(at("u_eye"), v.eye_m.x, v.eye_m.y, v.eye_m.z);
+        glUniform1f(at("u_focal"), static_cast<float>(v.focal_px));
+        glUniform1f(at("u_tan_x"), static_cast<float>(v.tan_half_x));
+        glUniform1f(at("u_tan_y"), static_cast<float>(v.tan_half_y));
+        glUniform1f(at("u_near"), static_cast<float>(v.near_m));
+        glUniform1f(at("u_far"), static_cast<float>(v.far_m));
+        // LodSettings' defaults, as update_lod reads them (lod/view.hpp, Limits in lod/update.cpp).
+        const double tol = st.tolerance_px > 0.0 ? std::max(st.tolerance_px, 1e-6) : 0.5;
+        glUniform1f(at("u_eps"), static_cast<float>(tol));
+        glUniform1f(at("u_band"), static_cast<float>(st.hysteresis_band == 0.0 ? 0.25 : st.hysteresis_band));
+        glUniform1f(at("u_strip_px"), static_cast<float>(st.strip_radius_px == 0.0 ? 2.0 : st.strip_radius_px));
+        glUniform1f(at("u_line_px"), static_cast<float>(st.line_radius_px == 0.0 ? 0.5 : st.line_radius_px));
+        glUniform1ui(at("u_max_rings"), max_rings);
+        glUniform1ui(at("u_max_sides"), std::clamp<uint32_t>(st.max_sides ? st.max_sides : 32u, 3u, kMaxSides));
+        static const std::array<float, kMaxSides + 1> sagitta = [] {
+            std::array<float, kMaxSides + 1> t{};
+            for (uint32_t n = 3; n <= kMaxSides; ++n) t[n] = static_cast<float>(1.0 - std::cos(std::numbers::pi / n));
+            return t;
+        }();
+        glUniform1fv(at("u_sagitta"), static_cast<GLsizei>(sagitta.size()), sagitta.data());
+        glUniform1i(at("u_coarse"), st.coarse_offscreen_segments ? 1 : 0);
+    }
     glDispatchCompute(static_cast<GLuint>((jobs.size() + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);
@@ -446,19 +654,40 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
 
 void GpuRingPass::read(std::vector<GpuRingResult>& out) const {
     out.clear();
-    if (ring_first_.empty()) return;
-    std::vector<PackedRing> rings(ring_total_);
-    glGetNamedBufferSubData(rings_.id(), 0, static_cast<GLsizeiptr>(rings.size() * sizeof(PackedRing)), rings.data());
-    std::vector<Job> jobs(ring_first_.size());
+    if (count_first_.empty()) return;
+    uint32_t counter[2] = {0, 0};
+    glGetNamedBufferSubData(counter_.id(), 0, sizeof(counter), counter);
+    const std::size_t used = std::min<std::size_t>(counter[0], ring_capacity_);
+    std::vector<PackedRing> rings(used);
+    if (used != 0) {
+        glGetNamedBufferSubData(rings_.id(), 0, static_cast<GLsizeiptr>(used * sizeof(PackedRing)), rings.data());
+    }
+    std::vector<Job> jobs(count_first_.size());
     glGetNamedBufferSubData(jobs_.id(), 0, static_cast<GLsizeiptr>(jobs.size() * sizeof(Job)), jobs.data());
-    out.resize(ring_first_.size());
+    std::vector<uint32_t> counts(count_total_);
+    glGetNamedBufferSubData(counts_.id(), 0, static_cast<GLsizeiptr>(counts.size() * sizeof(uint32_t)), counts.data());
+    std::vector<uint32_t> state(4 * jobs.size());
+    if (lod_) glGetNamedBufferSubData(state_.id(), 0, static_cast<GLsizeiptr>(state.size() * sizeof(uint32_t)), state.data());
+    out.resize(jobs.size());
     for (std::size_t w = 0; w < out.size(); ++w) {
         GpuRingResult& r = out[w];
-        r.rings.assign(rings.begin() + ring_first_[w], rings.begin() + ring_first_[w] + ring_counts_[w]);
-        r.first_normal = glm::vec3(jobs[w].first_normal[0], jobs[w].first_normal[1], jobs[w].first_normal[2]);
-        r.u_close = jobs[w].totals[0];
-        r.length_m = jobs[w].totals[1];
-        r.holonomy_rad = jobs[w].totals[2];
+        const Job& j = jobs[w];
+        const bool fits = j.ring_count != 0 && std::size_t{j.ring_first} + j.ring_count <= used;
+        if (fits) r.rings.assign(rings.begin() + j.ring_first, rings.begin() + j.ring_first + j.ring_count);
+        r.counts.assign(counts.begin() + count_first_[w], counts.begin() + count_first_[w] + segments_[w]);
+        r.first_normal = glm::vec3(j.first_normal[0], j.first_normal[1], j.first_normal[2]);
+        r.u_close = j.totals[0];
+        r.length_m = j.totals[1];
+        r.holonomy_rad = j.totals[2];
+        r.radius_px = j.totals[3];
+        if (lod_) {
+            r.sides = state[4 * w];
+            r.drawn_sides = state[4 * w + 1];
+            r.visible = state[4 * w + 3] != 0;
+            r.overflow = r.visible && !fits;
+        } else {
+            r.overflow = !fits;
+        }
     }
 }
 

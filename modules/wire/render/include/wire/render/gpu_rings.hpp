@@ -20,9 +20,14 @@
 // Precision: float arithmetic on the segments' difference form (GpuCurvePass keeps b0 and the differences of the
 // control points), so derivatives, chords between rings and arc lengths keep float precision relative to a
 // segment, not to the wire's extent; centres are float offsets from the wire's origin (as the CPU's Ring).
-// Not here yet: the screen-space LOD (the counts come from the caller), the scan and draw arguments (steps 4-5).
+// The counts: the caller's (place_rings' rule), or the screen-space LOD's (wire/lod.hpp's per-segment evaluation
+// at node resolution: Wang's count at each segment's nearest hull depth and off-axis factor, coarse off-screen
+// segments, the side count, strips and lines, hysteresis on counts and sides kept on the GPU between builds of the
+// same wires). A wire's rings get a range of the ring buffer by an atomic counter (no scan).
+// Not here yet: LOD below node resolution (spans), the draw arguments (steps 4-5).
 #pragma once
 
+#include "wire/lod.hpp"
 #include "wire/packed_ring.hpp"
 #include "wire/render/gpu_curves.hpp"
 
@@ -36,14 +41,36 @@ namespace wire::render {
 
 /// One wire's ring request, for the wire of the same index in the curve pass's last build.
 struct GpuRingJob {
-    std::span<const uint32_t> counts;  ///< rings per segment, place_rings' rule (segment 0 gets at least 1)
+    /// Without the LOD: rings per segment, place_rings' rule (segment 0 gets at least 1). With it: unused.
+    std::span<const uint32_t> counts;
     bool has_previous_normal = false;  ///< FrameSettings::has_previous_normal
     glm::vec3 previous_normal{};       ///< FrameSettings::previous_normal (world direction)
+    /// With the LOD: forget this wire's previous counts and sides (update_lod on a fresh WireLod). They are also
+    /// forgotten when the build's wires or segment counts differ from the last build's.
+    bool restart_lod = false;
+};
+
+/// The most radial sides the GPU LOD gives (LodSettings::max_sides above it is taken as this).
+inline constexpr uint32_t kMaxSides = 256;
+
+/// The LOD a build evaluates on the GPU.
+struct GpuLodFrame {
+    LodView view{};
+    /// keep_node_resolution must be true (spans are not on the GPU yet: build() refuses otherwise).
+    LodSettings settings{.keep_node_resolution = true};
+    /// Ring records the build may write; 0: every segment at max_rings_per_segment (always enough). A wire that
+    /// does not fit is not written (GpuRingResult::overflow).
+    std::size_t ring_capacity = 0;
 };
 
 /// One wire's rings read back.
 struct GpuRingResult {
-    std::vector<PackedRing> rings;  ///< centres relative to the curve pass's origin of the wire
+    std::vector<PackedRing> rings;  ///< centres relative to the curve pass's origin of the wire; empty if culled
+    std::vector<uint32_t> counts;   ///< rings per segment (the LOD's, or the caller's)
+    uint32_t sides = 0, drawn_sides = 0;  ///< with the LOD: WireLod::sides, drawn_sides (0 if culled)
+    bool visible = true;            ///< with the LOD: WireLod::visible
+    bool overflow = false;          ///< the ring buffer was full: nothing written
+    float radius_px = 0.0f;         ///< with the LOD: WireLod::radius_px
     glm::vec3 first_normal{};       ///< ring 0's normal r (the next frame's previous normal)
     double u_close = 0.0;           ///< closed loops: u where the loop closes (RingSet::u.back())
     double length_m = 0.0;          ///< RingSet::length_m
@@ -59,18 +86,20 @@ public:
 
     /// Every wire's rings from `curves`' last build (one dispatch). jobs.size() must equal the number of wires of
     /// that build and each job's counts its wire's segment count; otherwise the call fails naming the wire.
-    [[nodiscard]] Status build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs);
+    /// With `lod`, the counts come from the LOD on the GPU (see the file comment).
+    [[nodiscard]] Status build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs,
+                               const GpuLodFrame* lod = nullptr);
 
     /// The last build's rings, one result per wire (waits for the GPU).
     void read(std::vector<GpuRingResult>& out) const;
 
-    [[nodiscard]] std::size_t ring_count() const { return ring_total_; }  ///< rings of the last build
 
 private:
     engine::gfx::Program program_;
-    engine::gfx::Buffer jobs_, counts_, rings_;
-    std::vector<uint32_t> ring_first_, ring_counts_;
-    std::size_t ring_total_ = 0;
+    engine::gfx::Buffer jobs_, counts_, rings_, state_, counter_;
+    std::vector<uint32_t> count_first_, segments_;  // per wire of the last build: its counts' range
+    std::size_t ring_capacity_ = 0, ring_total_ = 0, count_total_ = 0;
+    bool lod_ = false;
 };
 
 }  // namespace wire::render
