@@ -3,6 +3,8 @@
 
 #include "wire/spline.hpp"
 
+#include "gpu_wire_data.hpp"
+
 #include <epoxy/gl.h>
 #include <glm/common.hpp>
 
@@ -12,9 +14,6 @@
 namespace wire::render {
 namespace {
 
-constexpr uint32_t kClosed = 1u;
-constexpr uint32_t kKindShift = 1u;
-constexpr uint32_t kLinear = 0u, kCatmullRom = 1u, kC2 = 2u;
 
 // One invocation per wire. Per curve node j: its incoming and outgoing chords (an open end reflects the missing
 // neighbour: the missing chord equals the other), the knot ratio rho = (l_out / l_in)^alpha, and the
@@ -22,22 +21,17 @@ constexpr uint32_t kLinear = 0u, kCatmullRom = 1u, kC2 = 2u;
 // in float); node j writes its incoming segment (put_segment), holding its outgoing tangent for the next node.
 constexpr const char* kCurveSource = R"glsl(#version 450 core
 layout(local_size_x = 64) in;
-struct Header {
-    uint node_first;
-    uint node_count;
-    uint segment_first;
-    uint flags;
-    vec4 kb;  // alpha, tension, bias, continuity
-    uint per_node_first;  // 0xffffffff: wire-wide kb
-    uint stretch_first;   // 0xffffffff: stretch 1 on every segment
-    uint pad1, pad2;
-};
+GPU_WIRE_HEADER
 layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
 layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };  // xyz: offset from the origin; w: radius
 layout(std430, binding = 2) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: see put_segment
 layout(std430, binding = 3) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
-layout(std430, binding = 4) readonly buffer PerNode { vec4 per_node[]; };  // tension, bias, continuity, 0
+// Per-node tension, bias, continuity (vec4 a node), then stretch (4 segments a vec4), from Header.extra_first.
+layout(std430, binding = 4) readonly buffer Extras { vec4 extras[]; };
+// u_persist: each wire's header goes on to its slot (the ring pass reads it there every frame).
+layout(std430, binding = 6) writeonly buffer SlotHeaders { Header slot_headers[]; };
 uniform uint u_wires;
+uniform bool u_persist;
 
 vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
 
@@ -150,11 +144,18 @@ void c2_tangents(Header h, bool closed) {
 // b3 - b2 = t1 / 3. The differences keep their own relative precision, so the ring pass's derivatives and chords
 // do not inherit the rounding of the offsets (2^-24 of the wire's extent, which on a 100 m wire of 5 cm segments is
 // 1e-4 of a segment).
+// The w components carry what the ring pass reads per segment: the radii of its start and end nodes and its
+// stretch.
+float seg_stretch(Header h, uint k) {
+    if ((h.flags & kHasStretch) == 0u) return 1.0;
+    uint base = h.extra_first + ((h.flags & kHasPerNode) != 0u ? h.node_count : 0u);
+    return extras[base + k / 4u][k % 4u];
+}
 void put_segment(Header h, uint k, vec3 p0, vec3 t0, vec3 t1, vec3 chord_k) {
     uint s = 4u * (h.segment_first + k);
-    segments[s] = vec4(p0, 1.0);
-    segments[s + 1u] = vec4(t0 / 3.0, 0.0);
-    segments[s + 2u] = vec4(chord_k - (t0 + t1) / 3.0, 0.0);
+    segments[s] = vec4(p0, nodes[h.node_first + k].w);
+    segments[s + 1u] = vec4(t0 / 3.0, nodes[h.node_first + (k + 1u) % h.node_count].w);
+    segments[s + 2u] = vec4(chord_k - (t0 + t1) / 3.0, seg_stretch(h, k));
     segments[s + 3u] = vec4(t1 / 3.0, 0.0);
 }
 
@@ -162,6 +163,7 @@ void main() {
     uint w = gl_GlobalInvocationID.x;
     if (w >= u_wires) return;
     Header h = headers[w];
+    if (u_persist) slot_headers[h.slot] = h;
     uint n = h.node_count;
     bool closed = (h.flags & 1u) != 0u;
     uint kind = (h.flags >> 1u) & 3u;
@@ -173,9 +175,9 @@ void main() {
             double len = hlen(h, k);
             dvec3 t0 = scratch[sidx(h, k)].xyz * len, t1 = scratch[sidx(h, (k + 1u) % n)].xyz * len;
             uint s = 4u * (h.segment_first + k);
-            segments[s] = vec4(vec3(p0), 1.0);
-            segments[s + 1u] = vec4(vec3(t0 / 3.0), 0.0);
-            segments[s + 2u] = vec4(vec3((p1 - p0) - (t0 + t1) / 3.0), 0.0);
+            segments[s] = vec4(vec3(p0), nodes[h.node_first + k].w);
+            segments[s + 1u] = vec4(vec3(t0 / 3.0), nodes[h.node_first + (k + 1u) % n].w);
+            segments[s + 2u] = vec4(vec3((p1 - p0) - (t0 + t1) / 3.0), seg_stretch(h, k));
             segments[s + 3u] = vec4(vec3(t1 / 3.0), 0.0);
         }
         return;
@@ -197,8 +199,8 @@ void main() {
             t0 = dout;
             t1 = din;
         } else {
-            if (h.per_node_first != 0xffffffffu) {
-                vec4 k = per_node[h.per_node_first + j];
+            if ((h.flags & kHasPerNode) != 0u) {
+                vec4 k = extras[h.extra_first + j];
                 keep = 1.0 - k.x;
                 b = k.y;
                 c = k.z;
@@ -234,7 +236,7 @@ bool physics(const SplineSettings& spline, const WireNodes& nodes) {
 
 engine::Expected<GpuCurvePass> GpuCurvePass::create() {
     engine::Expected<engine::gfx::Program> program =
-        engine::gfx::make_program({.label = "wire gpu curves", .compute = kCurveSource});
+        engine::gfx::make_program({.label = "wire gpu curves", .compute = detail::with_wire_header(kCurveSource)});
     if (!program) return program.error();
     GpuCurvePass pass;
     pass.program_ = std::move(*program);
@@ -246,83 +248,115 @@ bool GpuCurvePass::supported(const SplineSettings& spline, const WireNodes& node
     return spline.kind == SplineKind::linear || spline.kind == SplineKind::c2 || spline.kind == SplineKind::catmull_rom;
 }
 
+namespace detail {
+
+const char* curve_source() { return kCurveSource; }
+
+std::string with_wire_header(const char* source) {
+    std::string s(source);
+    const std::string key = "GPU_WIRE_HEADER";
+    const std::size_t at = s.find(key);
+    if (at != std::string::npos) s.replace(at, key.size(), kWireHeaderGlsl);
+    return s;
+}
+
+Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
+                   uint32_t material, bool caps, WireUpload& out, uint32_t& segments) {
+    if (!GpuCurvePass::supported(spline, wn)) {
+        return Status::error("the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic wires stay on "
+                             "the CPU path for now)");
+    }
+    const std::size_t n = curve_nodes(wn, spline, out.curve, &out.source, &out.last);
+    if (n < (spline.closed ? 3u : 2u)) {
+        return Status::error("a wire needs at least " + std::string(spline.closed ? "3" : "2") +
+                             " distinct nodes, got " + std::to_string(n) + " after merging coincident ones");
+    }
+    const std::vector<glm::dvec3>& curve = out.curve;
+    // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
+    glm::dvec3 lo = curve.front(), hi = curve.front();
+    for (const glm::dvec3& p : curve) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const glm::dvec3 origin = 0.5 * (lo + hi);
+    GpuCurveHeader h;
+    h.node_first = static_cast<uint32_t>(out.nodes.size());
+    h.node_count = static_cast<uint32_t>(n);
+    h.segment_first = segment_first;
+    const uint32_t kind = spline.kind == SplineKind::linear ? kKindLinear
+                          : spline.kind == SplineKind::c2   ? kKindC2
+                                                            : kKindCatmullRom;
+    h.flags = (spline.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
+              (material << kHeaderMaterialShift);
+    h.alpha = static_cast<float>(spline.alpha);
+    h.tension = static_cast<float>(spline.tension);
+    h.bias = static_cast<float>(spline.bias);
+    h.continuity = static_cast<float>(spline.continuity);
+    h.extra_first = static_cast<uint32_t>(out.extras.size());
+    h.slot = slot;
+    h.origin_m[0] = origin.x, h.origin_m[1] = origin.y, h.origin_m[2] = origin.z;
+    if (kind == kKindCatmullRom && (per_node_kb(wn) || physics(spline, wn))) {
+        // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
+        // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).
+        const bool phys = physics(spline, wn);
+        h.flags |= kHeaderPerNode;
+        for (const uint32_t src : out.source) {
+            const double t_user = wn.kb_tension.empty() ? spline.tension : wn.kb_tension[src];
+            const double b = wn.kb_bias.empty() ? spline.bias : wn.kb_bias[src];
+            const double c = wn.kb_continuity.empty() ? spline.continuity : wn.kb_continuity[src];
+            const double t_curv = phys ? curvature_tension(wn.theta_rad[src], wn.iz_m4[src], wn.length_m[src],
+                                                           wn.delta_length_m[src], wn.area_m2[src])
+                                       : 0.0;
+            const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
+            out.extras.emplace_back(static_cast<float>(t), static_cast<float>(b), static_cast<float>(c), 0.0f);
+        }
+    }
+    const std::size_t segs = spline.closed ? n : n - 1;
+    if (!wn.stretch.empty()) {  // build_curve's Curve::stretch: the element starting at a group's last node
+        h.flags |= kHeaderStretch;
+        for (std::size_t k = 0; k < segs; k += 4) {
+            glm::vec4 v(1.0f);
+            for (std::size_t i = 0; i < 4 && k + i < segs; ++i) v[static_cast<int>(i)] = wn.stretch[out.last[k + i]];
+            out.extras.push_back(v);
+        }
+    }
+    out.headers.push_back(h);
+    // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
+    const float wire_radius = spline.radius_m > 0.0f ? spline.radius_m : kDefaultWireRadius_m;
+    for (std::size_t j = 0; j < n; ++j) {
+        const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[out.source[j]];
+        out.nodes.emplace_back(glm::vec3(curve[j] - origin), r > 0.0f ? r : wire_radius);
+    }
+    segments = static_cast<uint32_t>(segs);
+    return Status::success();
+}
+
+}  // namespace detail
+
 Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
-    header_data_.clear();
+    thread_local detail::WireUpload up;
+    up.clear();
     origins_.clear();
-    std::vector<glm::vec4> node_data;
-    std::vector<glm::dvec3> curve;
-    std::vector<uint32_t> source, last;
-    std::vector<float> stretch;       // only wires whose nodes carry stretch
-    std::vector<glm::vec4> per_node;  // only wires with per-node tension, bias or continuity (or physics)
     uint32_t segment_first = 0;
     for (std::size_t w = 0; w < wires.size(); ++w) {
         const GpuCurveWire& wire = wires[w];
         const std::string name = "wire " + std::to_string(w) + ": ";
         if (wire.nodes == nullptr) return Status::error(name + "no nodes");
-        if (!supported(wire.spline, *wire.nodes)) {
-            return Status::error(name + "the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic "
-                                        "wires stay on the CPU path for now)");
+        uint32_t segs = 0;
+        if (Status st = detail::append_wire(*wire.nodes, wire.spline, segment_first, static_cast<uint32_t>(w), 0,
+                                            true, up, segs);
+            !st) {
+            return Status::error(name + st.message);
         }
-        const std::size_t n = curve_nodes(*wire.nodes, wire.spline, curve, &source, &last);
-        if (n < (wire.spline.closed ? 3u : 2u)) {
-            return Status::error(name + "a wire needs at least " + std::string(wire.spline.closed ? "3" : "2") +
-                                 " distinct nodes, got " + std::to_string(n) + " after merging coincident ones");
-        }
-        // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
-        glm::dvec3 lo = curve.front(), hi = curve.front();
-        for (const glm::dvec3& p : curve) lo = glm::min(lo, p), hi = glm::max(hi, p);
-        const glm::dvec3 origin = 0.5 * (lo + hi);
-        origins_.push_back(origin);
-        GpuCurveHeader h;
-        h.node_first = static_cast<uint32_t>(node_data.size());
-        h.node_count = static_cast<uint32_t>(n);
-        h.segment_first = segment_first;
-        const uint32_t kind = wire.spline.kind == SplineKind::linear ? kLinear
-                              : wire.spline.kind == SplineKind::c2 ? kC2
-                                                                   : kCatmullRom;
-        h.flags = (wire.spline.closed ? kClosed : 0u) | (kind << kKindShift);
-        h.alpha = static_cast<float>(wire.spline.alpha);
-        h.tension = static_cast<float>(wire.spline.tension);
-        h.bias = static_cast<float>(wire.spline.bias);
-        h.continuity = static_cast<float>(wire.spline.continuity);
-        const WireNodes& wn = *wire.nodes;
-        if (kind == kCatmullRom && (per_node_kb(wn) || physics(wire.spline, wn))) {
-            // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
-            // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).
-            const bool phys = physics(wire.spline, wn);
-            h.per_node_first = static_cast<uint32_t>(per_node.size());
-            for (const uint32_t src : source) {
-                const double t_user = wn.kb_tension.empty() ? wire.spline.tension : wn.kb_tension[src];
-                const double b = wn.kb_bias.empty() ? wire.spline.bias : wn.kb_bias[src];
-                const double c = wn.kb_continuity.empty() ? wire.spline.continuity : wn.kb_continuity[src];
-                const double t_curv = phys ? curvature_tension(wn.theta_rad[src], wn.iz_m4[src], wn.length_m[src],
-                                                               wn.delta_length_m[src], wn.area_m2[src])
-                                           : 0.0;
-                const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
-                per_node.emplace_back(static_cast<float>(t), static_cast<float>(b), static_cast<float>(c), 0.0f);
-            }
-        }
-        const std::size_t segs = wire.spline.closed ? n : n - 1;
-        if (!wn.stretch.empty()) {  // build_curve's Curve::stretch: the element starting at a group's last node
-            h.stretch_first = static_cast<uint32_t>(stretch.size());
-            for (std::size_t k = 0; k < segs; ++k) stretch.push_back(wn.stretch[last[k]]);
-        }
-        header_data_.push_back(h);
-        // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
-        const float wire_radius = wire.spline.radius_m > 0.0f ? wire.spline.radius_m : kDefaultWireRadius_m;
-        for (std::size_t j = 0; j < n; ++j) {
-            const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[source[j]];
-            node_data.emplace_back(glm::vec3(curve[j] - origin), r > 0.0f ? r : wire_radius);
-        }
-        segment_first += static_cast<uint32_t>(segs);
+        const GpuCurveHeader& h = up.headers.back();
+        origins_.emplace_back(h.origin_m[0], h.origin_m[1], h.origin_m[2]);
+        segment_first += segs;
     }
+    header_data_ = up.headers;
+    std::vector<glm::vec4>& node_data = up.nodes;
+    std::vector<glm::vec4>& extras = up.extras;
     segment_total_ = segment_first;
     node_bytes_ = node_data.size() * sizeof(glm::vec4);
     header_bytes_ = header_data_.size() * sizeof(GpuCurveHeader);
-    per_node_bytes_ = per_node.size() * sizeof(glm::vec4);
-    stretch_bytes_ = stretch.size() * sizeof(float);
-    if (per_node.empty()) per_node.emplace_back(0.0f);  // a buffer of size 0 cannot be bound
-    if (stretch.empty()) stretch.push_back(1.0f);
+    extra_bytes_ = extras.size() * sizeof(glm::vec4);
+    if (extras.empty()) extras.emplace_back(0.0f);  // a buffer of size 0 cannot be bound
     if (wires.empty()) return Status::success();
 
     auto headers = engine::gfx::make_buffer(std::span<const GpuCurveHeader>(header_data_), "wire gpu curve headers");
@@ -331,20 +365,20 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
                                               .dynamic = true, .label = "wire gpu curve segments"});
     auto scratch = engine::gfx::make_buffer({.size_bytes = node_data.size() * 2 * sizeof(glm::dvec4),
                                              .label = "wire gpu curve scratch"});
-    auto per_node_buffer = engine::gfx::make_buffer(std::span<const glm::vec4>(per_node), "wire gpu curve per-node kb");
-    auto stretch_buffer = engine::gfx::make_buffer(std::span<const float>(stretch), "wire gpu curve stretch");
-    for (const auto* b : {&headers, &nodes, &segments, &scratch, &per_node_buffer, &stretch_buffer}) {
+    auto extra_buffer = engine::gfx::make_buffer(std::span<const glm::vec4>(extras), "wire gpu curve extras");
+    for (const auto* b : {&headers, &nodes, &segments, &scratch, &extra_buffer}) {
         if (!*b) return Status::error(b->error().message);
     }
     headers_ = std::move(*headers), nodes_ = std::move(*nodes), segments_ = std::move(*segments);
-    scratch_ = std::move(*scratch), per_node_ = std::move(*per_node_buffer), stretch_ = std::move(*stretch_buffer);
+    scratch_ = std::move(*scratch), extras_ = std::move(*extra_buffer);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, per_node_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, extras_.id());
     program_.use();
     glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(wires.size()));
+    glUniform1i(program_.uniform_location("u_persist"), 0);
     glDispatchCompute(static_cast<GLuint>((wires.size() + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);
@@ -361,7 +395,7 @@ void GpuCurvePass::read_segments(std::vector<GpuCurveResult>& out) const {
         const GpuCurveHeader& h = header_data_[w];
         GpuCurveResult& r = out[w];
         r.origin_m = origins_[w];
-        r.closed = (h.flags & kClosed) != 0;
+        r.closed = (h.flags & detail::kHeaderClosed) != 0;
         const std::size_t segs = r.closed ? h.node_count : h.node_count - 1;
         r.segments.resize(segs);
         for (std::size_t k = 0; k < segs; ++k) {

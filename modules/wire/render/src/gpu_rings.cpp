@@ -1,6 +1,8 @@
 // The ring stage on the GPU (see gpu_rings.hpp).
 #include "wire/render/gpu_rings.hpp"
 
+#include "gpu_wire_data.hpp"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -16,40 +18,42 @@ namespace {
 // (build_rings, radius, u) and modules/wire/src/frames.cpp (compute_frames, mirrors, Transporter).
 constexpr const char* kRingSource = R"glsl(#version 450 core
 layout(local_size_x = 64) in;
-struct Header {
-    uint node_first;
-    uint node_count;
-    uint segment_first;
-    uint flags;
-    vec4 kb;
-    uint per_node_first;
-    uint stretch_first;  // 0xffffffff: stretch 1
-    uint pad1, pad2;
-};
+GPU_WIRE_HEADER
+// Per dispatched wire: inputs (previous normal for the tests' path) and what the passes found.
 struct Job {
-    uint ring_first;     // out: first ring record (allocated here)
-    uint count_first;    // first per-segment ring count
-    uint flags;          // bit 0: previous_normal is valid; bit 1: restart the LOD's hysteresis
-    uint ring_count;     // out: rings written (0: culled, or the ring buffer was full)
+    uint ring_first;     // out: first ring record (allocated by the LOD stage)
+    uint ring_count;     // out: rings (0: culled, or the ring buffer was full)
+    uint flags;          // in: bit 1 the job gives the previous normal (bit 0: previous_normal is one); else
+                         // the slot's last frame's ring 0 normal is carried
+    uint sides;          // out: drawn sides (3.. a tube, 2 a strip, 1 a line)
     vec4 previous_normal;
     vec4 first_normal;   // out: ring 0's r
     vec4 totals;         // out: u where a closed loop closes, length, holonomy, projected radius (pixels)
-    dvec4 origin;        // the wire's origin (world metres): the LOD's view offset
 };
-layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
-layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };     // w: radius
-layout(std430, binding = 2) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2
-layout(std430, binding = 5) readonly buffer Stretch { float stretch[]; };
+// Per slot, kept between frames: the LOD's state (sides, drawn sides, 1 when it holds a previous frame's, 1
+// visible) and ring 0's normal of the last frame (w = 1 when set). A slot is zeroed when it is given to a wire.
+struct SlotState { uvec4 lod; vec4 first_normal; };
+layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };  // by slot
+layout(std430, binding = 2) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2; w: see below
 layout(std430, binding = 6) buffer Jobs { Job jobs[]; };
-// Rings per segment: the caller's, or (u_lod) the LOD's, over the previous frame's (its hysteresis state).
+// Rings per segment (at Header.segment_first): the caller's, or (u_lod) the LOD's, over the previous frame's.
 layout(std430, binding = 7) buffer Counts { uint counts[]; };
 layout(std430, binding = 8) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
-// Per wire (u_lod): sides, drawn sides (3.. a tube, 2 a strip, 1 a line), 1 where it holds the previous frame's
-// state, 1 where visible.
-layout(std430, binding = 9) buffer WireState { uvec4 wire_state[]; };
+layout(std430, binding = 9) buffer Slots { SlotState slot_state[]; };
 layout(std430, binding = 10) buffer Counter { uint ring_counter; uint overflow; };
+layout(std430, binding = 11) readonly buffer Visible { uint visible[]; };  // the slot of each dispatched wire
+// u_draw: the single draw's records (wire::render's GpuDraw, the chunk records and the indirect commands).
+struct Draw { vec3 offset_m; uint ring_first; uint ring_count; uint sides; uint flags; float u_close; };
+layout(std430, binding = 12) writeonly buffer Draws { Draw draws[]; };
+layout(std430, binding = 13) writeonly buffer Chunks { uvec2 chunks[]; };
+layout(std430, binding = 14) buffer Buckets { uint buckets[]; };  // u_buckets chunk counts, then as many cursors
+layout(std430, binding = 15) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
+layout(std430, binding = 16) readonly buffer Templates { uvec2 templates[]; };  // (count, first index) per side slot and kind
 uniform uint u_wires;
 uniform uint u_ring_capacity;
+uniform uint u_stage;  // 0: LOD (or the caller's counts) and rings; 1: LOD only; 2: the commands; 3: rings only
+uniform bool u_draw;
+uniform uint u_buckets, u_side_slots;
 // The LOD (wire/lod.hpp, per-segment evaluation at node resolution): the view and the settings' values.
 uniform bool u_lod;
 uniform mat3 u_view_rot;  // world -> view rotation (GL view space: looking down -z)
@@ -103,7 +107,11 @@ vec3 unit_tangent(Seg c, float t) {
 }
 
 // ---- radius and u (SegmentCoeffs in rings.cpp) ----
-float node_radius(uint j) { return nodes[H.node_first + j].w; }
+// Node j's radius: segment j's start (w of its b0), the last node of an open wire its last segment's end.
+float node_radius(uint j) {
+    uint s = 4u * (H.segment_first + min(j, SEGS - 1u));
+    return j < SEGS ? segments[s].w : segments[s + 1u].w;
+}
 float node_slope(uint k) {
     bool has_left = CLOSED || k > 0u, has_right = CLOSED || k + 1u < N;
     float rk = node_radius(k);
@@ -124,7 +132,7 @@ Coeffs load(uint k) {
     float ra = node_radius(a), rb = node_radius(b);
     float ma = node_slope(a), mb = node_slope(b);
     o.r = vec4(ra, ma, -3.0 * ra - 2.0 * ma + 3.0 * rb - mb, 2.0 * ra + ma - 2.0 * rb + mb);
-    float st = H.stretch_first == 0xffffffffu ? 1.0 : stretch[H.stretch_first + k];
+    float st = segments[4u * (H.segment_first + k) + 2u].w;
     if (!(st > 0.0)) st = 1.0;
     o.constant = o.r.y == 0.0 && o.r.z == 0.0 && o.r.w == 0.0;
     o.u_per_m = o.constant ? 1.0 / (2.0 * kPi * st * max(o.r.x, 1e-30)) : 0.0;
@@ -327,11 +335,11 @@ uint outside(vec3 q, float rx, float ry, float r) {
 }
 // Writes the wire's counts (over the previous ones unless restart) and state; returns its ring total, 0 when
 // culled. radius_px: the projected radius.
-uint lod(uint w, Job job, vec3 offset, bool restart, out float radius_px) {
+uint lod(uint slot, vec3 offset, out float radius_px) {
     float radius = 0.0;
     for (uint j = 0u; j < N; ++j) radius = max(radius, node_radius(j));
     float rx = radius * sqrt(1.0 + u_tan_x * u_tan_x), ry = radius * sqrt(1.0 + u_tan_y * u_tan_y);
-    uvec4 state = restart ? uvec4(0u) : wire_state[w];
+    uvec4 state = slot_state[slot].lod;
     bool fresh = state.z == 0u;
     uint wire_outside = 63u, visible = 0u, total = CLOSED ? 0u : 1u;
     float wire_z = 1.0 / 0.0, wire_k = 1.0;
@@ -374,34 +382,34 @@ uint lod(uint w, Job job, vec3 offset, bool restart, out float radius_px) {
                 wire_k = max(wire_k, hk);
             }
         }
-        uint old_count = fresh ? 0u : counts[job.count_first + k];
+        uint old_count = fresh ? 0u : counts[H.segment_first + k];
         uint count = min(old_count > raw ? hysteresis_count(old_count, raw, u_band) : raw, u_max_rings);
-        counts[job.count_first + k] = count;
+        counts[H.segment_first + k] = count;
         total += count;
     }
     radius_px = 0.0;
     if (wire_outside != 0u) {
-        wire_state[w] = uvec4(0u);  // culled: the next frame starts afresh (cull_lod)
+        slot_state[slot].lod = uvec4(0u);  // culled: the next frame starts afresh (cull_lod)
         return 0u;
     }
     uint required_sides = visible == 0u ? 3u : sides_for_radius(radius, wire_z, wire_k);
     uint sides = min(fresh ? required_sides : hysteresis_count(state.x, required_sides, u_band), u_max_sides);
     radius_px = visible == 0u ? 0.0 : radius * u_focal * wire_k / max(wire_z, u_near);
     uint drawn = drawn_sides_for(radius_px, sides, state.y);
-    wire_state[w] = uvec4(sides, drawn, 1u, 1u);
+    slot_state[slot].lod = uvec4(sides, drawn, 1u, 1u);
     return total;
 }
 
 // ---- the walk ----
-uint count_of(Job job, uint k) {
-    uint c = counts[job.count_first + k];
+uint count_of(uint k) {
+    uint c = counts[H.segment_first + k];
     return k == 0u ? max(c, 1u) : c;
 }
 
 // Walks the rings in order: place_rings' parameters, build_rings' intervals, compute_frames' carry. With
 // `write`, rotates ring i's frame by -holonomy * s_i / total (closed loops) and writes it. Returns (u at the
 // close, length, holonomy, rings); r0 is ring 0's normal.
-vec4 walk(Job job, vec3 r0, bool write, float holonomy, double total) {
+vec4 walk(vec3 r0, bool write, float holonomy, double total) {
     Coeffs a = load(0u);
     uint sa = 0u;
     float ta = 0.0;
@@ -414,11 +422,11 @@ vec4 walk(Job job, vec3 r0, bool write, float holonomy, double total) {
     uint k = 0u, j = 1u;  // the next ring: j-th of segment k
     for (;;) {
         // Next ring's parameter: (k, j / count), segments without rings skipped; an open wire's last at t = 1.
-        while (k < SEGS && j >= count_of(job, k)) { ++k; j = 0u; }
+        while (k < SEGS && j >= count_of(k)) { ++k; j = 0u; }
         bool last_open = k == SEGS && !CLOSED;
         if (k == SEGS && !last_open) break;
         uint sb = last_open ? SEGS - 1u : k;
-        float tb = last_open ? 1.0 : float(j) / float(count_of(job, k));
+        float tb = last_open ? 1.0 : float(j) / float(count_of(k));
         Coeffs b = a;
         if (sb != sa) b = load(sb);
         // The interval's length and u: the rest of a's segment, the segments crossed, b's part of its own.
@@ -460,68 +468,186 @@ vec4 walk(Job job, vec3 r0, bool write, float holonomy, double total) {
     return vec4(float(u), float(s), hol, float(index + 1u));
 }
 
+// The chunk records a wire draws (upload_plan.hpp's chunk_counts): a cap chunk on a capped open tube, bands by
+// 16, then the remainder's binary digits.
+uint chunk_count_of(uint kind, uint rings, uint drawn, bool caps) {
+    uint bands = rings == 0u ? 0u : rings - 1u + (CLOSED ? 1u : 0u);
+    bool geometry = drawn <= 2u ? bands > 0u : (bands > 0u || (!CLOSED && caps));
+    if (!geometry || rings == 0u) return 0u;
+    if (kind == 0u) return drawn > 2u && !CLOSED && caps ? 1u : 0u;
+    if (kind == 1u) return bands / 16u;
+    return (bands & (16u >> (kind - 1u))) != 0u ? 1u : 0u;
+}
+uint bucket_of(uint material, uint drawn, uint kind) { return (material * u_side_slots + drawn) * 6u + kind; }
+
+void load_wire(uint slot) {
+    H = headers[slot];
+    N = H.node_count;
+    CLOSED = (H.flags & kClosed) != 0u;
+    SEGS = CLOSED ? N : N - 1u;
+}
+
 void main() {
     uint w = gl_GlobalInvocationID.x;
-    if (w >= u_wires) return;
-    H = headers[w];
-    N = H.node_count;
-    CLOSED = (H.flags & 1u) != 0u;
-    SEGS = CLOSED ? N : N - 1u;
-    Job job = jobs[w];
-    // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
-    uint n = CLOSED ? 0u : 1u;
-    float radius_px = 0.0;
-    if (u_lod) {
-        vec3 offset = vec3(job.origin.xyz - u_eye);
-        n = lod(w, job, offset, (job.flags & 2u) != 0u, radius_px);
-    } else {
-        for (uint k = 0u; k < SEGS; ++k) n += count_of(job, k);
-    }
-    jobs[w].ring_count = 0u;
-    jobs[w].totals = vec4(0.0, 0.0, 0.0, radius_px);
-    if (n == 0u) return;  // culled
-    RING_FIRST = atomicAdd(ring_counter, n);
-    jobs[w].ring_first = RING_FIRST;
-    if (RING_FIRST + n > u_ring_capacity) {
-        atomicAdd(overflow, 1u);
+    if (u_stage == 2u) {
+        // The indirect commands: per bucket (material, side count, chunk kind) its chunk count and first chunk.
+        if (w != 0u) return;
+        uint first = 0u;
+        for (uint b = 0u; b < u_buckets; ++b) {
+            uint count = buckets[b];
+            uvec2 t = templates[b % (6u * u_side_slots)];
+            commands[5u * b] = t.x;
+            commands[5u * b + 1u] = count;
+            commands[5u * b + 2u] = t.y;
+            commands[5u * b + 3u] = 0u;
+            commands[5u * b + 4u] = first;
+            buckets[u_buckets + b] = first;
+            first += count;
+        }
         return;
     }
+    if (w >= u_wires) return;
+    uint slot = visible[w];
+    load_wire(slot);
+    uint material = H.flags >> 16u;
+    bool caps = (H.flags & kCaps) != 0u;
+    Job job = jobs[w];
+    uint n = CLOSED ? 0u : 1u;
+    float radius_px = 0.0;
+    uint drawn = 0u;
+    if (u_stage != 3u) {
+        // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
+        if (u_lod) {
+            vec3 offset = vec3(dvec3(H.origin[0], H.origin[1], H.origin[2]) - u_eye);
+            n = lod(slot, offset, radius_px);
+            drawn = slot_state[slot].lod.y;
+        } else {
+            for (uint k = 0u; k < SEGS; ++k) n += count_of(k);
+            drawn = 3u;
+        }
+        jobs[w].ring_count = 0u;
+        jobs[w].sides = drawn;
+        jobs[w].totals = vec4(0.0, 0.0, 0.0, radius_px);
+        if (n == 0u) return;  // culled
+        uint first = atomicAdd(ring_counter, n);
+        jobs[w].ring_first = first;
+        if (first + n > u_ring_capacity) {
+            atomicAdd(overflow, 1u);
+            return;
+        }
+        jobs[w].ring_count = n;
+        if (u_draw) {
+            for (uint kind = 0u; kind < 6u; ++kind) {
+                uint c = chunk_count_of(kind, n, drawn, caps);
+                if (c != 0u) atomicAdd(buckets[bucket_of(material, drawn, kind)], c);
+            }
+        }
+        if (u_stage == 1u) return;
+        job = jobs[w];
+    } else {
+        n = job.ring_count;
+        drawn = job.sides;
+        radius_px = job.totals.w;
+        if (n == 0u) return;
+    }
+    RING_FIRST = job.ring_first;
     // The first normal: the carried previous one projected onto the first tangent, else seeded from an axis.
     vec3 t0 = unit_tangent(load_seg(0u), 0.0);
     if (t0 == vec3(0.0)) t0 = vec3(0.0, 0.0, 1.0);
     vec3 r0 = seed_normal(t0);
-    if ((job.flags & 1u) != 0u) {
-        vec3 p = job.previous_normal.xyz - dot(job.previous_normal.xyz, t0) * t0;
+    // Job flags bit 1: the job gives the previous normal (bit 0: there is one); else the slot's last frame's.
+    vec4 previous = (job.flags & 2u) == 0u           ? slot_state[slot].first_normal
+                    : (job.flags & 1u) != 0u ? vec4(job.previous_normal.xyz, 1.0)
+                                             : vec4(0.0);
+    if (previous.w != 0.0) {
+        vec3 p = previous.xyz - dot(previous.xyz, t0) * t0;
         float len = length(p);
         if (len > 1e-6) r0 = p / len;
     }
     vec4 totals = vec4(0.0);
     if (CLOSED) {
-        totals = walk(job, r0, false, 0.0, 0.0);
-        totals = walk(job, r0, true, totals.z, double(totals.y));
+        totals = walk(r0, false, 0.0, 0.0);
+        totals = walk(r0, true, totals.z, double(totals.y));
     } else {
-        totals = walk(job, r0, true, 0.0, 0.0);
+        totals = walk(r0, true, 0.0, 0.0);
     }
     jobs[w].first_normal = vec4(r0, 1.0);
     jobs[w].totals = vec4(totals.xyz, radius_px);
-    jobs[w].ring_count = n;
+    slot_state[slot].first_normal = vec4(r0, 1.0);
+    if (!u_draw) return;
+    // The draw record (GpuDraw) and the chunk records of this wire.
+    bool tilt = false;
+    float r_first = node_radius(0u);
+    for (uint j = 1u; j < N; ++j) tilt = tilt || node_radius(j) != r_first;
+    uint flags = (CLOSED ? 1u : 0u) | (caps ? 2u : 0u) | (tilt ? 4u : 0u) | (drawn == 2u ? 8u : 0u) |
+                 (drawn == 1u ? 16u : 0u);
+    vec3 offset = vec3(dvec3(H.origin[0], H.origin[1], H.origin[2]) - u_eye);
+    draws[w] = Draw(offset, 7u * RING_FIRST, n, drawn, flags, totals.x);
+    uint band = 0u;
+    for (uint kind = 0u; kind < 6u; ++kind) {
+        uint c = chunk_count_of(kind, n, drawn, caps);
+        if (c == 0u) continue;
+        uint at = atomicAdd(buckets[u_buckets + bucket_of(material, drawn, kind)], c);
+        for (uint i = 0u; i < c; ++i) {
+            uint first_band = kind == 0u ? 0u : band;
+            chunks[at + i] = uvec2(w, first_band);
+            if (kind != 0u) band += 16u >> (kind - 1u);
+        }
+    }
 }
 )glsl";
 
 struct Job {
-    uint32_t ring_first = 0, count_first = 0, flags = 0, ring_count = 0;
+    uint32_t ring_first = 0, ring_count = 0, flags = 0, sides = 0;
     float previous_normal[4] = {0, 0, 0, 0};
     float first_normal[4] = {0, 0, 0, 0};
     float totals[4] = {0, 0, 0, 0};
-    double origin[4] = {0, 0, 0, 0};
 };
-static_assert(sizeof(Job) == 96, "the ring pass's std430 job record");
+static_assert(sizeof(Job) == 64, "the ring pass's std430 job record");
+struct SlotState {
+    uint32_t lod[4] = {0, 0, 0, 0};
+    float first_normal[4] = {0, 0, 0, 0};
+};
+static_assert(sizeof(SlotState) == 32, "the ring pass's std430 slot record");
 
 }  // namespace
 
+namespace detail {
+
+void set_lod_uniforms(const engine::gfx::Program& program, const LodView& v, const LodSettings& st) {
+    const auto at = [&](const char* name) { return program.uniform_location(name); };
+    const glm::mat3 rotation(glm::dmat3(v.view_from_world));
+    glUniformMatrix3fv(at("u_view_rot"), 1, GL_FALSE, &rotation[0][0]);
+    glUniform3d(at("u_eye"), v.eye_m.x, v.eye_m.y, v.eye_m.z);
+    glUniform1f(at("u_focal"), static_cast<float>(v.focal_px));
+    glUniform1f(at("u_tan_x"), static_cast<float>(v.tan_half_x));
+    glUniform1f(at("u_tan_y"), static_cast<float>(v.tan_half_y));
+    glUniform1f(at("u_near"), static_cast<float>(v.near_m));
+    glUniform1f(at("u_far"), static_cast<float>(v.far_m));
+    // LodSettings' defaults, as update_lod reads them (lod/view.hpp, Limits in lod/update.cpp).
+    const double tol = st.tolerance_px > 0.0 ? std::max(st.tolerance_px, 1e-6) : 0.5;
+    glUniform1f(at("u_eps"), static_cast<float>(tol));
+    glUniform1f(at("u_band"), static_cast<float>(st.hysteresis_band == 0.0 ? 0.25 : st.hysteresis_band));
+    glUniform1f(at("u_strip_px"), static_cast<float>(st.strip_radius_px == 0.0 ? 2.0 : st.strip_radius_px));
+    glUniform1f(at("u_line_px"), static_cast<float>(st.line_radius_px == 0.0 ? 0.5 : st.line_radius_px));
+    glUniform1ui(at("u_max_rings"), st.max_rings_per_segment ? st.max_rings_per_segment : 256u);
+    glUniform1ui(at("u_max_sides"), std::clamp<uint32_t>(st.max_sides ? st.max_sides : 32u, 3u, kMaxSides));
+    glUniform1i(at("u_coarse"), st.coarse_offscreen_segments ? 1 : 0);
+    static const std::array<float, kMaxSides + 1> sagitta = [] {
+        std::array<float, kMaxSides + 1> t{};
+        for (uint32_t n = 3; n <= kMaxSides; ++n) t[n] = static_cast<float>(1.0 - std::cos(std::numbers::pi / n));
+        return t;
+    }();
+    glUniform1fv(at("u_sagitta"), static_cast<GLsizei>(sagitta.size()), sagitta.data());
+}
+
+const char* ring_source() { return kRingSource; }
+
+}  // namespace detail
+
 engine::Expected<GpuRingPass> GpuRingPass::create() {
     engine::Expected<engine::gfx::Program> program =
-        engine::gfx::make_program({.label = "wire gpu rings", .compute = kRingSource});
+        engine::gfx::make_program({.label = "wire gpu rings", .compute = detail::with_wire_header(kRingSource)});
     if (!program) return program.error();
     GpuRingPass pass;
     pass.program_ = std::move(*program);
@@ -542,23 +668,21 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
                                    ? 256u
                                    : lod->settings.max_rings_per_segment;
     std::vector<Job> job_data(jobs.size());
-    std::vector<uint32_t> counts, count_first(jobs.size()), segments(jobs.size());
+    std::vector<uint32_t> counts, count_first(jobs.size()), segments(jobs.size()), visible(jobs.size());
     std::size_t rings = 0, count_total = 0;
     for (std::size_t w = 0; w < jobs.size(); ++w) {
         const GpuCurveHeader& h = headers[w];
-        const bool closed = (h.flags & 1u) != 0;
+        const bool closed = (h.flags & detail::kHeaderClosed) != 0;
         const std::size_t segs = closed ? h.node_count : h.node_count - 1;
         Job& j = job_data[w];
-        j.count_first = static_cast<uint32_t>(count_total);
-        count_first[w] = j.count_first;
+        count_first[w] = h.segment_first;
         segments[w] = static_cast<uint32_t>(segs);
+        visible[w] = h.slot;
         count_total += segs;
-        j.flags = (jobs[w].has_previous_normal ? 1u : 0u) | (jobs[w].restart_lod ? 2u : 0u);
+        j.flags = 2u | (jobs[w].has_previous_normal ? 1u : 0u);
         j.previous_normal[0] = jobs[w].previous_normal.x;
         j.previous_normal[1] = jobs[w].previous_normal.y;
         j.previous_normal[2] = jobs[w].previous_normal.z;
-        const glm::dvec3 origin = curves.origins_[w];
-        j.origin[0] = origin.x, j.origin[1] = origin.y, j.origin[2] = origin.z;
         if (lod != nullptr) {
             rings += (closed ? 0 : 1) + segs * max_rings;
             continue;
@@ -575,7 +699,6 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     if (lod != nullptr && lod->ring_capacity != 0) rings = lod->ring_capacity;
     if (jobs.empty()) {
         count_first_.clear(), segments_.clear();
-        ring_total_ = 0;
         return Status::success();
     }
     // The counts and the LOD's per-wire state stay on the GPU while the wires' layout does (the hysteresis).
@@ -583,18 +706,26 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     if (!keep) {
         if (counts.empty()) counts.assign(count_total, 0);
         auto count_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(counts), "wire gpu ring counts");
-        const std::vector<uint32_t> zeros(4 * jobs.size(), 0);
-        auto state_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(zeros), "wire gpu lod state");
+        const std::vector<SlotState> zeros(jobs.size());
+        auto state_buffer = engine::gfx::make_buffer(std::span<const SlotState>(zeros), "wire gpu slot state");
         if (!count_buffer) return Status::error(count_buffer.error().message);
         if (!state_buffer) return Status::error(state_buffer.error().message);
         counts_ = std::move(*count_buffer), state_ = std::move(*state_buffer);
+    } else {
+        for (std::size_t w = 0; w < jobs.size(); ++w) {
+            if (!jobs[w].restart_lod) continue;
+            glClearNamedBufferSubData(state_.id(), GL_RGBA32UI, static_cast<GLintptr>(visible[w] * sizeof(SlotState)),
+                                      sizeof(SlotState::lod), GL_RGBA_INTEGER, GL_UNSIGNED_INT, nullptr);
+        }
     }
     auto job_buffer = engine::gfx::make_buffer(std::span<const Job>(job_data), "wire gpu ring jobs");
     const uint32_t zero_counter[2] = {0, 0};
     auto counter = engine::gfx::make_buffer(std::span<const uint32_t>(zero_counter), "wire gpu ring counter");
+    auto visible_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(visible), "wire gpu visible slots");
     if (!job_buffer) return Status::error(job_buffer.error().message);
     if (!counter) return Status::error(counter.error().message);
-    jobs_ = std::move(*job_buffer), counter_ = std::move(*counter);
+    if (!visible_buffer) return Status::error(visible_buffer.error().message);
+    jobs_ = std::move(*job_buffer), counter_ = std::move(*counter), visible_ = std::move(*visible_buffer);
     if (rings > ring_capacity_ || !rings_) {
         auto ring_buffer = engine::gfx::make_buffer({.size_bytes = std::max<std::size_t>(rings, 1) * sizeof(PackedRing),
                                                      .label = "wire gpu rings"});
@@ -606,46 +737,21 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     count_total_ = count_total;
     lod_ = lod != nullptr;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, curves.headers_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, curves.nodes_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, curves.segments_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, curves.stretch_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, jobs_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, counts_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, visible_.id());
     program_.use();
     const auto at = [&](const char* name) { return program_.uniform_location(name); };
     glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));
+    glUniform1ui(at("u_stage"), 0u);
+    glUniform1i(at("u_draw"), 0);
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);
-    if (lod != nullptr) {
-        const LodView& v = lod->view;
-        const LodSettings& st = lod->settings;
-        const glm::mat3 rotation(glm::dmat3(v.view_from_world));
-        glUniformMatrix3fv(at("u_view_rot"), 1, GL_FALSE, &rotation[0][0]);
-        glUniform3d(at("u_eye"), v.eye_m.x, v.eye_m.y, v.eye_m.z);
-        glUniform1f(at("u_focal"), static_cast<float>(v.focal_px));
-        glUniform1f(at("u_tan_x"), static_cast<float>(v.tan_half_x));
-        glUniform1f(at("u_tan_y"), static_cast<float>(v.tan_half_y));
-        glUniform1f(at("u_near"), static_cast<float>(v.near_m));
-        glUniform1f(at("u_far"), static_cast<float>(v.far_m));
-        // LodSettings' defaults, as update_lod reads them (lod/view.hpp, Limits in lod/update.cpp).
-        const double tol = st.tolerance_px > 0.0 ? std::max(st.tolerance_px, 1e-6) : 0.5;
-        glUniform1f(at("u_eps"), static_cast<float>(tol));
-        glUniform1f(at("u_band"), static_cast<float>(st.hysteresis_band == 0.0 ? 0.25 : st.hysteresis_band));
-        glUniform1f(at("u_strip_px"), static_cast<float>(st.strip_radius_px == 0.0 ? 2.0 : st.strip_radius_px));
-        glUniform1f(at("u_line_px"), static_cast<float>(st.line_radius_px == 0.0 ? 0.5 : st.line_radius_px));
-        glUniform1ui(at("u_max_rings"), max_rings);
-        glUniform1ui(at("u_max_sides"), std::clamp<uint32_t>(st.max_sides ? st.max_sides : 32u, 3u, kMaxSides));
-        static const std::array<float, kMaxSides + 1> sagitta = [] {
-            std::array<float, kMaxSides + 1> t{};
-            for (uint32_t n = 3; n <= kMaxSides; ++n) t[n] = static_cast<float>(1.0 - std::cos(std::numbers::pi / n));
-            return t;
-        }();
-        glUniform1fv(at("u_sagitta"), static_cast<GLsizei>(sagitta.size()), sagitta.data());
-        glUniform1i(at("u_coarse"), st.coarse_offscreen_segments ? 1 : 0);
-    }
+    if (lod != nullptr) detail::set_lod_uniforms(program_, lod->view, lod->settings);
     glDispatchCompute(static_cast<GLuint>((jobs.size() + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);
@@ -666,8 +772,8 @@ void GpuRingPass::read(std::vector<GpuRingResult>& out) const {
     glGetNamedBufferSubData(jobs_.id(), 0, static_cast<GLsizeiptr>(jobs.size() * sizeof(Job)), jobs.data());
     std::vector<uint32_t> counts(count_total_);
     glGetNamedBufferSubData(counts_.id(), 0, static_cast<GLsizeiptr>(counts.size() * sizeof(uint32_t)), counts.data());
-    std::vector<uint32_t> state(4 * jobs.size());
-    if (lod_) glGetNamedBufferSubData(state_.id(), 0, static_cast<GLsizeiptr>(state.size() * sizeof(uint32_t)), state.data());
+    std::vector<SlotState> state(jobs.size());
+    if (lod_) glGetNamedBufferSubData(state_.id(), 0, static_cast<GLsizeiptr>(state.size() * sizeof(SlotState)), state.data());
     out.resize(jobs.size());
     for (std::size_t w = 0; w < out.size(); ++w) {
         GpuRingResult& r = out[w];
@@ -676,14 +782,15 @@ void GpuRingPass::read(std::vector<GpuRingResult>& out) const {
         if (fits) r.rings.assign(rings.begin() + j.ring_first, rings.begin() + j.ring_first + j.ring_count);
         r.counts.assign(counts.begin() + count_first_[w], counts.begin() + count_first_[w] + segments_[w]);
         r.first_normal = glm::vec3(j.first_normal[0], j.first_normal[1], j.first_normal[2]);
+        r.sides = j.sides;
         r.u_close = j.totals[0];
         r.length_m = j.totals[1];
         r.holonomy_rad = j.totals[2];
         r.radius_px = j.totals[3];
         if (lod_) {
-            r.sides = state[4 * w];
-            r.drawn_sides = state[4 * w + 1];
-            r.visible = state[4 * w + 3] != 0;
+            r.sides = state[w].lod[0];
+            r.drawn_sides = state[w].lod[1];
+            r.visible = state[w].lod[3] != 0;
             r.overflow = r.visible && !fits;
         } else {
             r.overflow = !fits;

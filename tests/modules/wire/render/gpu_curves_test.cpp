@@ -154,18 +154,22 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
         std::vector<GpuCurveResult> results;
         pass->read_segments(results);
         ASSERT_EQ(results.size(), wires.size());
-        // The upload is nodes (16 B each) and a 32-byte header per wire.
+        // The upload is nodes (16 B each) and a 64-byte header per wire.
         std::size_t nodes = 0;
         for (const WireNodes& w : wires) nodes += w.size();
         EXPECT_EQ(pass->node_bytes(), 16 * nodes);
-        EXPECT_EQ(pass->header_bytes(), 48 * wires.size());
-        // Per-node tension, bias and continuity: 16 bytes a curve node, only for Catmull-Rom wires that carry them.
-        std::size_t per_node = 0;
-        for (const WireNodes& w : wires) {
+        EXPECT_EQ(pass->header_bytes(), 64 * wires.size());
+        // Extras: per-node tension, bias and continuity (16 bytes a curve node, only for Catmull-Rom wires that
+        // carry them) and stretch (4 bytes a segment, in vec4s, for wires that carry it).
+        std::size_t extras = 0;
+        for (std::size_t i = 0; i < wires.size(); ++i) {
+            const WireNodes& w = wires[i];
             const bool has = !w.kb_tension.empty() || !w.kb_bias.empty() || !w.kb_continuity.empty() || !w.theta_rad.empty();
-            if (has && kind.spline.kind == SplineKind::catmull_rom) per_node += w.size();
+            if (has && kind.spline.kind == SplineKind::catmull_rom) extras += 16 * w.size();
+            const std::size_t segs = closed[i] ? w.size() : w.size() - 1;
+            if (!w.stretch.empty()) extras += 16 * ((segs + 3) / 4);
         }
-        EXPECT_EQ(pass->per_node_bytes(), 16 * per_node);
+        EXPECT_EQ(pass->extra_bytes(), extras);
         for (std::size_t i = 0; i < wires.size(); ++i) {
             const GpuCurveResult& gpu = results[i];
             // The reference is build_curve of the nodes the GPU holds (each rounded to float relative to the

@@ -42,23 +42,24 @@ struct GpuCurveWire {
     SplineSettings spline{};           ///< its kind and settings, closed included
 };
 
-/// The per-wire record the pass reads (std430, 48 bytes).
+/// The per-wire record the passes read (std430, 64 bytes; its GLSL twin is in src/gpu_wire_data.hpp). Per-node
+/// tension, bias and continuity (Catmull-Rom wires that carry them, or the curvature-driven tension, computed on
+/// the CPU with build_curve's formula) and per-segment stretch travel in an "extras" array only for wires that have
+/// them.
 struct GpuCurveHeader {
-    uint32_t node_first = 0;     ///< first node in the node buffer
+    uint32_t node_first = 0;     ///< first curve node of this upload
     uint32_t node_count = 0;     ///< curve nodes (merged)
-    uint32_t segment_first = 0;  ///< first segment in the segment buffer
-    uint32_t flags = 0;          ///< bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2)
+    uint32_t segment_first = 0;  ///< first segment (and per-segment ring count) in the persistent storage
+    /// bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); bit 3 caps; bit 4 per-node kb in the extras
+    /// (a vec4 a node: tension, bias, continuity); bit 5 stretch in the extras (4 segments a vec4, after the kb);
+    /// bits 16-31 material
+    uint32_t flags = 0;
     float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
-    /// Catmull-Rom with per-node tension, bias or continuity, or curvature-driven tension: first of its
-    /// node_count (tension, bias, continuity, 0) records in the per-node buffer; kNoPerNode otherwise.
-    uint32_t per_node_first = 0xffffffffu;
-    /// Wires whose nodes carry stretch: first of its segment_count() floats in the stretch buffer (build_curve's
-    /// Curve::stretch); kNoPerNode: stretch 1 everywhere.
-    uint32_t stretch_first = 0xffffffffu;
-    uint32_t pad[2] = {0, 0};  ///< std430 alignment of the record (unused)
+    uint32_t extra_first = 0;  ///< first vec4 of the wire's extras
+    uint32_t slot = 0;         ///< the wire's persistent slot (LOD and frame state)
+    double origin_m[3] = {0.0, 0.0, 0.0};  ///< the wire's origin (its nodes' box centre), world metres
 };
-static_assert(sizeof(GpuCurveHeader) == 48, "GpuCurveHeader is the 48-byte std430 record");
-inline constexpr uint32_t kNoPerNode = 0xffffffffu;  ///< GpuCurveHeader::per_node_first of a wire-wide wire
+static_assert(sizeof(GpuCurveHeader) == 64, "GpuCurveHeader is the 64-byte std430 record");
 
 /// One wire's segments read back: control points relative to `origin_m`.
 struct GpuCurveResult {
@@ -87,16 +88,16 @@ public:
 
     [[nodiscard]] std::size_t node_bytes() const { return node_bytes_; }      ///< uploaded by the last build
     [[nodiscard]] std::size_t header_bytes() const { return header_bytes_; }  ///< uploaded by the last build
-    [[nodiscard]] std::size_t per_node_bytes() const { return per_node_bytes_; }  ///< uploaded by the last build
-    [[nodiscard]] std::size_t stretch_bytes() const { return stretch_bytes_; }    ///< uploaded by the last build
+    /// Per-node kb and stretch uploaded by the last build (16 bytes a node, 4 a segment, for wires that have them).
+    [[nodiscard]] std::size_t extra_bytes() const { return extra_bytes_; }
 
 private:
     friend class GpuRingPass;  // reads the headers, nodes, segments and stretch this pass keeps on the GPU
     engine::gfx::Program program_;
-    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, per_node_, stretch_;
+    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, extras_;
     std::vector<GpuCurveHeader> header_data_;
     std::vector<glm::dvec3> origins_;
-    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, per_node_bytes_ = 0, stretch_bytes_ = 0;
+    std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, extra_bytes_ = 0;
 };
 
 }  // namespace wire::render

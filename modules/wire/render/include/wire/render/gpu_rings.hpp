@@ -96,9 +96,9 @@ public:
 
 private:
     engine::gfx::Program program_;
-    engine::gfx::Buffer jobs_, counts_, rings_, state_, counter_;
+    engine::gfx::Buffer jobs_, counts_, rings_, state_, counter_, visible_;
     std::vector<uint32_t> count_first_, segments_;  // per wire of the last build: its counts' range
-    std::size_t ring_capacity_ = 0, ring_total_ = 0, count_total_ = 0;
+    std::size_t ring_capacity_ = 0, count_total_ = 0;
     bool lod_ = false;
 };
 

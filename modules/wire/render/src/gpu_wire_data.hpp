@@ -1,0 +1,66 @@
+// Internal: what the GPU wire passes share. The per-wire header's GLSL (the same record as GpuCurveHeader), and the
+// CPU side of a wire's upload: its curve nodes (float offsets from its origin, the radius in w), header and extras
+// (per-node tension, bias, continuity; per-segment stretch). GpuCurvePass and the renderer's nodes path use both.
+#pragma once
+
+#include "wire/lod.hpp"
+#include "wire/render/gpu_curves.hpp"
+
+#include "engine/gfx/resources.hpp"
+
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace wire::render::detail {
+
+/// GpuCurveHeader in GLSL (std430, 64 bytes) and its flag bits; `GPU_WIRE_HEADER` in a source is replaced by it.
+inline constexpr const char* kWireHeaderGlsl = R"glsl(
+const uint kClosed = 1u, kCaps = 8u, kHasPerNode = 16u, kHasStretch = 32u;
+struct Header {
+    uint node_first;     // this frame's curve nodes (the curve pass reads them)
+    uint node_count;     // curve nodes (merged)
+    uint segment_first;  // the wire's segments, and its per-segment ring counts
+    uint flags;          // bit 0 closed; 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); 3 caps; 4 per-node kb;
+                         // 5 stretch; 16-31 material
+    vec4 kb;             // alpha, tension, bias, continuity (wire-wide)
+    uint extra_first;    // per-node kb (a vec4 a node), then stretch (4 segments a vec4), in the extras
+    uint slot;           // the wire's persistent slot (ring pass state)
+    double origin[3];    // the wire's origin, world metres
+};
+)glsl";
+
+/// `source` with GPU_WIRE_HEADER replaced by kWireHeaderGlsl.
+std::string with_wire_header(const char* source);
+
+inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u;
+inline constexpr uint32_t kHeaderKindShift = 1u, kHeaderMaterialShift = 16u;
+inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u;
+
+/// One frame's upload of wires for the curve pass.
+struct WireUpload {
+    std::vector<GpuCurveHeader> headers;
+    std::vector<glm::vec4> nodes;   ///< 16 bytes a curve node
+    std::vector<glm::vec4> extras;  ///< only for wires that carry per-node kb or stretch
+    std::vector<glm::dvec3> curve;  ///< scratch
+    std::vector<uint32_t> source, last;
+    void clear() { headers.clear(), nodes.clear(), extras.clear(); }
+};
+
+/// Appends one wire (validated nodes: build_curve's checks) with its header's segment_first, slot and the
+/// material and caps bits. Fails naming what is wrong (not a supported kind, too few distinct nodes); nothing is
+/// appended then. `segments` (out): the wire's segment count.
+Status append_wire(const WireNodes& nodes, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
+                   uint32_t material, bool caps, WireUpload& out, uint32_t& segments);
+
+/// The ring program's LOD uniforms for a view and settings (LodSettings' defaults applied as update_lod does).
+void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, const LodSettings& settings);
+
+/// The ring program's GLSL (GPU_WIRE_HEADER not yet replaced): gpu_rings.cpp.
+const char* ring_source();
+/// The curve program's GLSL (GPU_WIRE_HEADER not yet replaced): gpu_curves.cpp.
+const char* curve_source();
+
+}  // namespace wire::render::detail
