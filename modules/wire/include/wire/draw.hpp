@@ -3,8 +3,10 @@
 // stay valid until the next frame's systems run.
 #pragma once
 
+#include "wire/nodes.hpp"
 #include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
+#include "wire/spline.hpp"
 #include "wire/tube.hpp"
 
 #include <glm/vec3.hpp>
@@ -21,6 +23,10 @@ enum class UploadPath : uint8_t {
     cpu_mesh,   ///< vertices + indices built on the CPU (TubeVertex, 32 bytes a vertex)
     gpu_rings,  ///< ring records only (packed to 28 bytes a ring by the renderer, retained on the GPU while a
                 ///< wire's rings are unchanged); the vertex shader expands sides from gl_VertexID
+    /// nodes only (issue 30): the nodes of wires whose nodes changed, 16 bytes a node plus a 64-byte header, and
+    /// 4 bytes a visible wire; curve, LOD (at node resolution), frames, rings and the draw's arguments are
+    /// computed on the GPU (wire/render's nodes path), the gpu-rings vertex shader draws them
+    gpu_nodes,
 };
 
 /// One visible wire this frame. Positions inside are relative to origin_m (double, world), so the renderer can
@@ -45,6 +51,13 @@ struct DrawItem {
     /// gpu_rings: whether the rings' radius varies along the wire (the shader then tilts normals); unset: the
     /// renderer checks the rings itself.
     std::optional<bool> radius_varies;
+    // gpu_nodes path
+    const WireNodes* nodes = nullptr;  ///< validated nodes (the systems' checks); alive until the draw returns
+    SplineSettings spline{};           ///< the curve's settings (kind, closed, radius, ...)
+    /// Changes whenever `nodes` or `spline` change; the renderer keeps the wire's curve on the GPU while
+    /// (wire_id, nodes_generation) stays the same. 0: unknown (the nodes are sent every frame).
+    uint64_t nodes_generation = 0;
+
     uint32_t sides = 8;      ///< radial sides of a tube (>= 3); 2 = camera-facing strip, 1 = one-pixel AA line
     bool closed = false;     ///< closed loop (the last ring connects back to the first)
     bool caps = true;        ///< flat end caps on open wires

@@ -4,6 +4,7 @@
 // expansion; one glMultiDrawElementsIndirect per run of (class, material) with a bounded number of commands.
 #include "wire/render/wire_renderer.hpp"
 
+#include "node_path.hpp"
 #include "shaders.hpp"
 #include "wire/render/upload_plan.hpp"
 #include "wire/render/weave.hpp"
@@ -99,6 +100,63 @@ struct WireRenderer::State {
     std::vector<PackedRing> packed;
     std::vector<uint8_t> streamed;     ///< retained path, per drawn item (order): rings streamed this frame
     std::size_t retained_ring_bytes = 0;  ///< retained path: bytes written into the ring storage this frame
+    std::unique_ptr<detail::NodePath> nodes;  ///< gpu-nodes: made on its first frame
+
+    /// The frame's GL state and the wire program's per-frame uniforms (both paths that draw rings, and cpu-mesh).
+    void begin_wires(const gfx::Program& program, const engine::scene::Camera& camera, const DrawSettings& settings) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+        glFrontFace(GL_CCW);
+        if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);  // front faces only: culling stays on
+        program.use();
+        // Camera-relative: the view is the camera's rotation only; positions arrive as offsets from the eye.
+        program.set("u_clip_from_rel", camera.clip_from_relative());
+        program.set("u_to_light", glm::normalize(settings.light.to_light));
+        program.set("u_light_color", settings.light.color);
+        program.set("u_ambient", settings.light.ambient);
+        program.set("u_specular", settings.light.specular);
+        program.set("u_shininess", settings.light.shininess);
+        GLint viewport[4] = {0, 0, 1, 1};
+        glGetIntegerv(GL_VIEWPORT, viewport);
+        program.set("u_viewport_px", glm::vec2(static_cast<float>(std::max(viewport[2], 1)),
+                                               static_cast<float>(std::max(viewport[3], 1))));
+        program.set("u_focal_px",
+                    0.5f * static_cast<float>(std::max(viewport[3], 1)) / std::tan(0.5f * camera.fov_y_rad));
+    }
+
+    /// The gpu-nodes frame (node_path.hpp).
+    DrawStats draw_nodes(const DrawList& list, const engine::scene::Camera& camera, const DrawSettings& settings) {
+        DrawStats stats;
+        if (!nodes) {
+            Expected<std::unique_ptr<detail::NodePath>> made = detail::NodePath::create(desc.node_lod, desc.retain_frames);
+            if (!made) return stats;
+            nodes = std::move(*made);
+        }
+        if (Status st = ensure_patterns(nodes->max_sides()); !st) return stats;
+        const std::size_t bytes = nodes->upload_bytes(list);
+        Expected<StreamRegion> begun = stream.begin(bytes);
+        if (!begun) return stats;
+        stats.buffer_grew = begun->grew;
+        stats.waited_for_gpu = begun->waited;
+        const detail::NodeDrawContext ctx{rings_program, rings_vao, circle.id(), pattern_first, materials, textures,
+                                          draw_parameters};
+        glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
+        engine::scene::Camera at_eye = camera;
+        at_eye.target += eye - camera.position;
+        at_eye.position = eye;
+        const bool drawn = nodes->prepare(list, at_eye, *begun, ctx, stats);
+        if (drawn && ensure_draw_index_capacity(nodes->chunk_capacity())) {
+            begin_wires(rings_program, camera, settings);
+            nodes->submit(ctx, stats);
+            glBindVertexArray(0);
+            if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+        }
+        stream.end();
+        return stats;
+    }
 
     /// The item's rings in GPU form at `out`: the rings system's packed records when the item has them (one
     /// memcpy), else packed here.
@@ -350,6 +408,7 @@ const std::vector<unsigned>& WireRenderer::allocated_ring_buffers() const {
 DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
                               const DrawSettings& settings) {
     State& s = *state_;
+    if (list.path == UploadPath::gpu_nodes) return s.draw_nodes(list, camera, settings);
     DrawStats stats;
     const bool cpu = list.path == UploadPath::cpu_mesh;
     const bool retained = !cpu && s.desc.retain_rings;
@@ -559,28 +618,8 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     stats.indirect_commands = s.commands.size();
 
     // (3) Submit: GL state for the wires, the mode's program and vertex array, one multi-draw per run.
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glEnable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW);
-    if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);  // front faces only: culling stays on
-
     const gfx::Program& program = cpu ? s.cpu_program : s.rings_program;
-    program.use();
-    // Camera-relative: the view is the camera's rotation only; positions arrive as offsets from the eye.
-    program.set("u_clip_from_rel", camera.clip_from_relative());
-    program.set("u_to_light", glm::normalize(settings.light.to_light));
-    program.set("u_light_color", settings.light.color);
-    program.set("u_ambient", settings.light.ambient);
-    program.set("u_specular", settings.light.specular);
-    program.set("u_shininess", settings.light.shininess);
-    GLint viewport[4] = {0, 0, 1, 1};
-    glGetIntegerv(GL_VIEWPORT, viewport);
-    program.set("u_viewport_px", glm::vec2(static_cast<float>(std::max(viewport[2], 1)),
-                                           static_cast<float>(std::max(viewport[3], 1))));
-    program.set("u_focal_px", 0.5f * static_cast<float>(std::max(viewport[3], 1)) / std::tan(0.5f * camera.fov_y_rad));
+    s.begin_wires(program, camera, settings);
 
     const GLuint buffer = region.buffer;
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, buffer, static_cast<GLintptr>(region.offset_bytes),

@@ -23,6 +23,7 @@
 #pragma once
 
 #include "wire/draw.hpp"
+#include "wire/lod.hpp"
 
 #include "engine/gfx/resources.hpp"
 #include "engine/core/expected.hpp"
@@ -81,6 +82,9 @@ struct RendererDesc {
     uint32_t retain_frames = 0;
     /// Initial size of the retained ring buffer (grows as needed); 0 -> 4 MiB.
     std::size_t ring_storage_bytes = 0;
+    /// gpu-nodes: the LOD the GPU evaluates (at node resolution: keep_node_resolution is implied; max_sides is
+    /// clamped to 256).
+    LodSettings node_lod{};
 };
 
 /// Per-frame options.
@@ -102,7 +106,8 @@ struct DrawStats {
     std::size_t ring_bytes_uploaded = 0;  ///< gpu-rings: the packed ring records among them
     std::size_t wires_uploaded = 0;       ///< gpu-rings: wires whose rings were written this frame
     std::size_t wires_streamed = 0;  ///< gpu-rings retained: of those, moving wires streamed with the frame
-    std::size_t wires_evicted = 0;        ///< gpu-rings retained: ranges freed (wires not drawn for a while)
+    std::size_t wires_evicted = 0;        ///< gpu-rings retained, gpu-nodes: ranges freed (wires not drawn for a while)
+    std::size_t wires_skipped = 0;  ///< gpu-nodes: items not drawn (a spline kind the GPU does not build yet)
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
     std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
     std::size_t triangles = 0;          ///< triangles drawn

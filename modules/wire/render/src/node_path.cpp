@@ -1,0 +1,382 @@
+// The renderer's nodes path (see node_path.hpp).
+#include "node_path.hpp"
+
+#include "gpu_wire_data.hpp"
+#include "shaders.hpp"
+
+#include "wire/render/gpu_rings.hpp"
+#include "wire/render/upload_plan.hpp"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+namespace wire::render::detail {
+namespace {
+
+namespace gfx = engine::gfx;
+
+constexpr std::size_t kAlign = 256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT everywhere we know
+constexpr uint32_t kReadbackSlots = 3;
+constexpr std::size_t kJobBytes = 64, kSlotStateBytes = 32, kSegmentBytes = 64, kDrawBytes = 32;
+
+std::size_t align_up(std::size_t v) { return (v + kAlign - 1) / kAlign * kAlign; }
+
+void clear_range(const gfx::Buffer& buffer, std::size_t offset, std::size_t bytes) {
+    glClearNamedBufferSubData(buffer.id(), GL_R32UI, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes),
+                              GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<NodePath>> NodePath::create(const LodSettings& lod, uint32_t retain_frames) {
+    auto path = std::make_unique<NodePath>();
+    auto curve = gfx::make_program({.label = "wire nodes: curves", .compute = with_wire_header(curve_source())});
+    if (!curve) return curve.error();
+    auto rings = gfx::make_program({.label = "wire nodes: rings", .compute = with_wire_header(ring_source())});
+    if (!rings) return rings.error();
+    path->curve_program_ = std::move(*curve);
+    path->ring_program_ = std::move(*rings);
+    path->lod_ = lod;
+    path->lod_.keep_node_resolution = true;
+    path->max_sides_ = std::clamp<uint32_t>(lod.max_sides ? lod.max_sides : 32u, 3u, kMaxSides);
+    path->retain_frames_ = retain_frames ? retain_frames : 180;
+    auto readback = gfx::make_buffer({.size_bytes = kReadbackSlots * 8,
+                                      .storage_flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT,
+                                      .label = "wire nodes: ring counter readback"});
+    if (!readback) return readback.error();
+    path->readback_ = std::move(*readback);
+    path->readback_map_ = glMapNamedBufferRange(path->readback_.id(), 0, kReadbackSlots * 8,
+                                                GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT);
+    if (path->readback_map_ == nullptr) return Error{"wire nodes: could not map the ring counter readback"};
+    return path;
+}
+
+Status NodePath::ensure(gfx::Buffer& buffer, std::size_t& capacity, std::size_t bytes, const char* label,
+                        bool keep_contents) {
+    bytes = std::max<std::size_t>(bytes, 16);
+    if (bytes <= capacity && buffer.id() != 0) return Status::success();
+    const std::size_t size = std::max(bytes, capacity + capacity / 2);
+    auto made = gfx::make_buffer({.size_bytes = size, .label = label});
+    if (!made) return made.error();
+    if (keep_contents && buffer.id() != 0 && capacity != 0) {
+        glCopyNamedBufferSubData(buffer.id(), made->id(), 0, 0, static_cast<GLsizeiptr>(capacity));
+    }
+    buffer = std::move(*made);
+    capacity = size;
+    return Status::success();
+}
+
+Status NodePath::grow_slots(std::size_t slots) {
+    if (slots <= slot_capacity_) return Status::success();
+    const std::size_t want = std::max<std::size_t>(slots, std::max<std::size_t>(256, 2 * slot_capacity_));
+    if (Status st = ensure(slot_headers_, slot_header_bytes_, want * sizeof(GpuCurveHeader), "wire nodes: headers", true); !st) return st;
+    const std::size_t old = slot_state_bytes_;
+    if (Status st = ensure(slot_state_, slot_state_bytes_, want * kSlotStateBytes, "wire nodes: slot state", true); !st) return st;
+    if (slot_state_bytes_ > old) clear_range(slot_state_, old, slot_state_bytes_ - old);
+    slot_capacity_ = want;
+    return Status::success();
+}
+
+Status NodePath::grow_segments(std::size_t segments) {
+    if (segments <= segment_capacity_) return Status::success();
+    const std::size_t want = std::max<std::size_t>(segments, std::max<std::size_t>(4096, 2 * segment_capacity_));
+    if (Status st = ensure(segments_, segment_bytes_, want * kSegmentBytes, "wire nodes: segments", true); !st) return st;
+    if (Status st = ensure(counts_, count_bytes_, want * 4, "wire nodes: ring counts", true); !st) return st;
+    segment_capacity_ = want;
+    return Status::success();
+}
+
+bool NodePath::allocate_segments(uint32_t count, uint32_t& first) {
+    for (std::size_t i = 0; i < free_ranges_.size(); ++i) {
+        auto& [f, c] = free_ranges_[i];
+        if (c < count) continue;
+        first = f;
+        f += count, c -= count;
+        if (c == 0) free_ranges_.erase(free_ranges_.begin() + static_cast<std::ptrdiff_t>(i));
+        return true;
+    }
+    if (segment_top_ + std::size_t{count} > segment_capacity_ && !grow_segments(segment_top_ + std::size_t{count})) {
+        return false;
+    }
+    first = segment_top_;
+    segment_top_ += count;
+    return true;
+}
+
+void NodePath::free_segments(uint32_t first, uint32_t count) {
+    if (count == 0) return;
+    auto at = std::lower_bound(free_ranges_.begin(), free_ranges_.end(), std::pair<uint32_t, uint32_t>{first, 0});
+    at = free_ranges_.insert(at, {first, count});
+    // Coalesce with the neighbours.
+    if (at + 1 != free_ranges_.end() && at->first + at->second == (at + 1)->first) {
+        at->second += (at + 1)->second;
+        free_ranges_.erase(at + 1);
+    }
+    if (at != free_ranges_.begin() && (at - 1)->first + (at - 1)->second == at->first) {
+        (at - 1)->second += at->second;
+        free_ranges_.erase(at);
+    }
+}
+
+std::size_t NodePath::upload_bytes(const DrawList& list) {
+    std::size_t headers = 0, nodes = 0, extras = 0;
+    changed_item_.assign(list.items.size(), 0);
+    std::size_t visible = 0;
+    for (std::size_t i = 0; i < list.items.size(); ++i) {
+        const DrawItem& item = list.items[i];
+        if (item.nodes == nullptr || item.nodes->size() < 2) continue;
+        ++visible;
+        const auto it = slots_.find(item.wire_id);
+        const bool changed = it == slots_.end() || !it->second.built || item.nodes_generation == 0 ||
+                             item.nodes_generation != it->second.generation;
+        if (!changed) continue;
+        changed_item_[i] = 1;
+        const std::size_t n = item.nodes->size();
+        headers += sizeof(GpuCurveHeader);
+        nodes += 16 * n;
+        extras += 16 * n + 16 * ((n + 3) / 4);
+    }
+    return align_up(headers) + align_up(nodes) + align_up(extras) + align_up(4 * visible) + kAlign;
+}
+
+bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera, const gfx::StreamRegion& region,
+                       const NodeDrawContext& ctx, DrawStats& stats) {
+    ++frame_;
+    // The ring buffer's size: the counts the GPU reported kReadbackSlots frames ago (the stream region's fence of
+    // that frame has signalled before this region could begin).
+    if (frame_ > kReadbackSlots) {
+        const auto* seen = static_cast<const uint32_t*>(readback_map_) + 2 * (frame_ % kReadbackSlots);
+        if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::size_t{seen[0]} * 3 / 2;
+    }
+    thread_local WireUpload up;
+    up.clear();
+    visible_slots_.clear();
+    material_used_.assign(ctx.materials.size(), 0);
+    std::size_t segments_visible = 0;
+    for (std::size_t i = 0; i < list.items.size(); ++i) {
+        const DrawItem& item = list.items[i];
+        if (item.nodes == nullptr || item.nodes->size() < 2) continue;
+        auto [it, fresh] = slots_.try_emplace(item.wire_id);
+        Slot& slot = it->second;
+        if (fresh) {
+            if (free_slots_.empty()) {
+                const auto index = static_cast<uint32_t>(slots_.size() - 1 + free_slots_.size());
+                if (!grow_slots(index + 1)) {
+                    slots_.erase(it);
+                    continue;
+                }
+                slot.index = index;
+            } else {
+                slot.index = free_slots_.back();
+                free_slots_.pop_back();
+            }
+            clear_range(slot_state_, slot.index * kSlotStateBytes, kSlotStateBytes);
+        }
+        slot.last_frame = frame_;
+        const bool changed = i < changed_item_.size() && changed_item_[i] != 0;
+        if (changed) {
+            uint32_t segments = 0;
+            const std::size_t nodes_before = up.nodes.size(), extras_before = up.extras.size();
+            const Status st = append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
+                                          item.caps, up, segments);
+            if (!st) {  // the systems validate; a kind the GPU does not build yet is skipped here
+                ++stats.wires_skipped;
+                continue;
+            }
+            if (segments != slot.segments) {
+                free_segments(slot.segment_first, slot.segments);
+                uint32_t first = 0;
+                if (!allocate_segments(segments, first)) {
+                    up.headers.pop_back();
+                    up.nodes.resize(nodes_before), up.extras.resize(extras_before);
+                    slot.segments = 0, slot.built = false;
+                    ++stats.wires_skipped;
+                    continue;
+                }
+                slot.segment_first = first, slot.segments = segments;
+                up.headers.back().segment_first = first;
+                clear_range(slot_state_, slot.index * kSlotStateBytes, 16);  // the LOD starts afresh
+            }
+            slot.generation = item.nodes_generation;
+            slot.built = true;
+        }
+        if (!slot.built) continue;
+        visible_slots_.push_back(slot.index);
+        segments_visible += slot.segments;
+        if (item.material < material_used_.size()) material_used_[item.material] = 1;
+    }
+    // Wires not drawn for a while give their slot and segments back.
+    for (auto it = slots_.begin(); it != slots_.end();) {
+        if (it->second.last_frame + retain_frames_ < frame_) {
+            free_segments(it->second.segment_first, it->second.segments);
+            free_slots_.push_back(it->second.index);
+            it = slots_.erase(it);
+            ++stats.wires_evicted;
+        } else {
+            ++it;
+        }
+    }
+    visible_ = visible_slots_.size();
+    changed_ = up.headers.size();
+    stats.wires_uploaded = changed_;
+    if (visible_ == 0) return false;
+
+    // The region: headers | nodes | extras | visible slots.
+    if (up.extras.empty()) up.extras.emplace_back(0.0f);
+    if (up.nodes.empty()) up.nodes.emplace_back(0.0f);
+    const std::size_t header_bytes = std::max<std::size_t>(up.headers.size() * sizeof(GpuCurveHeader), 64);
+    const std::size_t node_bytes = up.nodes.size() * sizeof(glm::vec4);
+    const std::size_t extra_bytes = up.extras.size() * sizeof(glm::vec4);
+    const std::size_t visible_bytes = visible_ * 4;
+    const std::size_t node_at = align_up(header_bytes), extra_at = node_at + align_up(node_bytes);
+    const std::size_t visible_at = extra_at + align_up(extra_bytes);
+    std::byte* base = region.data;
+    if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
+    std::memcpy(base + node_at, up.nodes.data(), node_bytes);
+    std::memcpy(base + extra_at, up.extras.data(), extra_bytes);
+    std::memcpy(base + visible_at, visible_slots_.data(), visible_bytes);
+    stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + node_bytes +
+                                           (up.extras.size() > 1 || up.extras[0] != glm::vec4(0.0f) ? extra_bytes : 0)
+                                     : 0) +
+                           visible_bytes;
+    const auto range = [&](GLuint binding, std::size_t offset, std::size_t bytes) {
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, region.buffer,
+                          static_cast<GLintptr>(region.offset_bytes + offset), static_cast<GLsizeiptr>(bytes));
+    };
+
+    // Per-frame GPU buffers.
+    if (ring_capacity_ == 0) ring_capacity_ = std::max<std::size_t>(4096, 8 * segments_visible + visible_);
+    side_slots_ = max_sides_ + 1;
+    materials_ = ctx.materials.size();
+    const std::size_t buckets = materials_ * side_slots_ * 6;
+    const std::size_t chunk_capacity = ring_capacity_ / kChunkBands + 6 * visible_ + 1;
+    std::size_t scratch_nodes = changed_ ? up.nodes.size() : 1;
+    const bool ok = ensure(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch", false) &&
+                    ensure(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs", false) &&
+                    ensure(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws", false) &&
+                    ensure(rings_, ring_bytes_, ring_capacity_ * sizeof(PackedRing), "wire nodes: rings", false) &&
+                    ensure(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks", false) &&
+                    ensure(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets", false) &&
+                    ensure(commands_, command_bytes_, buckets * 20, "wire nodes: commands", false) &&
+                    ensure(counter_, counter_bytes_, 8, "wire nodes: ring counter", false);
+    if (!ok) return false;
+    if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
+        // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
+        std::vector<uint32_t> t(2 * 6 * side_slots_, 0);
+        for (uint32_t d = 1; d < side_slots_; ++d) {
+            const uint32_t pattern = d < ctx.pattern_first.size() ? ctx.pattern_first[d] : 0;
+            const uint32_t band_indices = d > 2 ? 6 * d : 6;
+            for (uint32_t kind = 0; kind < kChunkKinds; ++kind) {
+                const uint32_t count = kind == 0 ? (d > 2 ? 6 * d : 0) : chunk_kind_bands(kind) * band_indices;
+                const uint32_t first = kind == 0 || d <= 2 ? pattern : pattern + 6 * d;
+                t[2 * (6 * d + kind)] = count;
+                t[2 * (6 * d + kind) + 1] = first;
+            }
+        }
+        auto made = gfx::make_buffer(std::span<const uint32_t>(t), "wire nodes: command templates");
+        if (!made) return false;
+        templates_ = std::move(*made);
+        template_sides_ = side_slots_;
+        template_patterns_ = ctx.pattern_first.size();
+    }
+    clear_range(counter_, 0, 8);
+    clear_range(buckets_, 0, buckets * 4);
+
+    // (1) Curves of the wires whose nodes changed, into their slots' segments and headers.
+    if (changed_ != 0) {
+        curve_program_.use();
+        range(0, 0, header_bytes);
+        range(1, node_at, node_bytes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
+        range(4, extra_at, extra_bytes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, slot_headers_.id());
+        glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(changed_));
+        glUniform1i(curve_program_.uniform_location("u_persist"), 1);
+        glDispatchCompute(static_cast<GLuint>((changed_ + 63) / 64), 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    // (2) LOD, (3) commands, (4) rings and records, over the visible wires.
+    ring_program_.use();
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, slot_headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, jobs_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, counts_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, slot_state_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
+    range(11, visible_at, visible_bytes);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, draws_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, chunks_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, buckets_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 15, commands_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 16, templates_.id());
+    const auto at = [&](const char* name) { return ring_program_.uniform_location(name); };
+    GLint viewport[4] = {0, 0, 1, 1};
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    const LodView view = LodView::perspective(camera.position, camera.target, camera.up, camera.fov_y_rad,
+                                              std::max(viewport[2], 1), std::max(viewport[3], 1), camera.near_m,
+                                              camera.far_m);
+    set_lod_uniforms(ring_program_, view, lod_);
+    glUniform1i(at("u_lod"), 1);
+    glUniform1i(at("u_draw"), 1);
+    glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
+    glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
+    glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
+    glUniform1ui(at("u_side_slots"), side_slots_);
+    const auto groups = static_cast<GLuint>((visible_ + 63) / 64);
+    glUniform1ui(at("u_stage"), 1u);
+    glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUniform1ui(at("u_stage"), 2u);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUniform1ui(at("u_stage"), 3u);
+    glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    // The counter, read kReadbackSlots frames later (the ring buffer's size).
+    glCopyNamedBufferSubData(counter_.id(), readback_.id(), 0, static_cast<GLintptr>(8 * (frame_ % kReadbackSlots)), 8);
+    glUseProgram(0);
+    buckets_used_ = buckets;
+    stats.draw_items = visible_;
+    stats.indirect_commands = buckets;
+    return true;
+}
+
+void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats) {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, draws_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, rings_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.circle);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, chunks_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, rings_.id());
+    ctx.vao.bind();
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands_.id());
+    const std::size_t per_material = std::size_t{side_slots_} * 6;
+    const auto draw = [&](std::size_t m, uint32_t first_slot, uint32_t slots) {
+        const Material& material = ctx.materials[m];
+        ctx.program.set("u_tint", material.tint);
+        ctx.textures[material.texture].bind(0);
+        const auto* indirect =
+            reinterpret_cast<const void*>((m * per_material + std::size_t{first_slot} * 6) * 20);
+        glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, indirect, static_cast<GLsizei>(slots * 6), 0);
+        ++stats.multi_draw_calls;
+    };
+    // Opaque (tubes and strips: side slots 2 ..), then the blended phone-wire lines (slot 1).
+    for (std::size_t m = 0; m < materials_; ++m) {
+        if (m < material_used_.size() && material_used_[m]) draw(m, 2, side_slots_ - 2);
+    }
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    for (std::size_t m = 0; m < materials_; ++m) {
+        if (m < material_used_.size() && material_used_[m]) draw(m, 1, 1);
+    }
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+}
+
+}  // namespace wire::render::detail

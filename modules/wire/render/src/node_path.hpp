@@ -1,0 +1,100 @@
+// Internal: the renderer's nodes path (UploadPath::gpu_nodes, issue 30). Per frame the CPU sends, for the visible
+// wires whose nodes changed, their curve nodes and a 64-byte header (into the renderer's fenced stream region),
+// plus a 4-byte slot per visible wire; everything after that runs in compute dispatches: the curve (into
+// persistent per-wire segments), the LOD at node resolution (hysteresis state per wire kept on the GPU), the
+// indirect commands, the rings with their frames and u, the draw and chunk records; then the gpu-rings vertex
+// shader draws them with one multi-draw per (class, material), reading commands the GPU wrote.
+#pragma once
+
+#include "wire/draw.hpp"
+#include "wire/lod.hpp"
+#include "wire/render/wire_renderer.hpp"
+
+#include "engine/gfx/resources.hpp"
+#include "engine/gfx/stream_buffer.hpp"
+#include "engine/scene/camera.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+namespace wire::render::detail {
+
+/// What the nodes path borrows from the renderer to draw.
+struct NodeDrawContext {
+    const engine::gfx::Program& program;  ///< the gpu-rings program
+    const engine::gfx::VertexArray& vao;  ///< its vertex array (element buffer: the patterns)
+    unsigned circle = 0;                  ///< the side table buffer
+    const std::vector<uint32_t>& pattern_first;
+    const std::vector<Material>& materials;
+    const std::vector<engine::gfx::Texture>& textures;
+    bool draw_parameters = true;
+};
+
+class NodePath {
+public:
+    static Expected<std::unique_ptr<NodePath>> create(const LodSettings& lod, uint32_t retain_frames);
+
+    /// Uploads and computes the frame (see the file comment) into `region` (begun by the caller with at least
+    /// upload_bytes(list) bytes); returns false (nothing to draw) when no item draws. The patterns in `ctx` must
+    /// cover max_sides().
+    bool prepare(const DrawList& list, const engine::scene::Camera& camera, const engine::gfx::StreamRegion& region,
+                 const NodeDrawContext& ctx, DrawStats& stats);
+    /// Issues the draws prepare() set up.
+    void submit(const NodeDrawContext& ctx, DrawStats& stats);
+    /// Bytes prepare() writes into the region for `list` (an upper bound; computed per frame).
+    std::size_t upload_bytes(const DrawList& list);
+    /// The most sides the frame's LOD can give (the patterns must cover it).
+    [[nodiscard]] uint32_t max_sides() const { return max_sides_; }
+
+    [[nodiscard]] std::size_t resident_wires() const { return slots_.size(); }
+    /// Chunk records the frame may draw (the instanced chunk-index attribute must cover them).
+    [[nodiscard]] std::size_t chunk_capacity() const { return chunk_bytes_ / 8; }
+
+private:
+    struct Slot {
+        uint32_t index = 0;
+        uint32_t segment_first = 0, segments = 0;
+        uint64_t generation = 0;
+        uint64_t last_frame = 0;
+        bool built = false;  ///< its curve is on the GPU
+    };
+    Status grow_slots(std::size_t slots);
+    Status grow_segments(std::size_t segments);
+    Status ensure(engine::gfx::Buffer& buffer, std::size_t& capacity, std::size_t bytes, const char* label,
+                  bool keep_contents);
+    bool allocate_segments(uint32_t count, uint32_t& first);
+    void free_segments(uint32_t first, uint32_t count);
+
+    engine::gfx::Program curve_program_, ring_program_;
+    LodSettings lod_{};
+    uint32_t retain_frames_ = 180, max_sides_ = 32;
+    uint64_t frame_ = 0;
+    std::unordered_map<uint64_t, Slot> slots_;
+    std::vector<uint32_t> free_slots_;
+    std::vector<std::pair<uint32_t, uint32_t>> free_ranges_;  ///< (first, count), sorted by first
+    uint32_t segment_top_ = 0;                                 ///< segments in use or freed below this
+    // Persistent (GPU only).
+    engine::gfx::Buffer slot_headers_, slot_state_, segments_, counts_;
+    std::size_t slot_capacity_ = 0, segment_capacity_ = 0;
+    std::size_t slot_header_bytes_ = 0, slot_state_bytes_ = 0, segment_bytes_ = 0, count_bytes_ = 0;
+    // Per frame (GPU only; regrown as needed).
+    engine::gfx::Buffer scratch_, jobs_, draws_, chunks_, rings_, buckets_, commands_, counter_, templates_, readback_;
+    std::size_t scratch_bytes_ = 0, job_bytes_ = 0, draw_bytes_ = 0, chunk_bytes_ = 0, ring_bytes_ = 0,
+                bucket_bytes_ = 0, command_bytes_ = 0, counter_bytes_ = 0, template_bytes_ = 0;
+    std::size_t ring_capacity_ = 0;  ///< rings the ring buffer holds
+    void* readback_map_ = nullptr;   ///< per frame in flight: the ring counter and overflow, read 3 frames later
+    uint32_t template_sides_ = 0;    ///< side slots the templates were built for
+    std::size_t template_patterns_ = 0;
+    // This frame.
+    std::size_t visible_ = 0, changed_ = 0, buckets_used_ = 0;
+    uint32_t side_slots_ = 0;
+    std::size_t materials_ = 0;
+    std::vector<uint8_t> material_used_;
+    std::vector<uint8_t> changed_item_;  ///< per item of the list upload_bytes() saw: it sends its nodes
+    std::vector<uint32_t> visible_slots_;
+};
+
+}  // namespace wire::render::detail
