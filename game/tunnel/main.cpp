@@ -309,8 +309,10 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     app.add_option("--pieces", args.pieces, "tunnel pieces of 4 m (default 16)")->check(CLI::Range(2, 256));
     app.add_option("--seed", args.seed, "seed of the bend animation (default 1)");
-    app.add_option("--path", args.path, "wire upload path: cpu (meshes) or gpu (ring records)")
-        ->check(CLI::IsMember({"cpu", "gpu"}));
+    app.add_option("--path", args.path,
+                   "wire upload path: cpu (meshes), gpu (ring records) or nodes (nodes only: curve, LOD and rings "
+                   "in compute shaders)")
+        ->check(CLI::IsMember({"cpu", "gpu", "nodes"}));
     app.add_option("--spline", args.spline, "catmull-rom, c2, automatic or linear")
         ->check(CLI::IsMember({"catmull-rom", "c2", "automatic", "linear"}));
     app.add_option("--lod-tolerance", args.lod_tolerance_px, "wire LOD screen error in pixels (default 0.5)")
@@ -343,7 +345,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     tunnel::LevelOptions& o = level.value()->options();
-    o.upload_path = args.path == "gpu" ? wire::UploadPath::gpu_rings : wire::UploadPath::cpu_mesh;
+    o.upload_path = args.path == "gpu"     ? wire::UploadPath::gpu_rings
+                    : args.path == "nodes" ? wire::UploadPath::gpu_nodes
+                                           : wire::UploadPath::cpu_mesh;
     o.spline = args.spline == "c2"          ? wire::SplineKind::c2
                : args.spline == "automatic" ? wire::SplineKind::automatic
                : args.spline == "linear"    ? wire::SplineKind::linear

@@ -261,6 +261,7 @@ int run_view(const ViewOptions& o) try {
     wire::UploadPath path = wire::systems::WireContext{}.path;
     if (o.path == "cpu") path = wire::UploadPath::cpu_mesh;
     if (o.path == "gpu") path = wire::UploadPath::gpu_rings;
+    if (o.path == "nodes") path = wire::UploadPath::gpu_nodes;
 
     wire::io::SceneSpec scene;
     if (engine::Status st = wire::io::load_wire_json(o.input, scene); !st.ok()) throw BadInput{st.message};
@@ -328,6 +329,7 @@ int run_view(const ViewOptions& o) try {
     schedule.add("wire.render", [&](engine::ecs::Registry&, const engine::ecs::FrameContext&) {
         wire::render::DrawSettings settings;
         settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
+        settings.node_lod = ctx.lod;
         drawn = renderer.draw(ctx.draw_list, ctx.camera, settings);
     });
 
@@ -479,9 +481,10 @@ Action add_view_command(CLI::App& app) {
                     "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear); default: the file's, else the "
                     "runtime's")
         ->check(CLI::IsMember({"uniform", "centripetal", "chordal", "c2", "auto", "automatic", "catmull-rom", "linear"}));
-    cmd->add_option("--path", o->path, "Upload path: cpu (meshes built on the CPU) or gpu (ring records, expanded in "
-                                       "the vertex shader); default: the runtime's")
-        ->check(CLI::IsMember({"cpu", "gpu"}));
+    cmd->add_option("--path", o->path, "Upload path: cpu (meshes built on the CPU), gpu (ring records, expanded in "
+                                       "the vertex shader) or nodes (nodes only: curve, LOD, frames and rings in "
+                                       "compute shaders); default: the runtime's")
+        ->check(CLI::IsMember({"cpu", "gpu", "nodes"}));
     cmd->add_option("--png", o->png_out,
                     "Write the last frame as PNG; if OUT contains %04d, every frame (%04d = frame number)");
     cmd->add_option("--csv", o->csv_out, "Write one row per ring of every visible wire and frame (the mesh ring CSV "

@@ -599,7 +599,7 @@ double percentile(std::vector<double> v, double q) {
 }
 
 // The same cables and camera 260 km and 1e6 m from the origin (random directions) draw the same picture as at the
-// origin: at most 1 % of the wire pixels off by more than 8/255, on both upload paths, over random scenes. (A float
+// origin: at most 1 % of the wire pixels off by more than 8/255, on the three upload paths, over random scenes. (A float
 // camera there steps by 3-6 cm: 17.6 % of the pixels were off at 260 km.)
 TEST_F(WiretoolView, OpenWorldFarFromTheOriginDrawsThePictureOfTheOrigin) {
     std::mt19937 rng(31);
@@ -614,7 +614,7 @@ TEST_F(WiretoolView, OpenWorldFarFromTheOriginDrawsThePictureOfTheOrigin) {
             const glm::dvec3 offset = distance * glm::normalize(glm::dvec3(gauss(rng), gauss(rng), gauss(rng)));
             const std::string far =
                 write("far.json", open_world_scene(open_world_cables(seed, offset), offset, 1, 0.0).dump());
-            for (const char* p : {"cpu", "gpu"}) {
+            for (const char* p : {"cpu", "gpu", "nodes"}) {
                 const std::string common = std::string(" --size 960x540 --path ") + p + " --png ";
                 ASSERT_EQ(run(origin + common + path("o.png")).status, 0);
                 const ToolRun r = run(far + common + path("f.png"));
@@ -644,7 +644,7 @@ TEST_F(WiretoolView, OpenWorldCameraStepsOfOneMillimetreMoveTheImageSmoothly) {
     const std::string origin =
         write("origin.json", open_world_scene(open_world_cables(7, glm::dvec3(0.0)), glm::dvec3(0.0), kFrames, 1e-3).dump());
     const std::string far = write("far.json", open_world_scene(open_world_cables(7, offset), offset, kFrames, 1e-3).dump());
-    for (const char* p : {"cpu", "gpu"}) {
+    for (const char* p : {"cpu", "gpu", "nodes"}) {
         const std::string common = std::string(" --size 960x540 --path ") + p + " --png ";
         ASSERT_EQ(run(origin + common + path("o_%04d.png")).status, 0);
         ASSERT_EQ(run(far + common + path("f_%04d.png")).status, 0);

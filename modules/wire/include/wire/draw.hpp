@@ -53,6 +53,9 @@ struct DrawItem {
     std::optional<bool> radius_varies;
     // gpu_nodes path
     const WireNodes* nodes = nullptr;  ///< validated nodes (the systems' checks); alive until the draw returns
+    /// Instead of `nodes`: the curve itself (a wire in a pop-free blend draws the blended curve), sent as its
+    /// segments (64 bytes each) while it blends.
+    const Curve* curve = nullptr;
     SplineSettings spline{};           ///< the curve's settings (kind, closed, radius, ...)
     /// Changes whenever `nodes` or `spline` change; the renderer keeps the wire's curve on the GPU while
     /// (wire_id, nodes_generation) stays the same. 0: unknown (the nodes are sent every frame).

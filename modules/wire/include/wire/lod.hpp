@@ -48,6 +48,7 @@
 #pragma once
 
 #include "wire/curve.hpp"
+#include "wire/spline.hpp"
 #include "wire/tessellate.hpp"
 
 #include <glm/mat3x3.hpp>
@@ -176,6 +177,15 @@ struct BoundingSphere {
 /// The bounding sphere of `curve` (centre of the control points' box, radius its half diagonal plus the largest
 /// tube radius, which it keeps as tube_radius_m). An empty curve gives radius -1.
 [[nodiscard]] BoundingSphere curve_bounding_sphere(const Curve& curve);
+
+/// A sphere enclosing the curve build_curve makes of `nodes` (every control point, inflated by the largest tube
+/// radius), from the nodes alone, for the kinds whose control points stay near their nodes: linear and
+/// Catmull-Rom / Kochanek-Bartels. A control point is B0 +- t/3 with |t| <= 2 |1 - tension| (1 + |bias|)
+/// (1 + |continuity|) max(|chord in|, |chord out|) for any alpha in [0, 1] (and the curvature-driven tension only
+/// shrinks t), so the nodes' box grown by 2/3 of that times the longest chord holds them. c2 and automatic: radius
+/// -1 (unknown: the global solve's overshoot has no local bound), as for an empty curve.
+[[nodiscard]] BoundingSphere node_bounding_sphere(const WireNodes& nodes, const SplineSettings& settings);
+
 
 /// A node of the span hierarchy: a sphere around the span's control points (not inflated by the tube radius)
 /// and its chord deviation (every curve point of the span is within it of the chord from the span's first point

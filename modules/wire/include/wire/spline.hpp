@@ -90,6 +90,11 @@ void build_curves(std::span<CurveBuildJob> jobs);
 std::size_t curve_nodes(const WireNodes& nodes, const SplineSettings& settings, std::vector<glm::dvec3>& out,
                         std::vector<uint32_t>* source = nullptr, std::vector<uint32_t>* last = nullptr);
 
+/// build_curve's checks without the build (the GPU curve path validates on the CPU, builds on the GPU): the same
+/// Status for bad settings, sizes, node values and too few distinct nodes (build_curve's messages, naming the
+/// node). Not checked: the tangent overflow of an extreme alpha (build_curve finds it while building).
+[[nodiscard]] Status check_curve_input(const WireNodes& nodes, const SplineSettings& settings);
+
 /// The thesis' curvature-driven tension for one node: R = theta*Iz*L / (A*dL^2); 0 if R > 100 (or dL = 0),
 /// else 1 - tanh(R/50). Non-finite or non-positive denominators give 0.
 [[nodiscard]] double curvature_tension(double theta_rad, double iz_m4, double length_m, double delta_length_m,

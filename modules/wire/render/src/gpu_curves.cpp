@@ -164,6 +164,11 @@ void main() {
     if (w >= u_wires) return;
     Header h = headers[w];
     if (u_persist) slot_headers[h.slot] = h;
+    if ((h.flags & kGivenSegments) != 0u) {  // a blended curve: its segments as they came
+        uint segs = (h.flags & 1u) != 0u ? h.node_count : h.node_count - 1u;
+        for (uint k = 0u; k < 4u * segs; ++k) segments[4u * h.segment_first + k] = nodes[h.node_first + k];
+        return;
+    }
     uint n = h.node_count;
     bool closed = (h.flags & 1u) != 0u;
     uint kind = (h.flags >> 1u) & 3u;
@@ -326,6 +331,34 @@ Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t s
     }
     segments = static_cast<uint32_t>(segs);
     return Status::success();
+}
+
+void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
+                     WireUpload& out) {
+    glm::dvec3 lo = curve.segments.front().b0, hi = lo;
+    for (const CubicBezier& c : curve.segments) {
+        for (const glm::dvec3* p : {&c.b0, &c.b1, &c.b2, &c.b3}) lo = glm::min(lo, *p), hi = glm::max(hi, *p);
+    }
+    const glm::dvec3 origin = 0.5 * (lo + hi);
+    GpuCurveHeader h;
+    h.node_first = static_cast<uint32_t>(out.nodes.size());
+    h.node_count = static_cast<uint32_t>(curve.closed ? curve.segment_count() : curve.segment_count() + 1);
+    h.segment_first = segment_first;
+    h.flags = (curve.closed ? kHeaderClosed : 0u) | (caps ? kHeaderCaps : 0u) | kHeaderGivenSegments |
+              (material << kHeaderMaterialShift);
+    h.slot = slot;
+    h.origin_m[0] = origin.x, h.origin_m[1] = origin.y, h.origin_m[2] = origin.z;
+    out.headers.push_back(h);
+    const std::size_t n = curve.radius_m.size();
+    const auto radius = [&](std::size_t j) { return n == 0 ? kDefaultWireRadius_m : curve.radius_m[j % n]; };
+    for (std::size_t k = 0; k < curve.segment_count(); ++k) {
+        const CubicBezier& c = curve.segments[k];
+        const float stretch = k < curve.stretch.size() ? curve.stretch[k] : 1.0f;
+        out.nodes.emplace_back(glm::vec3(c.b0 - origin), radius(k));
+        out.nodes.emplace_back(glm::vec3(c.b1 - c.b0), radius(k + 1));
+        out.nodes.emplace_back(glm::vec3(c.b2 - c.b1), stretch);
+        out.nodes.emplace_back(glm::vec3(c.b3 - c.b2), 0.0f);
+    }
 }
 
 }  // namespace detail

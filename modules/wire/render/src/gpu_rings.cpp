@@ -306,15 +306,15 @@ uint hysteresis_count(uint old_count, uint raw, float band) {
 // n = ceil(pi / acos(1 - x)) is the least n with x >= 1 - cos(pi / n) (the sagitta of an n-gon per unit
 // radius): found in a table of those, computed in double on the CPU, so no inverse cosine in float (GLSL leaves
 // its precision to the driver: llvmpipe's moved a 6 px tube from 4 to 5 sides).
-uint sides_for_radius(float radius, float z, float k) {
+uint sides_for_radius(float radius, float z, float k, uint max_sides) {
     float r_px = radius * u_focal * k / max(z, u_near);
     if (!(r_px > 0.0)) return 3u;
     float x = u_eps / r_px;
     if (x >= 0.5) return 3u;
-    for (uint n = 4u; n < u_max_sides; ++n) {
+    for (uint n = 4u; n < max_sides; ++n) {
         if (x >= u_sagitta[n]) return n;
     }
-    return u_max_sides;
+    return max_sides;
 }
 uint drawn_sides_for(float radius_px, uint sides, uint old_drawn) {
     float keep = 1.0 + max(u_band, 0.0);
@@ -392,8 +392,10 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
         slot_state[slot].lod = uvec4(0u);  // culled: the next frame starts afresh (cull_lod)
         return 0u;
     }
-    uint required_sides = visible == 0u ? 3u : sides_for_radius(radius, wire_z, wire_k);
-    uint sides = min(fresh ? required_sides : hysteresis_count(state.x, required_sides, u_band), u_max_sides);
+    uint wire_max = (H.flags >> 8u) & 255u;  // the wire's own most sides, if it has one
+    uint max_sides = wire_max == 0u ? u_max_sides : max(3u, min(u_max_sides, wire_max));
+    uint required_sides = visible == 0u ? 3u : sides_for_radius(radius, wire_z, wire_k, max_sides);
+    uint sides = min(fresh ? required_sides : hysteresis_count(state.x, required_sides, u_band), max_sides);
     radius_px = visible == 0u ? 0.0 : radius * u_focal * wire_k / max(wire_z, u_near);
     uint drawn = drawn_sides_for(radius_px, sides, state.y);
     slot_state[slot].lod = uvec4(sides, drawn, 1u, 1u);

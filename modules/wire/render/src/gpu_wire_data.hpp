@@ -18,13 +18,14 @@ namespace wire::render::detail {
 
 /// GpuCurveHeader in GLSL (std430, 64 bytes) and its flag bits; `GPU_WIRE_HEADER` in a source is replaced by it.
 inline constexpr const char* kWireHeaderGlsl = R"glsl(
-const uint kClosed = 1u, kCaps = 8u, kHasPerNode = 16u, kHasStretch = 32u;
+const uint kClosed = 1u, kCaps = 8u, kHasPerNode = 16u, kHasStretch = 32u, kGivenSegments = 64u;
 struct Header {
     uint node_first;     // this frame's curve nodes (the curve pass reads them)
     uint node_count;     // curve nodes (merged)
     uint segment_first;  // the wire's segments, and its per-segment ring counts
     uint flags;          // bit 0 closed; 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); 3 caps; 4 per-node kb;
-                         // 5 stretch; 16-31 material
+                         // 5 stretch; 6 the segments are given (4 vec4 each at node_first); 8-15 the wire's
+                         // most sides (0: the LOD settings'); 16-31 material
     vec4 kb;             // alpha, tension, bias, continuity (wire-wide)
     uint extra_first;    // per-node kb (a vec4 a node), then stretch (4 segments a vec4), in the extras
     uint slot;           // the wire's persistent slot (ring pass state)
@@ -35,7 +36,8 @@ struct Header {
 /// `source` with GPU_WIRE_HEADER replaced by kWireHeaderGlsl.
 std::string with_wire_header(const char* source);
 
-inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u;
+inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u,
+                          kHeaderGivenSegments = 64u;
 inline constexpr uint32_t kHeaderKindShift = 1u, kHeaderMaterialShift = 16u;
 inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u;
 
@@ -62,5 +64,11 @@ void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, 
 const char* ring_source();
 /// The curve program's GLSL (GPU_WIRE_HEADER not yet replaced): gpu_curves.cpp.
 const char* curve_source();
+
+/// Appends a curve given as segments (a wire in a pop-free blend): 4 vec4 a segment in `nodes` (b0 from the
+/// origin with its start node's radius in w; b1 - b0 with the end node's radius; b2 - b1 with the stretch;
+/// b3 - b2), which the curve pass copies.
+void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
+                     WireUpload& out);
 
 }  // namespace wire::render::detail

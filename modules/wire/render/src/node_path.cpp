@@ -31,7 +31,13 @@ void clear_range(const gfx::Buffer& buffer, std::size_t offset, std::size_t byte
 
 }  // namespace
 
-Expected<std::unique_ptr<NodePath>> NodePath::create(const LodSettings& lod, uint32_t retain_frames) {
+void NodePath::set_lod(const LodSettings& lod) {
+    lod_ = lod;
+    lod_.keep_node_resolution = true;
+    max_sides_ = std::clamp<uint32_t>(lod.max_sides ? lod.max_sides : 32u, 3u, kMaxSides);
+}
+
+Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     auto path = std::make_unique<NodePath>();
     auto curve = gfx::make_program({.label = "wire nodes: curves", .compute = with_wire_header(curve_source())});
     if (!curve) return curve.error();
@@ -39,9 +45,7 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(const LodSettings& lod, uin
     if (!rings) return rings.error();
     path->curve_program_ = std::move(*curve);
     path->ring_program_ = std::move(*rings);
-    path->lod_ = lod;
-    path->lod_.keep_node_resolution = true;
-    path->max_sides_ = std::clamp<uint32_t>(lod.max_sides ? lod.max_sides : 32u, 3u, kMaxSides);
+    path->set_lod({});
     path->retain_frames_ = retain_frames ? retain_frames : 180;
     auto readback = gfx::make_buffer({.size_bytes = kReadbackSlots * 8,
                                       .storage_flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT,
@@ -127,15 +131,20 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
     std::size_t visible = 0;
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
-        if (item.nodes == nullptr || item.nodes->size() < 2) continue;
+        const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
+        if (!has_curve && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         ++visible;
         const auto it = slots_.find(item.wire_id);
         const bool changed = it == slots_.end() || !it->second.built || item.nodes_generation == 0 ||
                              item.nodes_generation != it->second.generation;
         if (!changed) continue;
         changed_item_[i] = 1;
-        const std::size_t n = item.nodes->size();
         headers += sizeof(GpuCurveHeader);
+        if (has_curve) {
+            nodes += 64 * item.curve->segment_count();
+            continue;
+        }
+        const std::size_t n = item.nodes->size();
         nodes += 16 * n;
         extras += 16 * n + 16 * ((n + 3) / 4);
     }
@@ -158,7 +167,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     std::size_t segments_visible = 0;
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
-        if (item.nodes == nullptr || item.nodes->size() < 2) continue;
+        const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
+        if (!has_curve && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         auto [it, fresh] = slots_.try_emplace(item.wire_id);
         Slot& slot = it->second;
         if (fresh) {
@@ -180,12 +190,16 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         if (changed) {
             uint32_t segments = 0;
             const std::size_t nodes_before = up.nodes.size(), extras_before = up.extras.size();
-            const Status st = append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
-                                          item.caps, up, segments);
-            if (!st) {  // the systems validate; a kind the GPU does not build yet is skipped here
-                ++stats.wires_skipped;
+            if (has_curve) {
+                append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps, up);
+                segments = static_cast<uint32_t>(item.curve->segment_count());
+            } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
+                                    item.caps, up, segments)) {
+                ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build yet is skipped here
                 continue;
             }
+            // The wire's most sides (the LOD's max_sides for it; its Style's): header bits 8-15.
+            up.headers.back().flags |= std::min<uint32_t>(std::max<uint32_t>(item.sides, 3u), 255u) << 8;
             if (segments != slot.segments) {
                 free_segments(slot.segment_first, slot.segments);
                 uint32_t first = 0;

@@ -35,7 +35,9 @@ struct NodeDrawContext {
 
 class NodePath {
 public:
-    static Expected<std::unique_ptr<NodePath>> create(const LodSettings& lod, uint32_t retain_frames);
+    static Expected<std::unique_ptr<NodePath>> create(uint32_t retain_frames);
+    /// The LOD of the next frames (keep_node_resolution implied, max_sides clamped to 3 .. 256).
+    void set_lod(const LodSettings& lod);
 
     /// Uploads and computes the frame (see the file comment) into `region` (begun by the caller with at least
     /// upload_bytes(list) bytes); returns false (nothing to draw) when no item draws. The patterns in `ctx` must

@@ -131,10 +131,11 @@ struct WireRenderer::State {
     DrawStats draw_nodes(const DrawList& list, const engine::scene::Camera& camera, const DrawSettings& settings) {
         DrawStats stats;
         if (!nodes) {
-            Expected<std::unique_ptr<detail::NodePath>> made = detail::NodePath::create(desc.node_lod, desc.retain_frames);
+            Expected<std::unique_ptr<detail::NodePath>> made = detail::NodePath::create(desc.retain_frames);
             if (!made) return stats;
             nodes = std::move(*made);
         }
+        nodes->set_lod(settings.node_lod);
         if (Status st = ensure_patterns(nodes->max_sides()); !st) return stats;
         const std::size_t bytes = nodes->upload_bytes(list);
         Expected<StreamRegion> begun = stream.begin(bytes);

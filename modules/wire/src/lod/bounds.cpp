@@ -201,3 +201,44 @@ void compute_lod_bounds(const Curve& curve, LodBounds& out, const BoundingSphere
 }
 
 }  // namespace wire
+
+namespace wire {
+
+BoundingSphere node_bounding_sphere(const WireNodes& nodes, const SplineSettings& settings) {
+    const bool local = settings.kind == SplineKind::linear || settings.kind == SplineKind::catmull_rom;
+    const std::size_t n = nodes.size();
+    if (!local || n == 0) return {};
+    // K = max over nodes of |1 - tension| (1 + |bias|) (1 + |continuity|): the factor of t's bound (1 for linear,
+    // whose t is the chord itself).
+    double k = 1.0;
+    if (settings.kind == SplineKind::catmull_rom) {
+        const auto at = [](const auto& v, std::size_t i, double fallback) -> double {
+            return v.empty() ? fallback : v[i];
+        };
+        const bool per_node = !nodes.kb_tension.empty() || !nodes.kb_bias.empty() || !nodes.kb_continuity.empty();
+        for (std::size_t i = 0; i < (per_node ? n : 1); ++i) {
+            const double t = at(nodes.kb_tension, i, settings.tension), b = at(nodes.kb_bias, i, settings.bias),
+                         c = at(nodes.kb_continuity, i, settings.continuity);
+            k = std::max(k, 2.0 * std::abs(1.0 - t) * (1.0 + std::abs(b)) * (1.0 + std::abs(c)));
+        }
+    }
+    glm::dvec3 lo = nodes.positions[0], hi = nodes.positions[0];
+    double chord = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        lo = glm::min(lo, nodes.positions[i]);
+        hi = glm::max(hi, nodes.positions[i]);
+        if (i + 1 < n) chord = std::max(chord, glm::length(nodes.positions[i + 1] - nodes.positions[i]));
+    }
+    if (settings.closed && n > 1) chord = std::max(chord, glm::length(nodes.positions[0] - nodes.positions[n - 1]));
+    double radius = settings.radius_m > 0.0f ? settings.radius_m : kDefaultWireRadius_m;
+    for (const float r : nodes.radius_m) radius = std::max(radius, static_cast<double>(r));
+    BoundingSphere s;
+    s.centre_m = 0.5 * (lo + hi);
+    // Every control point within k/3 chord of its node (the node's box grown by that); a little more for rounding.
+    const double grow = k * chord / 3.0 * (1.0 + 1e-9);
+    s.tube_radius_m = radius;
+    s.radius_m = 0.5 * glm::length(hi - lo) + std::sqrt(3.0) * grow + radius;
+    return s;
+}
+
+}  // namespace wire

@@ -11,6 +11,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <string>
 
 namespace wire::curve_stage {
 
@@ -135,6 +136,27 @@ const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m,
 }  // namespace wire::curve_stage
 
 namespace wire {
+
+Status check_curve_input(const WireNodes& nodes, const SplineSettings& settings) {
+    if (Status st = curve_stage::check_settings(settings); !st) return st;
+    if (Status st = curve_stage::check_sizes(nodes); !st) return st;
+    const bool physics = settings.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
+                         !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
+    if (Status st = curve_stage::check_nodes(nodes, physics); !st) return st;
+    thread_local curve_stage::Merged m;
+    thread_local curve_stage::Chords ch;
+    std::size_t n = 0;
+    (void)curve_stage::merge_nodes(nodes, settings, m, ch, n);
+    if (n < 2) {
+        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(nodes.size()) +
+                             " node(s) and " + std::to_string(n) + " after merging coincident ones");
+    }
+    if (settings.closed && n < 3) {
+        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(n) +
+                             " after merging coincident ones");
+    }
+    return Status::success();
+}
 
 std::size_t curve_nodes(const WireNodes& nodes, const SplineSettings& settings, std::vector<glm::dvec3>& out,
                         std::vector<uint32_t>* source, std::vector<uint32_t>* last) {

@@ -482,7 +482,65 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         }
         c.blending = job.status.ok() && !c.pop_free_stale && c.pop_free.blending();
     };
-    parallel_over((jobs.size() + 3) / 4, [&](std::size_t group) {
+    if (ctx.path == UploadPath::gpu_nodes) {
+        // The nodes path: the GPU builds the curve from the nodes. Here only build_curve's checks, the sphere the
+        // CPU culls with (from the nodes), and the pop-free blend, whose blended curve is drawn while it lasts.
+        parallel_over(jobs.size(), [&](std::size_t i) {
+            CurveJob& job = jobs[i];
+            Step step;
+            prepare(job, step);
+            WireCurve& c = *job.curve;
+            const WireNodes& nodes = *job.nodes;
+            const WireNodes& prev = c.previous_nodes;
+            BoundingSphere sphere{};
+            if (step.exact && step.spline.kind == SplineKind::automatic) {
+                // Not built on the GPU yet: the CPU builds the curve and the renderer gets its segments.
+                thread_local Curve built;  // swapped in on success: a failure keeps the last valid curve
+                job.status = build_curve(nodes, step.spline, built);
+                if (job.status.ok() && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
+                if (job.status.ok()) {
+                    std::swap(c.curve, built);
+                    sphere = curve_bounding_sphere(c.curve);
+                }
+                if (!c.pop_free_stale) {
+                    c.pop_free = PopFreeCurve(
+                        PopFreeSettings{.spline = step.spline, .enabled = pop_free, .blend_s = job.style->blend_s});
+                    c.pop_free_stale = true;
+                }
+            } else if (step.exact) {
+                job.status = check_curve_input(nodes, step.spline);
+                if (job.status.ok() && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
+                if (job.status.ok()) {
+                    release(c.curve.segments);  // not kept: the GPU builds it
+                    sphere = node_bounding_sphere(nodes, step.spline);
+                }
+                if (!c.pop_free_stale) {
+                    c.pop_free = PopFreeCurve(
+                        PopFreeSettings{.spline = step.spline, .enabled = pop_free, .blend_s = job.style->blend_s});
+                    c.pop_free_stale = true;
+                }
+            } else {
+                thread_local Curve scratch;
+                if (c.pop_free_stale) {
+                    c.pop_free.reset();
+                    (void)c.pop_free.update(prev, scratch);
+                    c.pop_free_stale = false;
+                }
+                job.status = c.pop_free.update(nodes, c.curve);
+                if (job.status.ok()) sphere = curve_bounding_sphere(c.curve);
+            }
+            ++c.builds;
+            if (job.status.ok()) {
+                ++c.generation;
+                c.bounds = sphere;
+                c.bounds_generation = c.generation;
+                job.changed = true;
+                copy_nodes(c.previous_nodes, nodes);
+                c.released = false;
+            }
+            c.blending = job.status.ok() && !c.pop_free_stale && c.pop_free.blending();
+        });
+    } else parallel_over((jobs.size() + 3) / 4, [&](std::size_t group) {
         thread_local Curve scratch[4];
         const std::size_t first = 4 * group, count = std::min<std::size_t>(4, jobs.size() - first);
         CurveJob* const job = &jobs[first];
@@ -550,6 +608,23 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
 
 void lod_system(Registry& registry, WireContext& ctx) {
     refresh_view(ctx);
+    if (ctx.path == UploadPath::gpu_nodes) {
+        // The nodes path: the GPU chooses counts and sides. Here the cull by the sphere of the nodes (or of the
+        // blended curve); a wire without a sphere (c2, automatic: unknown overshoot) is sent and culled there.
+        auto& storage = registry.storage<WireLodState>();
+        for (std::size_t i = 0; i < storage.size(); ++i) {
+            const WireCurve* curve = registry.try_get<WireCurve>(storage.at(i));
+            WireLodState& lod = storage.at_position(i);
+            const bool visible = curve != nullptr && curve->generation > 0 &&
+                                 (curve->bounds.radius_m < 0.0 || !sphere_outside_view(curve->bounds, ctx.view));
+            if (visible != lod.lod.visible) ++lod.generation;
+            lod.lod.visible = visible;
+            lod.seen_curve = curve != nullptr ? curve->generation : 0;
+            lod.seen_view = ctx.view_generation;
+        }
+        ctx.lod_pass_generation = ctx.view_generation;
+        return;
+    }
     // The view moved on since the LOD last visited every wire (this frame's curve stage may have updated the
     // wires it rebuilt for the new view already: they are skipped below as up to date).
     const bool view_changed = ctx.lod_pass_generation != ctx.view_generation;
@@ -591,6 +666,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
 }
 
 void rings_system(Registry& registry, WireContext& ctx) {
+    if (ctx.path == UploadPath::gpu_nodes) return;  // on the GPU
     std::vector<RingJob>& jobs = reused<RingJob, 0>();
     auto& storage = registry.storage<WireRings>();
     for (std::size_t i = 0; i < storage.size(); ++i) {
@@ -673,6 +749,33 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
     std::sort(visible.begin(), visible.end(), by_index);  // entity order, whatever the storage order
 
     list.items.reserve(visible.size());
+    if (ctx.path == UploadPath::gpu_nodes) {
+        for (const Entity e : visible) {
+            const Style* style = registry.try_get<Style>(e);
+            const WireCurve* curve = registry.try_get<WireCurve>(e);
+            if (style == nullptr || curve == nullptr || curve->generation == 0) continue;
+            DrawItem item;
+            item.material = style->material;
+            item.wire_id = engine::ecs::to_integral(e);
+            // The last valid nodes (the current ones unless they are invalid), or the curve built on the CPU: the
+            // blended one while a pop-free blend is live, an automatic spline's (not on the GPU yet).
+            const bool cpu_curve = !curve->pop_free_stale || style->spline.kind == SplineKind::automatic;
+            if (cpu_curve && !curve->curve.segments.empty()) {
+                item.curve = &curve->curve;
+            } else {
+                item.nodes = &curve->previous_nodes;
+            }
+            item.spline = spline_of(*style);
+            item.nodes_generation = curve->generation;
+            item.sides = style->max_sides ? std::max<uint32_t>(style->max_sides, 3) : kDefaultMaxSides;
+            item.closed = style->closed;
+            item.caps = caps_of(*style);
+            list.items.push_back(item);
+        }
+        ctx.stats.visible_wires = visible.size();
+        ctx.stats.draw_items = list.items.size();
+        return;
+    }
     for (const Entity e : visible) {
         const WireRings* rings = registry.try_get<WireRings>(e);
         const WireLodState* lod = registry.try_get<WireLodState>(e);

@@ -487,9 +487,9 @@ EdgeComparison compare_off_edges(const platform::Image& a, const platform::Image
 TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
-    RendererDesc desc;
-    desc.node_lod.keep_node_resolution = true;
-    WireRenderer renderer = make_renderer(desc);
+    WireRenderer renderer = make_renderer();
+    DrawSettings node_settings;
+    node_settings.node_lod.keep_node_resolution = true;
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
     // The scene's nodes and settings (test_scene() keeps them in its pipelines; rebuilt here with the nodes).
     struct Wire {
@@ -546,7 +546,7 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
             wire::Curve curve;
             ASSERT_TRUE(wire::build_curve(wires[i].nodes, wires[i].spline, curve).ok());
             wire::WireLod lod;
-            wire::update_lod(curve, lod_view, desc.node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
+            wire::update_lod(curve, lod_view, node_settings.node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
             ASSERT_TRUE(lod.visible);
             std::vector<wire::RingParam> params;
             wire::place_rings(curve, lod.counts, params);
@@ -565,13 +565,14 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
             node_item.nodes = &wires[i].nodes;
             node_item.spline = wires[i].spline;
             node_item.nodes_generation = 1;
+            node_item.sides = 32;  // the most sides: the LOD settings' (update_lod's default)
             node_item.caps = wires[i].caps;
             gpu.items.push_back(node_item);
         }
         DrawStats cpu_stats, gpu_stats, second_stats;
         const platform::Image reference = render(*ctx, renderer, cpu, view.camera, {}, &cpu_stats);
-        const platform::Image first = render(*ctx, renderer, gpu, view.camera, {}, &gpu_stats);
-        const platform::Image second = render(*ctx, renderer, gpu, view.camera, {}, &second_stats);
+        const platform::Image first = render(*ctx, renderer, gpu, view.camera, node_settings, &gpu_stats);
+        const platform::Image second = render(*ctx, renderer, gpu, view.camera, node_settings, &second_stats);
         save(reference, std::string("wire_render_") + view.name + "_reference_for_nodes.png");
         save(first, std::string("wire_render_") + view.name + "_gpu_nodes.png");
         EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));

@@ -82,9 +82,6 @@ struct RendererDesc {
     uint32_t retain_frames = 0;
     /// Initial size of the retained ring buffer (grows as needed); 0 -> 4 MiB.
     std::size_t ring_storage_bytes = 0;
-    /// gpu-nodes: the LOD the GPU evaluates (at node resolution: keep_node_resolution is implied; max_sides is
-    /// clamped to 256).
-    LodSettings node_lod{};
 };
 
 /// Per-frame options.
@@ -95,6 +92,10 @@ struct DrawSettings {
     /// predate the double camera). Offsets origin_m - eye are computed in double and sent as float, and the view
     /// is Camera::clip_from_relative(), so wires far from the world origin keep their precision.
     std::optional<glm::dvec3> eye_m{};
+    /// gpu-nodes: the LOD the GPU evaluates this frame (pass the systems' WireContext::lod); at node resolution
+    /// (keep_node_resolution is implied); max_sides above 256 is taken as 256. A wire's own most sides is
+    /// DrawItem::sides.
+    LodSettings node_lod{};
 };
 
 /// What one draw() did.
