@@ -10,10 +10,12 @@
 #include <engine/gfx/lit_renderer.hpp>
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
+#include <wire/io/wire_json.hpp>
 #include <wire/render/upload_plan.hpp>
 #include <wire/render/wire_renderer.hpp>
 
 #include <algorithm>
+#include <unordered_map>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -25,13 +27,14 @@
 namespace wiretool::bench {
 namespace {
 
-enum class GlPathKind { cpu_mesh, gpu_streamed, gpu_retained, one_draw };
+enum class GlPathKind { cpu_mesh, gpu_streamed, gpu_retained, gpu_nodes, one_draw };
 
 const char* path_name(GlPathKind k) {
     switch (k) {
         case GlPathKind::cpu_mesh: return "cpu-mesh";
         case GlPathKind::gpu_streamed: return "gpu-rings";
         case GlPathKind::gpu_retained: return "gpu-retained";
+        case GlPathKind::gpu_nodes: return "gpu-nodes";
         case GlPathKind::one_draw: return "one-draw baseline";
     }
     return "?";
@@ -39,7 +42,7 @@ const char* path_name(GlPathKind k) {
 
 // Per measured frame of one row.
 struct RowFrames {
-    std::vector<double> systems_ms, draw_ms, finish_ms, gpu_ms, commands, calls, bytes, triangles, visible;
+    std::vector<double> systems_ms, draw_ms, finish_ms, gpu_ms, commands, calls, bytes, triangles, visible, nodes;
     std::size_t mismatches = 0;
     engine::gfx::GpuTimer timer;
 };
@@ -84,6 +87,50 @@ struct Row {
     double wire_memory_bytes = 0.0, gpu_buffer_bytes = 0.0;
 };
 
+// What the nodes path sends (node_path.hpp): for a wire whose curve generation it has not sent, a 64-byte header
+// and its curve nodes (16 bytes each; coincident ones merged, as the bench's never are) or, for a curve built on
+// the CPU (pop-free blend, automatic spline), 64 bytes a segment; per-node kb and stretch (the extras); 4 bytes for
+// each other visible wire (its slot).
+std::size_t nodes_plan(const wire::DrawList& list, std::unordered_map<uint64_t, uint64_t>& seen) {
+    std::size_t bytes = 0, extras = 0;
+    for (const wire::DrawItem& item : list.items) {
+        auto [it, fresh] = seen.try_emplace(item.wire_id, 0);
+        if (!fresh && item.nodes_generation != 0 && it->second == item.nodes_generation) {
+            bytes += 4;  // an unchanged wire: its slot
+            continue;
+        }
+        it->second = item.nodes_generation;
+        bytes += 64;
+        if (item.curve != nullptr) {
+            bytes += 64 * item.curve->segment_count();
+            continue;
+        }
+        if (item.packed_nodes != nullptr) {
+            bytes += 16 * (item.packed_nodes->nodes.size() + item.packed_nodes->extras.size());
+            continue;
+        }
+        const wire::WireNodes& n = *item.nodes;
+        bytes += 16 * n.size();
+        const bool kb = item.spline.kind == wire::SplineKind::catmull_rom &&
+                        (!n.kb_tension.empty() || !n.kb_bias.empty() || !n.kb_continuity.empty() ||
+                         (item.spline.curvature_tension && !n.theta_rad.empty()));
+        if (kb) extras += 16 * n.size();
+        const std::size_t segs = item.spline.closed ? n.size() : n.size() - 1;
+        if (!n.stretch.empty()) extras += 16 * ((segs + 3) / 4);
+    }
+    return bytes + extras;
+}
+
+std::size_t visible_nodes(const wire::DrawList& list) {
+    std::size_t n = 0;
+    for (const wire::DrawItem& item : list.items) {
+        if (item.nodes != nullptr) n += item.nodes->size();
+        else if (item.curve != nullptr) n += item.curve->node_count();
+        else n += item.rings.size();  // not a nodes-path item: its rings
+    }
+    return n;
+}
+
 class GlScale {
 public:
     bool init(const Options& o) {
@@ -97,6 +144,7 @@ public:
         return true;
     }
     const std::string& error() const { return error_; }
+    void set_spline(const wire::SplineSettings& spline) { spline_ = spline; }
     std::string gl_renderer() const { return context_ ? context_->gl_renderer() : std::string{}; }
 
     // One row: the scene run on `path` (the one-draw baseline rides on a cpu-mesh run with thin wires off).
@@ -114,18 +162,21 @@ public:
         row.scene = scene_name(kind), row.wires = wires, row.threads = threads, row.path = path, row.thin = thin;
         row.f.timer = engine::gfx::GpuTimer::create();
         wire::render::RingResidency model;  // what the retained renderer should send
+        std::unordered_map<uint64_t, uint64_t> seen;  // gpu-nodes: the generation each wire's curve was sent at
         MergedMesh merged;
         std::fprintf(stderr, "bench --gl: %s, %d wires, %dx%d, %d thread(s), %s%s\n", row.scene.c_str(), wires,
                      o.width_px, o.height_px, threads, path_name(path), thin ? "" : ", strips and lines off");
         RunSpec spec{.kind = kind,
-                     .path = cpu ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_rings,
+                     .path = cpu                              ? wire::UploadPath::cpu_mesh
+                             : path == GlPathKind::gpu_nodes ? wire::UploadPath::gpu_nodes
+                                                              : wire::UploadPath::gpu_rings,
                      .threads = threads,
                      .frames = frames,
                      .wires = wires,
                      .sample_errors = false,
                      .error_samples = 0,
                      .after_frame = {},
-                     .spline = {.kind = wire::SplineKind::automatic},
+                     .spline = spline_,
                      .width_px = o.width_px,
                      .height_px = o.height_px,
                      .thin_wires = thin};
@@ -139,6 +190,8 @@ public:
                 computed = upload_bytes(*list);
             } else if (path == GlPathKind::gpu_retained) {
                 computed = wire::render::plan_retained_frame(ctx.draw_list, model).bytes;
+            } else if (path == GlPathKind::gpu_nodes) {
+                computed = nodes_plan(ctx.draw_list, seen);
             } else {
                 computed = upload_bytes(ctx.draw_list);
             }
@@ -146,7 +199,9 @@ public:
             engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
             const double t0 = wall_ms();
             row.f.timer.begin();
-            const wire::render::DrawStats st = renderer.draw(*list, ctx.camera);
+            wire::render::DrawSettings settings;
+            settings.node_lod = ctx.lod;
+            const wire::render::DrawStats st = renderer.draw(*list, ctx.camera, settings);
             row.f.timer.end();
             const double t1 = wall_ms();
             engine::gfx::finish_gpu();
@@ -168,6 +223,7 @@ public:
             row.f.bytes.push_back(static_cast<double>(st.bytes_uploaded));
             row.f.triangles.push_back(static_cast<double>(st.triangles));
             row.f.visible.push_back(static_cast<double>(ctx.stats.visible_wires));
+            row.f.nodes.push_back(static_cast<double>(visible_nodes(ctx.draw_list)));
             row.f.mismatches += st.bytes_uploaded != computed;
         };
         const SceneRun run = run_scene(spec);
@@ -182,6 +238,7 @@ public:
 private:
     std::unique_ptr<engine::platform::Context> context_;
     std::string error_;
+    wire::SplineSettings spline_{.kind = wire::SplineKind::automatic};
 };
 
 std::vector<int> thread_counts() {
@@ -206,6 +263,17 @@ int run_gl_scale_bench(const Options& o) {
     std::string md = "# wiretool bench --gl\n\n";
     GlScale gl;
     if (scenes.empty()) return exit_ok;
+    {
+        // The wires' spline (--spline), resolved as `wiretool mesh` does (the systems rows do the same).
+        wire::PipelineSettings resolved;
+        wire::io::SettingsOverrides overrides;
+        overrides.spline_type = o.spline;
+        if (engine::Status st = wire::io::resolve_settings(wire::io::WireSpec{}, overrides, resolved); !st.ok()) {
+            std::fprintf(stderr, "wiretool bench: --spline: %s\n", st.message.c_str());
+            return 2;
+        }
+        gl.set_spline(resolved.spline);
+    }
     if (!gl.init(o)) {
         std::fprintf(stderr, "wiretool bench: --gl: no headless GL context (%s): bench_gl.md says so, no rows\n",
                      gl.error().c_str());
@@ -214,20 +282,40 @@ int run_gl_scale_bench(const Options& o) {
     }
     const int frames = o.quick ? 9 : 61;  // frame 0 is not measured
     std::vector<Row> rows;
+    std::string nodes_md;  // the nodes path against cpu-mesh, per scene and thread count
     for (SceneKind kind : scenes) {
         const int wires = o.wires > 0 ? o.wires : scene_wire_count(kind);
         const std::size_t first = rows.size();
         for (int threads : thread_counts())
-            for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_streamed, GlPathKind::gpu_retained})
+            for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_streamed, GlPathKind::gpu_retained,
+                                 GlPathKind::gpu_nodes})
                 gl.run_row(o, kind, wires, threads, p, true, frames, rows);
         // Strips and lines off, so that the one-draw baseline draws exactly the triangles the paths draw.
         const int all = thread_counts().back();
         for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_streamed, GlPathKind::gpu_retained,
-                             GlPathKind::one_draw})
+                             GlPathKind::gpu_nodes, GlPathKind::one_draw})
             gl.run_row(o, kind, wires, all, p, false, frames, rows);
         double baseline_gpu = 0.0;
         for (std::size_t r = first; r < rows.size(); ++r)
             if (rows[r].path == GlPathKind::one_draw) baseline_gpu = median(rows[r].f.gpu_ms);
+        for (std::size_t r = first; r < rows.size(); ++r) {
+            if (rows[r].path != GlPathKind::gpu_nodes || !rows[r].thin) continue;
+            for (std::size_t c = first; c < rows.size(); ++c) {
+                const Row& cpu = rows[c];
+                if (cpu.path != GlPathKind::cpu_mesh || !cpu.thin || cpu.threads != rows[r].threads) continue;
+                const Row& n = rows[r];
+                const double cpu_wall = median(cpu.f.systems_ms) + median(cpu.f.draw_ms);
+                const double nodes_wall = median(n.f.systems_ms) + median(n.f.draw_ms);
+                const double budget = 16.0 * median(n.f.nodes) + 64.0 * median(n.f.visible);
+                char line[512];
+                std::snprintf(line, sizeof line,
+                              "| %s | %d | %.3f | %.3f | %.3f | %.3f | %.0f | %.0f | %.2f |\n", n.scene.c_str(),
+                              n.threads, median(cpu.f.systems_ms) + median(cpu.f.draw_ms), nodes_wall,
+                              cpu_wall > 0.0 ? nodes_wall / cpu_wall : 0.0, median(n.f.gpu_ms), median(n.f.bytes),
+                              budget, budget > 0.0 ? median(n.f.bytes) / budget : 0.0);
+                nodes_md += line;
+            }
+        }
         for (std::size_t r = first; r < rows.size(); ++r) {
             const Row& row = rows[r];
             const double systems = median(row.f.systems_ms), draw = median(row.f.draw_ms),
@@ -260,6 +348,14 @@ int run_gl_scale_bench(const Options& o) {
           "draws the same frame's triangles merged into one indexed mesh with one command (same shaders), and "
           "gpu_vs_one_draw is each such row's GPU ms over the baseline's (nan in rows with thin wires on).\n\n";
     md += table.markdown();
+    md += "\n## The nodes path against cpu-mesh (issue 30)\n\nCPU wall per frame = systems_wall_ms + draw_ms (what "
+          "the CPU spends, without waiting for the GPU: run with GALLIUM_NOOP=1 on llvmpipe, where draw() would "
+          "otherwise run the compute shaders on the CPU); bytes: gpu-nodes bytes_per_frame against 16 B per "
+          "visible node + 64 B per visible wire (the issue's bound; nodes of the visible wires' items).\n\n"
+          "| scene | threads | cpu-mesh CPU ms | gpu-nodes CPU ms | nodes / cpu-mesh (aim <= 0.2) | gpu-nodes GPU ms "
+          "| gpu-nodes bytes | 16 B/node + 64 B/wire | bytes / bound (aim <= 1) |\n| --- | --- | --- | --- | --- | "
+          "--- | --- | --- | --- |\n" +
+          nodes_md;
     if (!write_text(o.out_dir / "bench_gl.md", md)) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench_gl.md").c_str());
         return exit_failure;

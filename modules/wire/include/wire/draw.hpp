@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wire/nodes.hpp"
+#include "wire/packed_nodes.hpp"
 #include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
 #include "wire/spline.hpp"
@@ -53,6 +54,9 @@ struct DrawItem {
     std::optional<bool> radius_varies;
     // gpu_nodes path
     const WireNodes* nodes = nullptr;  ///< validated nodes (the systems' checks); alive until the draw returns
+    /// `nodes` packed for the GPU (wire::pack_nodes, done by the systems on their worker threads); when set, the
+    /// renderer copies it and does not read `nodes`.
+    const PackedNodes* packed_nodes = nullptr;
     /// Instead of `nodes`: the curve itself (a wire in a pop-free blend draws the blended curve), sent as its
     /// segments (64 bytes each) while it blends.
     const Curve* curve = nullptr;

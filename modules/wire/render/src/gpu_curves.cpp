@@ -1,6 +1,7 @@
 // The curve stage on the GPU (see gpu_curves.hpp).
 #include "wire/render/gpu_curves.hpp"
 
+#include "wire/packed_nodes.hpp"
 #include "wire/spline.hpp"
 
 #include "gpu_wire_data.hpp"
@@ -228,15 +229,6 @@ void main() {
 }
 )glsl";
 
-bool per_node_kb(const WireNodes& nodes) {
-    return !nodes.kb_tension.empty() || !nodes.kb_bias.empty() || !nodes.kb_continuity.empty();
-}
-
-bool physics(const SplineSettings& spline, const WireNodes& nodes) {
-    return spline.curvature_tension && !nodes.theta_rad.empty() && !nodes.iz_m4.empty() &&
-           !nodes.length_m.empty() && !nodes.delta_length_m.empty() && !nodes.area_m2.empty();
-}
-
 }  // namespace
 
 engine::Expected<GpuCurvePass> GpuCurvePass::create() {
@@ -250,7 +242,7 @@ engine::Expected<GpuCurvePass> GpuCurvePass::create() {
 
 bool GpuCurvePass::supported(const SplineSettings& spline, const WireNodes& nodes) {
     (void)nodes;
-    return spline.kind == SplineKind::linear || spline.kind == SplineKind::c2 || spline.kind == SplineKind::catmull_rom;
+    return gpu_builds(spline.kind);
 }
 
 namespace detail {
@@ -265,71 +257,33 @@ std::string with_wire_header(const char* source) {
     return s;
 }
 
-Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
-                   uint32_t material, bool caps, WireUpload& out, uint32_t& segments) {
-    if (!GpuCurvePass::supported(spline, wn)) {
-        return Status::error("the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic wires stay on "
-                             "the CPU path for now)");
-    }
-    const std::size_t n = curve_nodes(wn, spline, out.curve, &out.source, &out.last);
-    if (n < (spline.closed ? 3u : 2u)) {
-        return Status::error("a wire needs at least " + std::string(spline.closed ? "3" : "2") +
-                             " distinct nodes, got " + std::to_string(n) + " after merging coincident ones");
-    }
-    const std::vector<glm::dvec3>& curve = out.curve;
-    // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
-    glm::dvec3 lo = curve.front(), hi = curve.front();
-    for (const glm::dvec3& p : curve) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    const glm::dvec3 origin = 0.5 * (lo + hi);
+void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
+                   WireUpload& out) {
     GpuCurveHeader h;
     h.node_first = static_cast<uint32_t>(out.nodes.size());
-    h.node_count = static_cast<uint32_t>(n);
+    h.node_count = static_cast<uint32_t>(p.nodes.size());
     h.segment_first = segment_first;
-    const uint32_t kind = spline.kind == SplineKind::linear ? kKindLinear
-                          : spline.kind == SplineKind::c2   ? kKindC2
-                                                            : kKindCatmullRom;
-    h.flags = (spline.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
+    const uint32_t kind = p.kind == SplineKind::linear ? kKindLinear
+                          : p.kind == SplineKind::c2   ? kKindC2
+                                                       : kKindCatmullRom;
+    h.flags = (p.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
+              (p.per_node_kb ? kHeaderPerNode : 0u) | (p.stretch ? kHeaderStretch : 0u) |
               (material << kHeaderMaterialShift);
-    h.alpha = static_cast<float>(spline.alpha);
-    h.tension = static_cast<float>(spline.tension);
-    h.bias = static_cast<float>(spline.bias);
-    h.continuity = static_cast<float>(spline.continuity);
+    h.alpha = p.alpha, h.tension = p.tension, h.bias = p.bias, h.continuity = p.continuity;
     h.extra_first = static_cast<uint32_t>(out.extras.size());
     h.slot = slot;
-    h.origin_m[0] = origin.x, h.origin_m[1] = origin.y, h.origin_m[2] = origin.z;
-    if (kind == kKindCatmullRom && (per_node_kb(wn) || physics(spline, wn))) {
-        // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
-        // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).
-        const bool phys = physics(spline, wn);
-        h.flags |= kHeaderPerNode;
-        for (const uint32_t src : out.source) {
-            const double t_user = wn.kb_tension.empty() ? spline.tension : wn.kb_tension[src];
-            const double b = wn.kb_bias.empty() ? spline.bias : wn.kb_bias[src];
-            const double c = wn.kb_continuity.empty() ? spline.continuity : wn.kb_continuity[src];
-            const double t_curv = phys ? curvature_tension(wn.theta_rad[src], wn.iz_m4[src], wn.length_m[src],
-                                                           wn.delta_length_m[src], wn.area_m2[src])
-                                       : 0.0;
-            const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
-            out.extras.emplace_back(static_cast<float>(t), static_cast<float>(b), static_cast<float>(c), 0.0f);
-        }
-    }
-    const std::size_t segs = spline.closed ? n : n - 1;
-    if (!wn.stretch.empty()) {  // build_curve's Curve::stretch: the element starting at a group's last node
-        h.flags |= kHeaderStretch;
-        for (std::size_t k = 0; k < segs; k += 4) {
-            glm::vec4 v(1.0f);
-            for (std::size_t i = 0; i < 4 && k + i < segs; ++i) v[static_cast<int>(i)] = wn.stretch[out.last[k + i]];
-            out.extras.push_back(v);
-        }
-    }
+    h.origin_m[0] = p.origin_m.x, h.origin_m[1] = p.origin_m.y, h.origin_m[2] = p.origin_m.z;
     out.headers.push_back(h);
-    // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
-    const float wire_radius = spline.radius_m > 0.0f ? spline.radius_m : kDefaultWireRadius_m;
-    for (std::size_t j = 0; j < n; ++j) {
-        const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[out.source[j]];
-        out.nodes.emplace_back(glm::vec3(curve[j] - origin), r > 0.0f ? r : wire_radius);
-    }
-    segments = static_cast<uint32_t>(segs);
+    out.nodes.insert(out.nodes.end(), p.nodes.begin(), p.nodes.end());
+    out.extras.insert(out.extras.end(), p.extras.begin(), p.extras.end());
+}
+
+Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
+                   uint32_t material, bool caps, WireUpload& out, uint32_t& segments) {
+    thread_local PackedNodes packed;
+    if (Status st = pack_nodes(wn, spline, packed); !st) return st;
+    append_packed(packed, segment_first, slot, material, caps, out);
+    segments = static_cast<uint32_t>(packed.segment_count());
     return Status::success();
 }
 

@@ -41,7 +41,10 @@ layout(std430, binding = 7) buffer Counts { uint counts[]; };
 layout(std430, binding = 8) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
 layout(std430, binding = 9) buffer Slots { SlotState slot_state[]; };
 layout(std430, binding = 10) buffer Counter { uint ring_counter; uint overflow; };
-layout(std430, binding = 11) readonly buffer Visible { uint visible[]; };  // the slot of each dispatched wire
+// The slot of each dispatched wire: the first u_changed are this frame's curve headers' (their nodes changed), the
+// others listed.
+layout(std430, binding = 11) readonly buffer Visible { uint visible[]; };
+layout(std430, binding = 17) readonly buffer FrameHeaders { Header frame_headers[]; };
 // u_draw: the single draw's records (wire::render's GpuDraw, the chunk records and the indirect commands).
 struct Draw { vec3 offset_m; uint ring_first; uint ring_count; uint sides; uint flags; float u_close; };
 layout(std430, binding = 12) writeonly buffer Draws { Draw draws[]; };
@@ -50,6 +53,7 @@ layout(std430, binding = 14) buffer Buckets { uint buckets[]; };  // u_buckets c
 layout(std430, binding = 15) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
 layout(std430, binding = 16) readonly buffer Templates { uvec2 templates[]; };  // (count, first index) per side slot and kind
 uniform uint u_wires;
+uniform uint u_changed;
 uniform uint u_ring_capacity;
 uniform uint u_stage;  // 0: LOD (or the caller's counts) and rings; 1: LOD only; 2: the commands; 3: rings only
 uniform bool u_draw;
@@ -509,7 +513,7 @@ void main() {
         return;
     }
     if (w >= u_wires) return;
-    uint slot = visible[w];
+    uint slot = w < u_changed ? frame_headers[w].slot : visible[w - u_changed];
     load_wire(slot);
     uint material = H.flags >> 16u;
     bool caps = (H.flags & kCaps) != 0u;
@@ -750,6 +754,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     const auto at = [&](const char* name) { return program_.uniform_location(name); };
     glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));
     glUniform1ui(at("u_stage"), 0u);
+    glUniform1ui(at("u_changed"), 0u);
     glUniform1i(at("u_draw"), 0);
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);

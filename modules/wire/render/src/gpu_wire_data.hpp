@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wire/lod.hpp"
+#include "wire/packed_nodes.hpp"
 #include "wire/render/gpu_curves.hpp"
 
 #include "engine/gfx/resources.hpp"
@@ -46,10 +47,12 @@ struct WireUpload {
     std::vector<GpuCurveHeader> headers;
     std::vector<glm::vec4> nodes;   ///< 16 bytes a curve node
     std::vector<glm::vec4> extras;  ///< only for wires that carry per-node kb or stretch
-    std::vector<glm::dvec3> curve;  ///< scratch
-    std::vector<uint32_t> source, last;
     void clear() { headers.clear(), nodes.clear(), extras.clear(); }
 };
+
+/// Appends a wire packed by wire::pack_nodes (the systems pack on their worker threads).
+void append_packed(const PackedNodes& packed, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
+                   WireUpload& out);
 
 /// Appends one wire (validated nodes: build_curve's checks) with its header's segment_first, slot and the
 /// material and caps bits. Fails naming what is wrong (not a supported kind, too few distinct nodes); nothing is

@@ -132,7 +132,8 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
-        if (!has_curve && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
+        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
+        if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         ++visible;
         const auto it = slots_.find(item.wire_id);
         const bool changed = it == slots_.end() || !it->second.built || item.nodes_generation == 0 ||
@@ -142,6 +143,11 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
         headers += sizeof(GpuCurveHeader);
         if (has_curve) {
             nodes += 64 * item.curve->segment_count();
+            continue;
+        }
+        if (packed) {
+            nodes += 16 * item.packed_nodes->nodes.size();
+            extras += 16 * item.packed_nodes->extras.size();
             continue;
         }
         const std::size_t n = item.nodes->size();
@@ -168,7 +174,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
-        if (!has_curve && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
+        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
+        if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         auto [it, fresh] = slots_.try_emplace(item.wire_id);
         Slot& slot = it->second;
         if (fresh) {
@@ -193,6 +200,9 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             if (has_curve) {
                 append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps, up);
                 segments = static_cast<uint32_t>(item.curve->segment_count());
+            } else if (packed) {
+                append_packed(*item.packed_nodes, slot.segment_first, slot.index, item.material, item.caps, up);
+                segments = static_cast<uint32_t>(item.packed_nodes->segment_count());
             } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
                                     item.caps, up, segments)) {
                 ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build yet is skipped here
@@ -218,7 +228,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             slot.built = true;
         }
         if (!slot.built) continue;
-        visible_slots_.push_back(slot.index);
+        // The ring pass takes the changed wires' slots from their headers: only the others are listed.
+        if (!changed) visible_slots_.push_back(slot.index);
         segments_visible += slot.segments;
         if (item.material < material_used_.size()) material_used_[item.material] = 1;
     }
@@ -233,29 +244,28 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             ++it;
         }
     }
-    visible_ = visible_slots_.size();
     changed_ = up.headers.size();
+    visible_ = changed_ + visible_slots_.size();
     stats.wires_uploaded = changed_;
     if (visible_ == 0) return false;
 
-    // The region: headers | nodes | extras | visible slots.
+    // The region: headers | nodes | extras | visible slots of the unchanged wires.
+    const std::size_t real_extra_bytes = up.extras.size() * sizeof(glm::vec4);
     if (up.extras.empty()) up.extras.emplace_back(0.0f);
     if (up.nodes.empty()) up.nodes.emplace_back(0.0f);
     const std::size_t header_bytes = std::max<std::size_t>(up.headers.size() * sizeof(GpuCurveHeader), 64);
     const std::size_t node_bytes = up.nodes.size() * sizeof(glm::vec4);
     const std::size_t extra_bytes = up.extras.size() * sizeof(glm::vec4);
-    const std::size_t visible_bytes = visible_ * 4;
+    const std::size_t visible_bytes = std::max<std::size_t>(visible_slots_.size() * 4, 4);
     const std::size_t node_at = align_up(header_bytes), extra_at = node_at + align_up(node_bytes);
     const std::size_t visible_at = extra_at + align_up(extra_bytes);
     std::byte* base = region.data;
     if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
     std::memcpy(base + node_at, up.nodes.data(), node_bytes);
     std::memcpy(base + extra_at, up.extras.data(), extra_bytes);
-    std::memcpy(base + visible_at, visible_slots_.data(), visible_bytes);
-    stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + node_bytes +
-                                           (up.extras.size() > 1 || up.extras[0] != glm::vec4(0.0f) ? extra_bytes : 0)
-                                     : 0) +
-                           visible_bytes;
+    if (!visible_slots_.empty()) std::memcpy(base + visible_at, visible_slots_.data(), visible_slots_.size() * 4);
+    stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + node_bytes : 0) +
+                           real_extra_bytes + visible_slots_.size() * 4;
     const auto range = [&](GLuint binding, std::size_t offset, std::size_t bytes) {
         glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, region.buffer,
                           static_cast<GLintptr>(region.offset_bytes + offset), static_cast<GLsizeiptr>(bytes));
@@ -323,6 +333,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, slot_state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
     range(11, visible_at, visible_bytes);
+    range(17, 0, header_bytes);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, draws_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, chunks_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, buckets_.id());
@@ -338,6 +349,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glUniform1i(at("u_lod"), 1);
     glUniform1i(at("u_draw"), 1);
     glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
+    glUniform1ui(at("u_changed"), static_cast<GLuint>(changed_));
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
     glUniform1ui(at("u_side_slots"), side_slots_);

@@ -508,8 +508,9 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                     c.pop_free_stale = true;
                 }
             } else if (step.exact) {
-                job.status = check_curve_input(nodes, step.spline);
-                if (job.status.ok() && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
+                // build_curve's checks and the GPU's packing in one pass (c.packed is kept on failure).
+                if (nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
+                if (job.status.ok()) job.status = pack_nodes(nodes, step.spline, c.packed);
                 if (job.status.ok()) {
                     release(c.curve.segments);  // not kept: the GPU builds it
                     sphere = node_bounding_sphere(nodes, step.spline);
@@ -764,6 +765,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
                 item.curve = &curve->curve;
             } else {
                 item.nodes = &curve->previous_nodes;
+                if (curve->packed.nodes.size() >= 2) item.packed_nodes = &curve->packed;
             }
             item.spline = spline_of(*style);
             item.nodes_generation = curve->generation;

@@ -7,6 +7,7 @@
 #include "wire/motion.hpp"
 #include "wire/pop_free.hpp"
 #include "wire/nodes.hpp"
+#include "wire/packed_nodes.hpp"
 #include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
 #include "wire/tube.hpp"
@@ -75,6 +76,9 @@ struct WireCurve {
     // `previous_nodes` (the last valid state) when the ids change. While stale the pop-free state is released
     // (re-priming rebuilds it from previous_nodes anyway); build_curve's output buffer is per thread, not per wire.
     WireNodes previous_nodes;          ///< the last valid nodes (re-primes `pop-free blend` when ids change)
+    /// UploadPath::gpu_nodes: the last valid nodes packed for the GPU (wire::pack_nodes, on the curve stage's
+    /// worker threads; the renderer only copies them). Empty on the other paths.
+    PackedNodes packed;
     PopFreeCurve pop_free{PopFreeSettings{}};  ///< pop-free state: blends nodes in and out over frames
 };
 

@@ -1,0 +1,42 @@
+// A wire's nodes as the GPU curve pass reads them (issue 30, the nodes path): its curve nodes (coincident ones
+// merged by build_curve's rule) as float offsets from an origin kept in double (the centre of their box), 16 bytes a
+// node with the tube radius in w, plus "extras" for the wires that have them: per-node tension, bias and continuity
+// (Catmull-Rom wires that carry them, or the curvature-driven tension, computed here with build_curve's formula; a
+// vec4 a node) and per-segment stretch (4 segments a vec4). The wire systems pack these on their worker threads, so
+// the renderer's thread only copies them (as the rings system packs ring records for the gpu-rings path).
+#pragma once
+
+#include "wire/nodes.hpp"
+#include "wire/spline.hpp"
+#include "wire/status.hpp"
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace wire {
+
+/// See the file comment.
+struct PackedNodes {
+    glm::dvec3 origin_m{};          ///< what `nodes` are offsets from (world metres)
+    std::vector<glm::vec4> nodes;   ///< per curve node: xyz offset from origin_m, w the tube radius
+    std::vector<glm::vec4> extras;  ///< per-node kb (if per_node_kb), then stretch (if stretch), 4 segments a vec4
+    bool closed = false;
+    SplineKind kind = SplineKind::catmull_rom;
+    float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;  ///< wire-wide Kochanek-Bartels values
+    bool per_node_kb = false;
+    bool stretch = false;
+    [[nodiscard]] std::size_t segment_count() const { return closed ? nodes.size() : nodes.size() - 1; }
+};
+
+/// Whether the GPU curve pass builds `kind` (linear, Catmull-Rom / Kochanek-Bartels, c2; not automatic yet).
+[[nodiscard]] bool gpu_builds(SplineKind kind);
+
+/// build_curve's checks (check_curve_input) and the packing above, in one pass over the merged nodes. On failure
+/// `out` is left as it was and the Status is build_curve's (naming the node), or says the kind is not built on
+/// the GPU yet.
+[[nodiscard]] Status pack_nodes(const WireNodes& nodes, const SplineSettings& settings, PackedNodes& out);
+
+}  // namespace wire

@@ -1,0 +1,69 @@
+// The nodes path's packed nodes (packed_nodes.hpp).
+#include "wire/packed_nodes.hpp"
+
+#include <glm/common.hpp>
+
+namespace wire {
+
+bool gpu_builds(SplineKind kind) {
+    return kind == SplineKind::linear || kind == SplineKind::c2 || kind == SplineKind::catmull_rom;
+}
+
+Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes& out) {
+    if (!gpu_builds(spline.kind)) {
+        return Status::error("the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic wires stay on "
+                             "the CPU path for now)");
+    }
+    if (Status st = check_curve_input(wn, spline); !st) return st;
+    thread_local std::vector<glm::dvec3> curve;
+    thread_local std::vector<uint32_t> source, last;
+    const std::size_t n = curve_nodes(wn, spline, curve, &source, &last);
+    // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
+    glm::dvec3 lo = curve.front(), hi = curve.front();
+    for (const glm::dvec3& p : curve) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    out.origin_m = 0.5 * (lo + hi);
+    out.closed = spline.closed;
+    out.kind = spline.kind;
+    out.alpha = static_cast<float>(spline.alpha);
+    out.tension = static_cast<float>(spline.tension);
+    out.bias = static_cast<float>(spline.bias);
+    out.continuity = static_cast<float>(spline.continuity);
+    out.extras.clear();
+    const bool physics = spline.curvature_tension && !wn.theta_rad.empty() && !wn.iz_m4.empty() &&
+                         !wn.length_m.empty() && !wn.delta_length_m.empty() && !wn.area_m2.empty();
+    const bool kb = !wn.kb_tension.empty() || !wn.kb_bias.empty() || !wn.kb_continuity.empty();
+    out.per_node_kb = spline.kind == SplineKind::catmull_rom && (kb || physics);
+    if (out.per_node_kb) {
+        // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
+        // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).
+        for (const uint32_t src : source) {
+            const double t_user = wn.kb_tension.empty() ? spline.tension : wn.kb_tension[src];
+            const double b = wn.kb_bias.empty() ? spline.bias : wn.kb_bias[src];
+            const double c = wn.kb_continuity.empty() ? spline.continuity : wn.kb_continuity[src];
+            const double t_curv = physics ? curvature_tension(wn.theta_rad[src], wn.iz_m4[src], wn.length_m[src],
+                                                              wn.delta_length_m[src], wn.area_m2[src])
+                                          : 0.0;
+            const double t = 1.0 - (1.0 - t_user) * (1.0 - t_curv);
+            out.extras.emplace_back(static_cast<float>(t), static_cast<float>(b), static_cast<float>(c), 0.0f);
+        }
+    }
+    const std::size_t segs = spline.closed ? n : n - 1;
+    out.stretch = !wn.stretch.empty();
+    if (out.stretch) {  // build_curve's Curve::stretch: the element starting at a group's last node
+        for (std::size_t k = 0; k < segs; k += 4) {
+            glm::vec4 v(1.0f);
+            for (std::size_t i = 0; i < 4 && k + i < segs; ++i) v[static_cast<int>(i)] = wn.stretch[last[k + i]];
+            out.extras.push_back(v);
+        }
+    }
+    // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
+    const float wire_radius = spline.radius_m > 0.0f ? spline.radius_m : kDefaultWireRadius_m;
+    out.nodes.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+        const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[source[j]];
+        out.nodes[j] = glm::vec4(glm::vec3(curve[j] - out.origin_m), r > 0.0f ? r : wire_radius);
+    }
+    return Status::success();
+}
+
+}  // namespace wire
