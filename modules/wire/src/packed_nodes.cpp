@@ -1,7 +1,14 @@
 // The nodes path's packed nodes (packed_nodes.hpp).
 #include "wire/packed_nodes.hpp"
 
+#include "spline/validate.hpp"
+
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace wire {
 
@@ -14,14 +21,36 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
         return Status::error("the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic wires stay on "
                              "the CPU path for now)");
     }
-    if (Status st = check_curve_input(wn, spline); !st) return st;
+    // check_curve_input's checks, with the merge done once (curve_nodes) for the count and the packing.
+    if (Status st = curve_stage::check_settings(spline); !st) return st;
+    if (Status st = curve_stage::check_sizes(wn); !st) return st;
+    const bool physics = spline.curvature_tension && !wn.theta_rad.empty() && !wn.iz_m4.empty() &&
+                         !wn.length_m.empty() && !wn.delta_length_m.empty() && !wn.area_m2.empty();
+    if (Status st = curve_stage::check_nodes(wn, physics); !st) return st;
     thread_local std::vector<glm::dvec3> curve;
     thread_local std::vector<uint32_t> source, last;
     const std::size_t n = curve_nodes(wn, spline, curve, &source, &last);
+    if (n < 2) {
+        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(wn.size()) +
+                             " node(s) and " + std::to_string(n) + " after merging coincident ones");
+    }
+    if (spline.closed && n < 3) {
+        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(n) +
+                             " after merging coincident ones");
+    }
     // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
     glm::dvec3 lo = curve.front(), hi = curve.front();
-    for (const glm::dvec3& p : curve) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    double chord2 = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+        lo = glm::min(lo, curve[j]), hi = glm::max(hi, curve[j]);
+        if (j + 1 < n || spline.closed) {
+            const glm::dvec3 d = curve[j + 1 == n ? 0 : j + 1] - curve[j];
+            chord2 = std::max(chord2, d.x * d.x + d.y * d.y + d.z * d.z);
+        }
+    }
     out.origin_m = 0.5 * (lo + hi);
+    out.half_diagonal_m = 0.5 * glm::length(hi - lo);
+    out.max_chord_m = std::sqrt(chord2);
     out.closed = spline.closed;
     out.kind = spline.kind;
     out.alpha = static_cast<float>(spline.alpha);
@@ -29,8 +58,6 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     out.bias = static_cast<float>(spline.bias);
     out.continuity = static_cast<float>(spline.continuity);
     out.extras.clear();
-    const bool physics = spline.curvature_tension && !wn.theta_rad.empty() && !wn.iz_m4.empty() &&
-                         !wn.length_m.empty() && !wn.delta_length_m.empty() && !wn.area_m2.empty();
     const bool kb = !wn.kb_tension.empty() || !wn.kb_bias.empty() || !wn.kb_continuity.empty();
     out.per_node_kb = spline.kind == SplineKind::catmull_rom && (kb || physics);
     if (out.per_node_kb) {
@@ -59,11 +86,39 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
     const float wire_radius = spline.radius_m > 0.0f ? spline.radius_m : kDefaultWireRadius_m;
     out.nodes.resize(n);
+    out.max_radius_m = wire_radius;
     for (std::size_t j = 0; j < n; ++j) {
         const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[source[j]];
-        out.nodes[j] = glm::vec4(glm::vec3(curve[j] - out.origin_m), r > 0.0f ? r : wire_radius);
+        const float radius = r > 0.0f ? r : wire_radius;
+        out.max_radius_m = std::max(out.max_radius_m, static_cast<double>(radius));
+        out.nodes[j] = glm::vec4(glm::vec3(curve[j] - out.origin_m), radius);
+    }
+    // K of node_bounding_sphere: 2 |1 - t| (1 + |b|) (1 + |c|) at the worst node (t with the curvature-driven
+    // tension, as the GPU gets it); 1 for linear.
+    out.tangent_factor = 1.0;
+    if (spline.kind == SplineKind::catmull_rom) {
+        const auto factor = [](double t, double b, double c) {
+            return 2.0 * std::abs(1.0 - t) * (1.0 + std::abs(b)) * (1.0 + std::abs(c));
+        };
+        out.tangent_factor = std::max(1.0, factor(spline.tension, spline.bias, spline.continuity));
+        if (out.per_node_kb) {
+            for (std::size_t j = 0; j < n; ++j) {
+                const glm::vec4& e = out.extras[j];
+                out.tangent_factor = std::max(out.tangent_factor, factor(e.x, e.y, e.z));
+            }
+        }
     }
     return Status::success();
+}
+
+BoundingSphere packed_bounding_sphere(const PackedNodes& p) {
+    if (p.kind != SplineKind::linear && p.kind != SplineKind::catmull_rom) return {};
+    BoundingSphere s;
+    s.centre_m = p.origin_m;
+    s.tube_radius_m = p.max_radius_m;
+    s.radius_m = p.half_diagonal_m + std::sqrt(3.0) * (p.tangent_factor * p.max_chord_m / 3.0 * (1.0 + 1e-9)) +
+                 p.max_radius_m;
+    return s;
 }
 
 }  // namespace wire

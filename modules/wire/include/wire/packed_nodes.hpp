@@ -6,6 +6,7 @@
 // the renderer's thread only copies them (as the rings system packs ring records for the gpu-rings path).
 #pragma once
 
+#include "wire/lod.hpp"
 #include "wire/nodes.hpp"
 #include "wire/spline.hpp"
 #include "wire/status.hpp"
@@ -28,6 +29,9 @@ struct PackedNodes {
     float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;  ///< wire-wide Kochanek-Bartels values
     bool per_node_kb = false;
     bool stretch = false;
+    // For the CPU's cull (packed_bounding_sphere): the curve nodes' box half diagonal, their longest chord, the
+    // largest tube radius and the tangent factor K (see node_bounding_sphere in lod.hpp).
+    double half_diagonal_m = 0.0, max_chord_m = 0.0, max_radius_m = 0.0, tangent_factor = 1.0;
     [[nodiscard]] std::size_t segment_count() const { return closed ? nodes.size() : nodes.size() - 1; }
 };
 
@@ -38,5 +42,9 @@ struct PackedNodes {
 /// `out` is left as it was and the Status is build_curve's (naming the node), or says the kind is not built on
 /// the GPU yet.
 [[nodiscard]] Status pack_nodes(const WireNodes& nodes, const SplineSettings& settings, PackedNodes& out);
+
+/// node_bounding_sphere (lod.hpp) of the packed wire, from what pack_nodes measured (the merged nodes' box and
+/// chords: the curve build_curve makes; one pass fewer): linear and Catmull-Rom; radius -1 otherwise.
+[[nodiscard]] BoundingSphere packed_bounding_sphere(const PackedNodes& packed);
 
 }  // namespace wire

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <tuple>
 
 namespace wire::render::detail {
 namespace {
@@ -128,6 +129,7 @@ void NodePath::free_segments(uint32_t first, uint32_t count) {
 std::size_t NodePath::upload_bytes(const DrawList& list) {
     std::size_t headers = 0, nodes = 0, extras = 0;
     changed_item_.assign(list.items.size(), 0);
+    item_slot_.assign(list.items.size(), nullptr);
     std::size_t visible = 0;
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
@@ -136,6 +138,7 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         ++visible;
         const auto it = slots_.find(item.wire_id);
+        if (it != slots_.end()) item_slot_[i] = &it->second;
         const bool changed = it == slots_.end() || !it->second.built || item.nodes_generation == 0 ||
                              item.nodes_generation != it->second.generation;
         if (!changed) continue;
@@ -176,8 +179,14 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
         const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
-        auto [it, fresh] = slots_.try_emplace(item.wire_id);
-        Slot& slot = it->second;
+        Slot* known = i < item_slot_.size() ? item_slot_[i] : nullptr;
+        bool fresh = false;
+        auto it = slots_.end();
+        if (known == nullptr) {
+            std::tie(it, fresh) = slots_.try_emplace(item.wire_id);
+            known = &it->second;
+        }
+        Slot& slot = *known;
         if (fresh) {
             if (free_slots_.empty()) {
                 const auto index = static_cast<uint32_t>(slots_.size() - 1 + free_slots_.size());

@@ -96,6 +96,7 @@ private:
     std::size_t materials_ = 0;
     std::vector<uint8_t> material_used_;
     std::vector<uint8_t> changed_item_;  ///< per item of the list upload_bytes() saw: it sends its nodes
+    std::vector<Slot*> item_slot_;       ///< per item: its slot when upload_bytes() found one (map nodes are stable)
     std::vector<uint32_t> visible_slots_;
 };
 

@@ -513,7 +513,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 if (job.status.ok()) job.status = pack_nodes(nodes, step.spline, c.packed);
                 if (job.status.ok()) {
                     release(c.curve.segments);  // not kept: the GPU builds it
-                    sphere = node_bounding_sphere(nodes, step.spline);
+                    sphere = packed_bounding_sphere(c.packed);
                 }
                 if (!c.pop_free_stale) {
                     c.pop_free = PopFreeCurve(
