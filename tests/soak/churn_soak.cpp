@@ -245,7 +245,7 @@ private:
 
     // What was exercised, for the summary.
     std::size_t spawned_ = 0, destroyed_ = 0, moved_ = 0, edited_ = 0, inserted_ = 0, removed_ = 0, restyled_ = 0;
-    std::size_t frames_[2] = {0, 0};  ///< frames drawn per upload path
+    std::size_t frames_[3] = {0, 0, 0};  ///< frames drawn per upload path (cpu-mesh, gpu-rings, gpu-nodes)
     std::size_t items_drawn_ = 0;
     GlObjects baseline_{};
     std::size_t max_live_stream_ = 0;
@@ -253,10 +253,14 @@ private:
     double check_s_ = 0.0, render_s_ = 0.0, sample_s_ = 0.0;  ///< time spent, for the summary
 };
 
+const char* path_name(wire::UploadPath p) {
+    return p == wire::UploadPath::cpu_mesh ? "cpu-mesh" : p == wire::UploadPath::gpu_rings ? "gpu-rings" : "gpu-nodes";
+}
+
 void Soak::fail(const char* fmt, ...) {
     std::fprintf(stderr, "churn_soak: FAILED at frame %ld (seed %llu, %s path): ", frame_,
                  static_cast<unsigned long long>(opt_.seed),
-                 context_.path == wire::UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings");
+                 path_name(context_.path));
     va_list args;
     va_start(args, fmt);
     std::vfprintf(stderr, fmt, args);
@@ -444,6 +448,16 @@ void Soak::check_frame() {
             for (const uint32_t i : item.indices)
                 if (i >= item.vertices.size())
                     fail("wire %u: index %u >= %zu vertices", id, i, item.vertices.size());
+        } else if (list.path == wire::UploadPath::gpu_nodes) {
+            // The nodes path: the last valid nodes packed for the GPU, or a curve built on the CPU (a blend).
+            if (item.packed_nodes == nullptr && item.curve == nullptr)
+                fail("gpu-nodes item %zu (wire %u) has neither packed nodes nor a curve", k, id);
+            if (item.packed_nodes != nullptr) {
+                if (item.packed_nodes->nodes.size() < 2) fail("wire %u: %zu packed nodes", id, item.packed_nodes->nodes.size());
+                for (const glm::vec4& n : item.packed_nodes->nodes)
+                    if (!std::isfinite(n.x + n.y + n.z + n.w) || !(n.w > 0.0f)) fail("wire %u: a packed node is not finite", id);
+            }
+            if (item.curve != nullptr && item.curve->segments.empty()) fail("wire %u: an empty curve", id);
         } else {
             if (!item.vertices.empty() || !item.indices.empty()) fail("gpu-rings item %zu carries a mesh", k);
             if (!std::isfinite(item.u_close)) fail("wire %u: u_close is not finite", id);
@@ -478,17 +492,21 @@ void Soak::check_errors() {
 
 Sample Soak::sample(const wire::render::DrawStats& fs) {
     const GlObjects gl = count_gl_objects();
+    // The nodes path compiles its two compute programs on its first frame.
+    const int programs = baseline_.programs + static_cast<int>(renderer_->node_path_programs());
     if (gl.textures != baseline_.textures || gl.vertex_arrays != baseline_.vertex_arrays ||
-        gl.programs != baseline_.programs || gl.shaders != baseline_.shaders ||
+        gl.programs != programs || gl.shaders != baseline_.shaders ||
         gl.framebuffers != baseline_.framebuffers)
         fail("GL objects changed: textures %d (start %d), VAOs %d (%d), programs %d (%d), shaders %d (%d), "
              "framebuffers %d (%d)",
              gl.textures, baseline_.textures, gl.vertex_arrays, baseline_.vertex_arrays, gl.programs,
-             baseline_.programs, gl.shaders, baseline_.shaders, gl.framebuffers, baseline_.framebuffers);
+             programs, gl.shaders, baseline_.shaders, gl.framebuffers, baseline_.framebuffers);
     // Every live GL buffer is either one the renderer made before the soak, or a stream buffer still alive.
-    // (The retained ring storage likewise: its current buffer plus retired ones waiting for fences.)
+    // (The retained ring storage likewise: its current buffer plus retired ones waiting for fences; and the nodes
+    // path's buffers.)
     const int allowed = baseline_.buffers + static_cast<int>(renderer_->live_stream_buffers()) - 1 +
-                        static_cast<int>(renderer_->live_ring_buffers()) - 1;
+                        static_cast<int>(renderer_->live_ring_buffers()) - 1 +
+                        static_cast<int>(renderer_->node_path_buffers());
     if (gl.buffers > allowed)
         fail("%d GL buffers live, at most %d expected (%d at start, %zu live stream buffers): a buffer leaks",
              gl.buffers, allowed, baseline_.buffers, renderer_->live_stream_buffers());
@@ -513,7 +531,7 @@ void Soak::check_curve(const std::vector<Sample>& curve) {
     std::printf("rss: peak %ld KiB in the second quarter, %ld KiB in the last half (limit %ld)\n", q2, h2, limit);
     if (h2 > limit) fail("RSS grows: %ld KiB peak in the last half > %ld KiB (second quarter %ld KiB + 10%% + 8 MiB)",
                          h2, limit, q2);
-    const int gl_limit = baseline_.buffers + 3;
+    const int gl_limit = baseline_.buffers + 3 + static_cast<int>(renderer_->node_path_buffers());
     if (gl_max > gl_limit) fail("GL buffers peaked at %d > %d", gl_max, gl_limit);
 }
 
@@ -575,7 +593,8 @@ int Soak::run() {
     target_wires_ = integer(opt_.min_wires, opt_.max_wires);
     for (int i = 0; i < opt_.min_wires; ++i) spawn_good();
     for (frame_ = 0; frame_ < opt_.frames; ++frame_) {
-        context_.path = (frame_ / opt_.path_every) % 2 == 0 ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_rings;
+        const long turn = (frame_ / opt_.path_every) % 3;  // the three upload paths in turn
+        context_.path = turn == 0 ? wire::UploadPath::cpu_mesh : turn == 1 ? wire::UploadPath::gpu_rings : wire::UploadPath::gpu_nodes;
         if (frame_ > 0) churn();
         move_camera();
         schedule_.run(registry_, 1.0 / 60.0);
@@ -587,7 +606,9 @@ int Soak::run() {
 
         context->begin_frame();
         engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
-        const wire::render::DrawStats fs = renderer_->draw(context_.draw_list, context_.camera);
+        wire::render::DrawSettings draw_settings;
+        draw_settings.node_lod = context_.lod;
+        const wire::render::DrawStats fs = renderer_->draw(context_.draw_list, context_.camera, draw_settings);
         context->end_frame();
         render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
         if (const GLenum err = glGetError(); err != GL_NO_ERROR) fail("GL error 0x%x after draw", err);
@@ -596,7 +617,7 @@ int Soak::run() {
         waits_ += fs.waited_for_gpu ? 1 : 0;
         growths_ += fs.buffer_grew ? 1 : 0;
         uploaded_ += fs.bytes_uploaded;
-        ++frames_[context_.path == wire::UploadPath::cpu_mesh ? 0 : 1];
+        ++frames_[context_.path == wire::UploadPath::cpu_mesh ? 0 : context_.path == wire::UploadPath::gpu_rings ? 1 : 2];
         max_live_stream_ = std::max(max_live_stream_, renderer_->live_stream_buffers());
         if (renderer_->live_stream_buffers() > 3) fail("%zu live stream buffers", renderer_->live_stream_buffers());
 
@@ -622,11 +643,12 @@ int Soak::run() {
     }
     frame_ = opt_.frames - 1;
     check_curve(curve);
-    if (frames_[0] == 0 || frames_[1] == 0) fail("only one upload path ran: raise --frames or lower --path-every");
+    if (frames_[0] == 0 || frames_[1] == 0 || frames_[2] == 0)
+        fail("not every upload path ran: raise --frames or lower --path-every");
 
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("frames %ld in %.1f s (%.1f frames/s): %zu cpu-mesh, %zu gpu-rings\n", opt_.frames, seconds,
-                static_cast<double>(opt_.frames) / seconds, frames_[0], frames_[1]);
+    std::printf("frames %ld in %.1f s (%.1f frames/s): %zu cpu-mesh, %zu gpu-rings, %zu gpu-nodes\n", opt_.frames,
+                seconds, static_cast<double>(opt_.frames) / seconds, frames_[0], frames_[1], frames_[2]);
     std::printf("wires: %zu spawned, %zu destroyed, %zu live at the end; %zu items drawn\n", spawned_,
                 destroyed_, good_.size(), items_drawn_);
     std::printf("renderer: %.0f triangles and %.0f KiB uploaded a frame on average; %zu waits for the GPU, %zu "

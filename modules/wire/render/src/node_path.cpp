@@ -59,6 +59,15 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     return path;
 }
 
+std::size_t NodePath::gl_buffers() const {
+    std::size_t n = 0;
+    for (const gfx::Buffer* b : {&slot_headers_, &slot_state_, &segments_, &counts_, &scratch_, &jobs_, &draws_, &chunks_,
+                                 &rings_, &buckets_, &commands_, &counter_, &templates_, &readback_}) {
+        n += b->id() != 0 ? 1 : 0;
+    }
+    return n;
+}
+
 Status NodePath::ensure(gfx::Buffer& buffer, std::size_t& capacity, std::size_t bytes, const char* label,
                         bool keep_contents) {
     bytes = std::max<std::size_t>(bytes, 16);

@@ -52,6 +52,8 @@ public:
     [[nodiscard]] uint32_t max_sides() const { return max_sides_; }
 
     [[nodiscard]] std::size_t resident_wires() const { return slots_.size(); }
+    /// GL buffers it holds now (its persistent and per-frame buffers; a grown one replaces the old).
+    [[nodiscard]] std::size_t gl_buffers() const;
     /// Chunk records the frame may draw (the instanced chunk-index attribute must cover them).
     [[nodiscard]] std::size_t chunk_capacity() const { return chunk_bytes_ / 8; }
 

@@ -406,6 +406,10 @@ const std::vector<unsigned>& WireRenderer::allocated_ring_buffers() const {
     return state_->ring_storage.allocated_buffers();
 }
 
+std::size_t WireRenderer::node_path_buffers() const { return state_->nodes ? state_->nodes->gl_buffers() : 0; }
+std::size_t WireRenderer::node_path_programs() const { return state_->nodes ? 2 : 0; }
+std::size_t WireRenderer::node_path_wires() const { return state_->nodes ? state_->nodes->resident_wires() : 0; }
+
 DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
                               const DrawSettings& settings) {
     State& s = *state_;

@@ -347,6 +347,14 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     for (const Entity e : registry.changed<Nodes>(since)) work.push_back(e);
     for (const Entity e : registry.changed<Style>(since)) work.push_back(e);
     for (const Entity e : ctx.blending) work.push_back(e);
+    const bool nodes_path = ctx.path == UploadPath::gpu_nodes;
+    if (ctx.has_seen_path && (ctx.seen_path == UploadPath::gpu_nodes) != nodes_path) {
+        // To or from the nodes path: every wire again (one keeps packed nodes and no curve, the other a curve).
+        auto& curves = registry.storage<WireCurve>();
+        for (std::size_t i = 0; i < curves.size(); ++i) work.push_back(curves.at(i));
+    }
+    ctx.seen_path = ctx.path;
+    ctx.has_seen_path = true;
     sort_unique(work);
 
     const bool fused = ctx.fused_stages;

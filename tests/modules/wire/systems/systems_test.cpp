@@ -579,3 +579,73 @@ TEST(WireSystems, FirstFrameIsCarriedOver) {
 
 }  // namespace
 }  // namespace wire::systems
+
+namespace wire::systems {
+namespace {
+
+// The nodes path (issue 30): the systems send packed nodes (no curve, rings or mesh on the CPU), the blended curve
+// while a pop-free blend lasts (then packed nodes again), and keep drawing the last valid nodes after a bad
+// update, reported once; automatic wires send their CPU-built curve. A wire far behind the camera is culled by the
+// sphere from its nodes.
+TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
+    World w;
+    w.ctx.path = UploadPath::gpu_nodes;
+    const Entity e = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.6), {.spline = {.kind = SplineKind::catmull_rom}});
+    const Entity a = spawn_wire(w.registry, cable(9, {-2, 1, 0}, 4.0, 0.3));  // automatic (Style's default)
+    const Entity behind = spawn_wire(w.registry, cable(9, {-2, 0, 50}, 4.0, 0.3), {.spline = {.kind = SplineKind::c2}});
+    const Entity far_away = spawn_wire(w.registry, cable(9, {-2, 0, 5000}, 4.0, 0.3), {.spline = {.kind = SplineKind::catmull_rom}});
+    w.run();
+    const auto item_of = [&](Entity x) -> const DrawItem* {
+        for (const DrawItem& it : w.ctx.draw_list.items)
+            if (it.wire_id == engine::ecs::to_integral(x)) return &it;
+        return nullptr;
+    };
+    ASSERT_NE(item_of(e), nullptr);
+    EXPECT_NE(item_of(e)->packed_nodes, nullptr);
+    EXPECT_EQ(item_of(e)->curve, nullptr);
+    EXPECT_EQ(item_of(e)->packed_nodes->nodes.size(), 12u);
+    EXPECT_EQ(w.ctx.stats.rings_built, 0u);
+    EXPECT_EQ(w.ctx.stats.meshes_built, 0u);
+    EXPECT_TRUE(w.registry.get<WireCurve>(e).curve.segments.empty());  // built on the GPU, not kept here
+    ASSERT_NE(item_of(a), nullptr);
+    EXPECT_NE(item_of(a)->curve, nullptr);  // automatic: the CPU's curve
+    EXPECT_NE(item_of(behind), nullptr);    // c2: no sphere from nodes, culled on the GPU
+    EXPECT_EQ(item_of(far_away), nullptr);  // behind the camera: culled by the sphere from its nodes
+    const uint64_t generation = item_of(e)->nodes_generation;
+    w.run();
+    EXPECT_EQ(item_of(e)->nodes_generation, generation);  // unchanged: the renderer sends nothing for it
+
+    // A node inserted: the blended curve is sent while the blend lasts (and, unchanged, its last state after it),
+    // then packed nodes again from the next change.
+    const auto& p = w.registry.get<Nodes>(e).positions;
+    insert_node(w.registry, e, 6, 0.5 * (p[5] + p[6]) + glm::dvec3(0, 0.02, 0));
+    int blend_frames = 0;
+    for (int frame = 0; frame < 300; ++frame) {
+        w.run();
+        ASSERT_NE(item_of(e), nullptr);
+        EXPECT_NE(item_of(e)->curve, nullptr);
+        if (!w.registry.get<WireCurve>(e).blending) break;
+        ++blend_frames;
+    }
+    EXPECT_GT(blend_frames, 1);
+    EXPECT_LT(blend_frames, 300);
+    edit_nodes(w.registry, e).positions[0].y += 0.01;  // the next change takes the fast path: packed nodes
+    w.run();
+    ASSERT_NE(item_of(e)->packed_nodes, nullptr);
+    EXPECT_EQ(item_of(e)->packed_nodes->nodes.size(), 13u);
+
+    // A bad update: reported once, the last valid nodes keep drawing.
+    const std::vector<glm::vec4> last_valid = item_of(e)->packed_nodes->nodes;
+    edit_nodes(w.registry, e).positions[2].x = std::numeric_limits<double>::quiet_NaN();
+    w.run();
+    EXPECT_NE(wire_error(w.registry, e), nullptr);
+    EXPECT_EQ(w.ctx.new_errors.size(), 1u);
+    ASSERT_NE(item_of(e), nullptr);
+    ASSERT_NE(item_of(e)->packed_nodes, nullptr);
+    EXPECT_EQ(item_of(e)->packed_nodes->nodes, last_valid);
+    w.run();
+    EXPECT_TRUE(w.ctx.new_errors.empty());  // once
+}
+
+}  // namespace
+}  // namespace wire::systems

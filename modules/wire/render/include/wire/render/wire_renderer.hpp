@@ -174,6 +174,11 @@ public:
     [[nodiscard]] std::size_t live_ring_buffers() const;
     /// Retained ring storage: GL names of every buffer it allocated so far (the first is the initial one).
     [[nodiscard]] const std::vector<unsigned>& allocated_ring_buffers() const;
+    /// gpu-nodes: GL buffers and programs the nodes path holds (0 before its first frame; its programs are compiled
+    /// then), and the wires it keeps a slot for.
+    [[nodiscard]] std::size_t node_path_buffers() const;
+    [[nodiscard]] std::size_t node_path_programs() const;
+    [[nodiscard]] std::size_t node_path_wires() const;
 
 private:
     struct State;

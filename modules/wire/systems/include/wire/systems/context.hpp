@@ -74,6 +74,10 @@ struct WireContext {
     uint64_t lod_pass_generation = 0;            ///< view_generation the LOD last visited every wire for
     std::vector<engine::ecs::Entity> curve_changed;  ///< wires whose curve changed this frame
     std::vector<engine::ecs::Entity> blending;       ///< wires in a blend (their curve changes next frame)
+    /// The path the curve stage last ran for: a change rebuilds every wire (the nodes path keeps packed nodes and
+    /// no curve, the others a curve; each needs its own).
+    UploadPath seen_path = UploadPath::cpu_mesh;
+    bool has_seen_path = false;
 };
 
 }  // namespace wire::systems
