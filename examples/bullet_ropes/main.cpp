@@ -27,6 +27,7 @@ struct Options {
     int width = 1280;
     int height = 720;
     double dt_s = 1.0 / 60.0;
+    std::string path = "cpu";  // wire upload path: cpu, gpu or nodes
 };
 
 std::string frame_name(int frame) {
@@ -64,6 +65,11 @@ int main(int argc, char** argv) {
     app.add_option("--dt", opt.dt_s, "Frame time step in seconds (Bullet steps at 1/240 s inside)")
         ->check(CLI::Range(1e-4, 0.1))
         ->capture_default_str();
+    app.add_option("--path", opt.path,
+                   "Wire upload path: cpu (meshes), gpu (ring records) or nodes (the ropes' nodes only: curve, LOD "
+                   "and rings in compute shaders)")
+        ->check(CLI::IsMember({"cpu", "gpu", "nodes"}))
+        ->capture_default_str();
     app.footer("Window keys: F12 saves a screenshot to the --out directory, Esc quits.");
     CLI11_PARSE(app, argc, argv);
 
@@ -89,6 +95,9 @@ int main(int argc, char** argv) {
     wires.on_error = [](const wire::systems::ErrorReport& e) {
         std::fprintf(stderr, "bullet_ropes: %s\n", e.message.c_str());
     };
+    wires.path = opt.path == "gpu"     ? wire::UploadPath::gpu_rings
+                 : opt.path == "nodes" ? wire::UploadPath::gpu_nodes
+                                       : wire::UploadPath::cpu_mesh;
     wire::systems::install(schedule, wires);
     bullet_ropes::RopeScene scene(registry);
     auto view = bullet_ropes::RopeView::create(scene);
@@ -113,7 +122,7 @@ int main(int argc, char** argv) {
         schedule.run(registry, opt.dt_s);  // wire systems -> wires.draw_list
 
         ctx.begin_frame();
-        view->draw(scene, wires.draw_list, wires.camera);
+        view->draw(scene, wires.draw_list, wires.camera, wires.lod);
         const bool last = frames != 0 && frame + 1 == frames;
         const bool capture = (opt.capture_every > 0 && frame % opt.capture_every == 0) ||
                              (last && (ctx.headless() || opt.capture_every > 0)) ||

@@ -84,7 +84,9 @@ public:
     static engine::Expected<RopeView> create(const RopeScene& scene);
 
     /// Clears, draws the floor and the box, then the wires of `list`.
-    void draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera);
+    /// `lod`: the wire systems' LOD settings (the nodes path evaluates them on the GPU).
+    void draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera,
+              const wire::LodSettings& lod = {});
 
     /// Background colour the frame is cleared to.
     static constexpr glm::vec3 kBackground{0.62f, 0.70f, 0.80f};
