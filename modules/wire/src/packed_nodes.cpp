@@ -13,7 +13,8 @@
 namespace wire {
 
 bool gpu_builds(SplineKind kind) {
-    return kind == SplineKind::linear || kind == SplineKind::c2 || kind == SplineKind::catmull_rom;
+    return kind == SplineKind::linear || kind == SplineKind::c2 || kind == SplineKind::catmull_rom ||
+           kind == SplineKind::automatic;
 }
 
 Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes& out) {
@@ -60,6 +61,9 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     out.extras.clear();
     const bool kb = !wn.kb_tension.empty() || !wn.kb_bias.empty() || !wn.kb_continuity.empty();
     out.per_node_kb = spline.kind == SplineKind::catmull_rom && (kb || physics);
+    // The automatic spline reads its weights from the turning pattern on the GPU; its per-node tension (and the
+    // curvature-driven one) travels as the Catmull-Rom's does (only the tension is read).
+    if (spline.kind == SplineKind::automatic) out.per_node_kb = !wn.kb_tension.empty() || physics;
     if (out.per_node_kb) {
         // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
         // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).

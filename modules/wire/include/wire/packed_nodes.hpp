@@ -35,12 +35,14 @@ struct PackedNodes {
     [[nodiscard]] std::size_t segment_count() const { return closed ? nodes.size() : nodes.size() - 1; }
 };
 
-/// Whether the GPU curve pass builds `kind` (linear, Catmull-Rom / Kochanek-Bartels, c2; not automatic yet).
+/// Whether the GPU curve pass builds `kind`: every kind the CPU has (linear, Catmull-Rom / Kochanek-Bartels, c2,
+/// automatic); a kind added to the CPU later is false until the GPU has it (the systems then send its CPU curve).
 [[nodiscard]] bool gpu_builds(SplineKind kind);
 
 /// build_curve's checks (check_curve_input) and the packing above, in one pass over the merged nodes. On failure
-/// `out` is left as it was and the Status is build_curve's (naming the node), or says the kind is not built on
-/// the GPU yet.
+/// `out` is left as it was and the Status is build_curve's (naming the node), or says the kind is not built on the
+/// GPU. The automatic spline's weights are read from the turning pattern on the GPU; its per-node tension travels
+/// in the extras as the Catmull-Rom's does.
 [[nodiscard]] Status pack_nodes(const WireNodes& nodes, const SplineSettings& settings, PackedNodes& out);
 
 /// node_bounding_sphere (lod.hpp) of the packed wire, from what pack_nodes measured (the merged nodes' box and

@@ -50,12 +50,82 @@ double hlen(Header h, uint k) { return length(chord(h, k)); }
 dvec3 unit_chord(Header h, uint k) { return chord(h, k) / hlen(h, k); }
 
 // Row j of the interior system: (a, b, c) and its right-hand side.
+// The automatic spline (kind 3): the c2 system with node j's tension weight w_j on the diagonal (Nielson's
+// nu-spline) and its ends blending from not-a-knot to free as the nodes next to them get tensed, the weights read
+// from the turning pattern as concentrated_turns does on the CPU (modules/wire/src/spline/tension.cpp, the same
+// operations in double; the weights' exponentials in float: GLSL has no double exp), then each node's tension
+// scaling both its tangents (build_curve's end_curve): 1 - t, t wire-wide or, for nodes that carry tension or the
+// physics arrays, per node in the extras (x).
+bool automatic(Header h) { return ((h.flags >> 1u) & 3u) == 3u; }
+double keep_at(Header h, uint j) {
+    if (!automatic(h)) return 1.0;
+    return 1.0lf - double((h.flags & kHasPerNode) != 0u ? extras[h.extra_first + j].x : h.kb.y);
+}
+dvec3 e_out(Header h, uint j) { return unit_chord(h, j % h.node_count); }
+dvec3 e_in(Header h, uint j) { return unit_chord(h, (j + h.node_count - 1u) % h.node_count); }
+// Curvature vector and chord-bisector tangent of node j (an open wire's end nodes take their neighbour's).
+uint inner(Header h, uint j) {
+    bool closed = (h.flags & kClosed) != 0u;
+    return closed ? j % h.node_count : clamp(j, 1u, h.node_count - 2u);
+}
+dvec3 kvec(Header h, uint j) {
+    j = inner(h, j);
+    uint n = h.node_count;
+    return (e_out(h, j) - e_in(h, j)) * (2.0lf / (hlen(h, (j + n - 1u) % n) + hlen(h, j)));
+}
+dvec3 tvec(Header h, uint j) {
+    j = inner(h, j);
+    dvec3 b = e_in(h, j) + e_out(h, j);
+    double lb = length(b);
+    return lb > 1e-12lf ? b / lb : e_out(h, j);
+}
+// k carried from the node at one end of an edge (tangents ta -> tb) to the other: forwards (sign 1) or back (-1).
+dvec3 carry_k(dvec3 ta, dvec3 tb, dvec3 v, double sgn) {
+    double c = dot(ta, tb);
+    if (c <= -1.0lf + 1e-12lf) return -v;
+    dvec3 a = cross(ta, tb);
+    return v * c + sgn * cross(a, v) + a * (dot(a, v) / (1.0lf + c));
+}
+float smoothstep_d(double e0, double e1, double x) {
+    double t = clamp((x - e0) * (1.0lf / (e1 - e0)), 0.0lf, 1.0lf);
+    return float(t * t * (3.0lf - 2.0lf * t));
+}
+// (w, g, max(g, straight)) of node j: 0 where its neighbours predict its turn (the spread test).
+vec3 turn_weights(Header h, uint j) {
+    uint n = h.node_count;
+    bool closed = (h.flags & kClosed) != 0u;
+    if (!automatic(h) || n < 3u || (!closed && (j == 0u || j + 1u >= n))) return vec3(0.0);
+    uint jp = (j + n - 1u) % n, jn = (j + 1u) % n;
+    double hin = hlen(h, jp), hout = hlen(h, j);
+    dvec3 tp = tvec(h, closed ? jp : j - 1u), t = tvec(h, j), tn = tvec(h, closed ? jn : j + 1u);
+    dvec3 f = carry_k(tp, t, kvec(h, closed ? jp : j - 1u), 1.0);
+    dvec3 b = carry_k(t, tn, kvec(h, closed ? jn : j + 1u), -1.0);
+    dvec3 p = (hout * f + hin * b) * (1.0lf / (hin + hout));
+    dvec3 k = kvec(h, j);
+    double lk2 = dot(k, k), lp2 = dot(p, p);
+    dvec3 m = k - p;
+    double miss2 = dot(m, m);
+    double s2 = (lk2 + lp2) + 2.0lf * min(lk2, lp2);
+    if (s2 >= 1.1830521861667747e-271lf && s2 <= 1.0715086071862673e301lf && miss2 <= 0.3024lf * s2) return vec3(0.0);  // predicted (the certificate)
+    double lk = sqrt(lk2), sum = lk + sqrt(lp2);
+    if (!(sum > 0.0lf) || !(sum <= 1.7976931348623157e308lf) || miss2 <= (0.55lf * sum) * (0.55lf * sum)) return vec3(0.0);
+    double d = sqrt(miss2) / sum;
+    double turn = 0.5lf * sum * (hin + hout);
+    float unshared = smoothstep_d(0.55lf, 0.85lf, d) * smoothstep_d(1e-8lf, 1e-6lf, turn);
+    if (unshared == 0.0) return vec3(0.0);
+    double share = lk / sum;
+    float g = unshared * smoothstep_d(0.3lf, 0.45lf, share);
+    float straight = unshared * (1.0 - smoothstep_d(0.0lf, 0.1lf, share));
+    float w = (g != 0.0 ? exp(g * log(1.0 + 3e4)) - 1.0 : 0.0) + (straight != 0.0 ? exp(straight * log(31.0)) - 1.0 : 0.0);
+    return vec3(w, g, max(g, straight));
+}
+
 void row(Header h, uint j, out dvec3 abc, out dvec3 rhs) {
     uint n = h.node_count;
     uint kin = (j + n - 1u) % n, kout = j % n;
     double hin = hlen(h, kin), hout = hlen(h, kout), sum = hin + hout;
     double a = hout / sum, c = hin / sum;
-    abc = dvec3(a, 2.0, c);
+    abc = dvec3(a, 2.0 + double(turn_weights(h, j % n).x), c);
     rhs = 3.0 * (a * unit_chord(h, kin) + c * unit_chord(h, kout));
 }
 
@@ -107,15 +177,32 @@ void c2_tangents(Header h, bool closed) {
     double h0 = hlen(h, 0u), h1 = hlen(h, 1u), hl = hlen(h, segs - 1u), hp = hlen(h, segs - 2u);
     dvec3 s0 = unit_chord(h, 0u), s1 = unit_chord(h, 1u), sl = unit_chord(h, segs - 1u), sp = unit_chord(h, segs - 2u);
     if (n == 3u) {
-        scratch[sidx(h, 0u)] = dvec4(s0 - h0 * (s1 - s0) / (h0 + h1), 0.0);
-        scratch[sidx(h, 1u)] = dvec4((h1 * s0 + h0 * s1) / (h0 + h1), 0.0);
-        scratch[sidx(h, 2u)] = dvec4(s1 + h1 * (s1 - s0) / (h0 + h1), 0.0);
+        // The parabola (not-a-knot at both ends), blended with the free-ended tensed solution by g of node 1.
+        dvec3 p0 = s0 - h0 * (s1 - s0) / (h0 + h1), p1 = (h1 * s0 + h0 * s1) / (h0 + h1);
+        dvec3 p2 = s1 + h1 * (s1 - s0) / (h0 + h1);
+        double g1 = double(turn_weights(h, 1u).y);
+        if (g1 != 0.0) {
+            dvec3 abc, rhs;
+            row(h, 1u, abc, rhs);
+            dvec3 t1 = (rhs - 1.5 * (abc.x * s0 + abc.z * s1)) / (abc.y - 0.5 * (abc.x + abc.z));
+            dvec3 t0 = 0.5 * (3.0 * s0 - t1), t2 = 0.5 * (3.0 * s1 - t1);
+            p0 = (1.0 - g1) * p0 + g1 * t0;
+            p1 = (1.0 - g1) * p1 + g1 * t1;
+            p2 = (1.0 - g1) * p2 + g1 * t2;
+        }
+        scratch[sidx(h, 0u)] = dvec4(p0, 0.0);
+        scratch[sidx(h, 1u)] = dvec4(p1, 0.0);
+        scratch[sidx(h, 2u)] = dvec4(p2, 0.0);
         return;
     }
-    // End rows beta D0 + D1 = r (not-a-knot), eliminated into the first and last interior rows.
-    dvec3 r0 = (s0 * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s1) / ((h0 + h1) * (h0 + h1));
-    dvec3 rl = (sl * (hp * (3.0 * hl + 2.0 * hp)) + (hl * hl) * sp) / ((hp + hl) * (hp + hl));
-    double beta0 = h1 / (h0 + h1), betal = hp / (hp + hl);
+    // End rows beta D0 + D1 = r (not-a-knot, blending to free: beta = 2, r = 3 s as a node next to the end gets
+    // tensed), eliminated into the first and last interior rows.
+    dvec3 r0n = (s0 * (h1 * (3.0 * h0 + 2.0 * h1)) + (h0 * h0) * s1) / ((h0 + h1) * (h0 + h1));
+    dvec3 rln = (sl * (hp * (3.0 * hl + 2.0 * hp)) + (hl * hl) * sp) / ((hp + hl) * (hp + hl));
+    double g0 = double(max(turn_weights(h, 1u).z, n > 3u ? turn_weights(h, 2u).z : 0.0));
+    double gl = double(max(turn_weights(h, n - 2u).z, n > 3u ? turn_weights(h, n - 3u).z : 0.0));
+    double beta0 = (1.0 - g0) * h1 / (h0 + h1) + 2.0 * g0, betal = (1.0 - gl) * hp / (hp + hl) + 2.0 * gl;
+    dvec3 r0 = (1.0 - g0) * r0n + (3.0 * g0) * s0, rl = (1.0 - gl) * rln + (3.0 * gl) * sl;
     uint m = n - 2u;
     double cp = 0.0;
     dvec3 dp = dvec3(0.0);
@@ -174,12 +261,14 @@ void main() {
     bool closed = (h.flags & 1u) != 0u;
     uint kind = (h.flags >> 1u) & 3u;
     uint segs = closed ? n : n - 1u;
-    if (kind == 2u) {
+    if (kind >= 2u) {
         c2_tangents(h, closed);
         for (uint k = 0u; k < segs; ++k) {
             dvec3 p0 = dnode(h, k), p1 = dnode(h, k + 1u);
             double len = hlen(h, k);
-            dvec3 t0 = scratch[sidx(h, k)].xyz * len, t1 = scratch[sidx(h, (k + 1u) % n)].xyz * len;
+            // keep: the node's tension scales both its tangents (automatic; 1 for c2).
+            double keep0 = keep_at(h, k), keep1 = keep_at(h, (k + 1u) % n);
+            dvec3 t0 = scratch[sidx(h, k)].xyz * (len * keep0), t1 = scratch[sidx(h, (k + 1u) % n)].xyz * (len * keep1);
             uint s = 4u * (h.segment_first + k);
             segments[s] = vec4(vec3(p0), nodes[h.node_first + k].w);
             segments[s + 1u] = vec4(vec3(t0 / 3.0), nodes[h.node_first + (k + 1u) % n].w);
@@ -263,9 +352,10 @@ void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, 
     h.node_first = static_cast<uint32_t>(out.nodes.size());
     h.node_count = static_cast<uint32_t>(p.nodes.size());
     h.segment_first = segment_first;
-    const uint32_t kind = p.kind == SplineKind::linear ? kKindLinear
-                          : p.kind == SplineKind::c2   ? kKindC2
-                                                       : kKindCatmullRom;
+    const uint32_t kind = p.kind == SplineKind::linear      ? kKindLinear
+                          : p.kind == SplineKind::c2        ? kKindC2
+                          : p.kind == SplineKind::automatic ? kKindAutomatic
+                                                            : kKindCatmullRom;
     h.flags = (p.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
               (p.per_node_kb ? kHeaderPerNode : 0u) | (p.stretch ? kHeaderStretch : 0u) |
               (material << kHeaderMaterialShift);

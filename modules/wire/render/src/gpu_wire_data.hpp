@@ -24,7 +24,8 @@ struct Header {
     uint node_first;     // this frame's curve nodes (the curve pass reads them)
     uint node_count;     // curve nodes (merged)
     uint segment_first;  // the wire's segments, and its per-segment ring counts
-    uint flags;          // bit 0 closed; 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); 3 caps; 4 per-node kb;
+    uint flags;          // bit 0 closed; 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2, 3 automatic); 3 caps; 4 per-node
+                         // values (kb, or the automatic spline's weights);
                          // 5 stretch; 6 the segments are given (4 vec4 each at node_first); 8-15 the wire's
                          // most sides (0: the LOD settings'); 16-31 material
     vec4 kb;             // alpha, tension, bias, continuity (wire-wide)
@@ -40,7 +41,7 @@ std::string with_wire_header(const char* source);
 inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u,
                           kHeaderGivenSegments = 64u;
 inline constexpr uint32_t kHeaderKindShift = 1u, kHeaderMaterialShift = 16u;
-inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u;
+inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u, kKindAutomatic = 3u;
 
 /// One frame's upload of wires for the curve pass.
 struct WireUpload {

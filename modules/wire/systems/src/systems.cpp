@@ -501,8 +501,8 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             const WireNodes& nodes = *job.nodes;
             const WireNodes& prev = c.previous_nodes;
             BoundingSphere sphere{};
-            if (step.exact && step.spline.kind == SplineKind::automatic) {
-                // Not built on the GPU yet: the CPU builds the curve and the renderer gets its segments.
+            if (step.exact && !gpu_builds(step.spline.kind)) {
+                // A kind the GPU does not build: the CPU builds the curve and the renderer gets its segments.
                 thread_local Curve built;  // swapped in on success: a failure keeps the last valid curve
                 job.status = build_curve(nodes, step.spline, built);
                 if (job.status.ok() && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
@@ -767,8 +767,8 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
             item.material = style->material;
             item.wire_id = engine::ecs::to_integral(e);
             // The last valid nodes (the current ones unless they are invalid), or the curve built on the CPU: the
-            // blended one while a pop-free blend is live, an automatic spline's (not on the GPU yet).
-            const bool cpu_curve = !curve->pop_free_stale || style->spline.kind == SplineKind::automatic;
+            // blended one while a pop-free blend is live (or a kind the GPU does not build).
+            const bool cpu_curve = !curve->pop_free_stale || !gpu_builds(style->spline.kind);
             if (cpu_curve && !curve->curve.segments.empty()) {
                 item.curve = &curve->curve;
             } else {

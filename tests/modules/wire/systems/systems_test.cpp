@@ -585,8 +585,8 @@ namespace {
 
 // The nodes path (issue 30): the systems send packed nodes (no curve, rings or mesh on the CPU), the blended curve
 // while a pop-free blend lasts (then packed nodes again), and keep drawing the last valid nodes after a bad
-// update, reported once; automatic wires send their CPU-built curve. A wire far behind the camera is culled by the
-// sphere from its nodes.
+// update, reported once; automatic wires too (their weights packed with the nodes). A wire far behind the camera
+// is culled by the sphere from its nodes.
 TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
     World w;
     w.ctx.path = UploadPath::gpu_nodes;
@@ -608,7 +608,7 @@ TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
     EXPECT_EQ(w.ctx.stats.meshes_built, 0u);
     EXPECT_TRUE(w.registry.get<WireCurve>(e).curve.segments.empty());  // built on the GPU, not kept here
     ASSERT_NE(item_of(a), nullptr);
-    EXPECT_NE(item_of(a)->curve, nullptr);  // automatic: the CPU's curve
+    EXPECT_NE(item_of(a)->packed_nodes, nullptr);  // automatic: built on the GPU too (weights from the CPU)
     EXPECT_NE(item_of(behind), nullptr);    // c2: no sphere from nodes, culled on the GPU
     EXPECT_EQ(item_of(far_away), nullptr);  // behind the camera: culled by the sphere from its nodes
     const uint64_t generation = item_of(e)->nodes_generation;
