@@ -7,12 +7,16 @@
 //   pass->build(wires);                                   // uploads, dispatches
 //   pass->read_segments(out);                             // (tests, tools) the segments back, per wire
 //
-// Kinds so far: linear; Catmull-Rom / Kochanek-Bartels with any alpha, wire-wide or per-node tension, bias and
-// continuity, and the curvature-driven tension of nodes that carry the physics arrays (computed on the CPU with
-// build_curve's formula and sent as 16 bytes a node, only for such wires); c2 (its tangent system solved by one
-// invocation in double, GLSL 4.00's fp64: the not-a-knot end cancels by the ratio of the first two chords, which
-// in float moved a 4-node wire with 100:1 chords by 1e-4 of its extent; closed loops cyclic). Not yet
-// (supported() says so, build() refuses it by name): automatic (its concentrated-turn tension).
+// Every kind the CPU has: linear; Catmull-Rom / Kochanek-Bartels with any alpha, wire-wide or per-node tension,
+// bias and continuity, and the curvature-driven tension of nodes that carry the physics arrays (computed on the CPU
+// with build_curve's formula and sent as 16 bytes a node, only for such wires); c2 (its tangent system solved by
+// one invocation in double, GLSL 4.00's fp64: the not-a-knot end cancels by the ratio of the first two chords,
+// which in float moved a 4-node wire with 100:1 chords by 1e-4 of its extent; closed loops cyclic); automatic (the
+// c2 system with the concentrated-turn weights read from the turning pattern in the same invocation, as
+// concentrated_turns does on the CPU, in double). The automatic spline's weights react to 1e-7 rad of noise at
+// collinear nodes (its 1e-8 .. 1e-6 rad turn ramp): the float rounding of the nodes is such noise, so on taut runs
+// the curve of the rounded nodes may differ visibly from the exact nodes' (by 0.1 of a zig-zag's extent at worst
+// over the test's families); the GPU equals build_curve of the rounded nodes.
 // Precision: nodes go to the GPU in float relative to the wire's own origin (the centre of its nodes' box,
 // kept in double), so a wire far from the world origin keeps its float precision; the segments come back
 // relative to that origin. Coincident nodes are merged on the CPU by build_curve's own rule
@@ -77,9 +81,9 @@ public:
     /// Whether this pass builds `spline` (see the file comment for what it does not yet).
     [[nodiscard]] static bool supported(const SplineSettings& spline, const WireNodes& nodes);
 
-    /// Builds every wire's segments on the GPU (one dispatch). A wire this pass cannot build (a kind it does not
-    /// support yet, or fewer than 2 distinct nodes, 3 closed) fails the call with a message naming the wire and
-    /// why; nothing is dispatched then. Validate nodes first (build_curve's checks): NaN is not looked for here.
+    /// Builds every wire's segments on the GPU (one dispatch). A wire this pass cannot build (build_curve's checks:
+    /// fewer than 2 distinct nodes, 3 closed, bad values) fails the call with a message naming the wire and why;
+    /// nothing is dispatched then. Validate nodes first (build_curve's checks): NaN is not looked for here.
     /// Leaves shader storage bindings 0-4 pointing at its buffers and no program in use.
     [[nodiscard]] Status build(std::span<const GpuCurveWire> wires);
 
