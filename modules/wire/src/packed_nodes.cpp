@@ -31,14 +31,7 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     thread_local std::vector<glm::dvec3> curve;
     thread_local std::vector<uint32_t> source, last;
     const std::size_t n = curve_nodes(wn, spline, curve, &source, &last);
-    if (n < 2) {
-        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(wn.size()) +
-                             " node(s) and " + std::to_string(n) + " after merging coincident ones");
-    }
-    if (spline.closed && n < 3) {
-        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(n) +
-                             " after merging coincident ones");
-    }
+    if (Status st = curve_stage::check_distinct(wn.size(), n, spline.closed); !st) return st;
     // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
     glm::dvec3 lo = curve.front(), hi = curve.front();
     double chord2 = 0.0;

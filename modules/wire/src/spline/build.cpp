@@ -253,14 +253,7 @@ Status begin_curve(const WireNodes& nodes, const SplineSettings& settings, Curve
     std::size_t n = 0;
     const dvec3* const P = merge_nodes(nodes, settings, m, ch, n);
     const bool closed = settings.closed;
-    if (n < 2) {
-        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(nodes.size()) +
-                             " node(s) and " + std::to_string(n) + " after merging coincident ones");
-    }
-    if (closed && n < 3) {
-        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(n) +
-                             " after merging coincident ones");
-    }
+    if (Status st = check_distinct(nodes.size(), n, closed); !st) return st;
     const std::size_t segs = closed ? n : n - 1;
 
     std::vector<float>& seg_stretch = out.stretch;  // built in place

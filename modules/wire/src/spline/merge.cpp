@@ -147,14 +147,7 @@ Status check_curve_input(const WireNodes& nodes, const SplineSettings& settings)
     thread_local curve_stage::Chords ch;
     std::size_t n = 0;
     (void)curve_stage::merge_nodes(nodes, settings, m, ch, n);
-    if (n < 2) {
-        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(nodes.size()) +
-                             " node(s) and " + std::to_string(n) + " after merging coincident ones");
-    }
-    if (settings.closed && n < 3) {
-        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(n) +
-                             " after merging coincident ones");
-    }
+    if (Status st = curve_stage::check_distinct(nodes.size(), n, settings.closed); !st) return st;
     return Status::success();
 }
 

@@ -207,4 +207,16 @@ Status check_nodes(const WireNodes& w, bool use_physics) {
 
 bool values_within(const double* v, std::size_t count, double limit) { return all_within(v, count, limit); }
 
+Status check_distinct(std::size_t input, std::size_t merged, bool closed) {
+    if (merged < 2) {
+        return Status::error("a wire needs at least 2 distinct nodes, got " + std::to_string(input) + " node(s) and " +
+                             std::to_string(merged) + " after merging coincident ones");
+    }
+    if (closed && merged < 3) {
+        return Status::error("a closed loop needs at least 3 distinct nodes, got " + std::to_string(merged) +
+                             " after merging coincident ones");
+    }
+    return Status::success();
+}
+
 }  // namespace wire::curve_stage

@@ -24,6 +24,9 @@ Status check_settings(const SplineSettings& s);
 // Every node's values finite and in range (the physics arrays' too with use_physics).
 Status check_nodes(const WireNodes& w, bool use_physics);
 
+// Enough distinct nodes after merging coincident ones: `input` nodes merged to `merged` (2, a closed loop 3).
+Status check_distinct(std::size_t input, std::size_t merged, bool closed);
+
 // True when |v[i]| <= limit for every i < count (false for NaN and Inf), by the widest version the CPU has.
 bool values_within(const double* v, std::size_t count, double limit);
 // True when v[i] > limit for every i < count (false for NaN).
