@@ -263,8 +263,8 @@ void check_pop_free_csv(const fs::path& dir) {
     }
 }
 
-// `--gl` rows (bench_gl.csv): every selected scene on every path at 1, 2 and all threads, then strips and lines off
-// with the one-draw baseline; the bytes draw() sent equal the computed plan on every frame, the baseline is one
+// `--gl` rows (bench_gl.csv): every selected scene on every path (cpu-mesh, gpu-rings, gpu-retained, gpu-nodes) at
+// 1, 2 and all threads, then strips and lines off with the one-draw baseline; the bytes draw() sent equal the computed plan on every frame, the baseline is one
 // command over exactly the triangles of the tube-only rows.
 TEST(WiretoolBench, GlRowsAtScale) {
     const fs::path dir = out_dir().string() + "_gl";
@@ -284,7 +284,7 @@ TEST(WiretoolBench, GlRowsAtScale) {
     std::set<std::string> threads;
     for (const auto& r : csv.rows) threads.insert(r.at("threads"));
     EXPECT_TRUE(threads.count("1") && threads.count("2"));
-    ASSERT_EQ(csv.rows.size(), 2 * (3 * threads.size() + 4)) << "2 scenes x (3 paths x threads + 4 tube-only rows)";
+    ASSERT_EQ(csv.rows.size(), 2 * (4 * threads.size() + 5)) << "2 scenes x (4 paths x threads + 5 tube-only rows)";
     for (const char* scene : {"standard", "swaying"}) {
         const auto* base = find(csv.rows, {{"scene", scene}, {"path", "one-draw baseline"}});
         ASSERT_TRUE(base) << scene;
@@ -297,6 +297,14 @@ TEST(WiretoolBench, GlRowsAtScale) {
             EXPECT_EQ(number(*tubes, "triangles"), number(*base, "triangles")) << scene << " " << p;
             EXPECT_GT(number(*tubes, "gpu_vs_one_draw"), 0.0);
         }
+        // The nodes path draws the GPU's LOD at node resolution (its triangles are counted on the GPU, not here).
+        for (const char* thin : {"on", "off"})
+            EXPECT_TRUE(find(csv.rows, {{"scene", scene}, {"path", "gpu-nodes"}, {"thin_wires", thin}})) << scene << " " << thin;
+    }
+    {
+        std::ifstream md(dir / "bench_gl.md");
+        const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+        EXPECT_NE(text.find("## The nodes path against cpu-mesh"), std::string::npos);
     }
     for (const auto& r : csv.rows) {
         EXPECT_EQ(number(r, "bytes_mismatch_frames"), 0.0) << r.at("scene") << " " << r.at("path");

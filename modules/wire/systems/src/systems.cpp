@@ -621,16 +621,20 @@ void lod_system(Registry& registry, WireContext& ctx) {
         // The nodes path: the GPU chooses counts and sides. Here the cull by the sphere of the nodes (or of the
         // blended curve); a wire without a sphere (c2, automatic: unknown overshoot) is sent and culled there.
         auto& storage = registry.storage<WireLodState>();
-        for (std::size_t i = 0; i < storage.size(); ++i) {
-            const WireCurve* curve = registry.try_get<WireCurve>(storage.at(i));
-            WireLodState& lod = storage.at_position(i);
-            const bool visible = curve != nullptr && curve->generation > 0 &&
-                                 (curve->bounds.radius_m < 0.0 || !sphere_outside_view(curve->bounds, ctx.view));
-            if (visible != lod.lod.visible) ++lod.generation;
-            lod.lod.visible = visible;
-            lod.seen_curve = curve != nullptr ? curve->generation : 0;
-            lod.seen_view = ctx.view_generation;
-        }
+        const auto& curves = registry.storage<WireCurve>();  // looked up here: the workers only read it
+        constexpr std::size_t kBlock = 256;  // each wire writes only its own state
+        parallel_over((storage.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
+            for (std::size_t i = block * kBlock; i < std::min(storage.size(), (block + 1) * kBlock); ++i) {
+                const WireCurve* curve = curves.try_get(storage.at(i));
+                WireLodState& lod = storage.at_position(i);
+                const bool visible = curve != nullptr && curve->generation > 0 &&
+                                     (curve->bounds.radius_m < 0.0 || !sphere_outside_view(curve->bounds, ctx.view));
+                if (visible != lod.lod.visible) ++lod.generation;
+                lod.lod.visible = visible;
+                lod.seen_curve = curve != nullptr ? curve->generation : 0;
+                lod.seen_view = ctx.view_generation;
+            }
+        });
         ctx.lod_pass_generation = ctx.view_generation;
         return;
     }
@@ -759,9 +763,19 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
 
     list.items.reserve(visible.size());
     if (ctx.path == UploadPath::gpu_nodes) {
-        for (const Entity e : visible) {
-            const Style* style = registry.try_get<Style>(e);
-            const WireCurve* curve = registry.try_get<WireCurve>(e);
+        // Items built in parallel (each its own slot), then the ones without a curve dropped, in entity order.
+        std::vector<DrawItem>& items = list.items;
+        items.resize(visible.size());
+        std::vector<unsigned char>& keep = reused<unsigned char, 1>();
+        keep.assign(visible.size(), 0);
+        constexpr std::size_t kBlock = 256;
+        const auto& styles = registry.storage<Style>();  // looked up here: the workers only read them
+        const auto& curves = registry.storage<WireCurve>();
+        parallel_over((visible.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
+          for (std::size_t v = block * kBlock; v < std::min(visible.size(), (block + 1) * kBlock); ++v) {
+            const Entity e = visible[v];
+            const Style* style = styles.try_get(e);
+            const WireCurve* curve = curves.try_get(e);
             if (style == nullptr || curve == nullptr || curve->generation == 0) continue;
             DrawItem item;
             item.material = style->material;
@@ -780,8 +794,14 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
             item.sides = style->max_sides ? std::max<uint32_t>(style->max_sides, 3) : kDefaultMaxSides;
             item.closed = style->closed;
             item.caps = caps_of(*style);
-            list.items.push_back(item);
-        }
+            items[v] = item;
+            keep[v] = 1;
+          }
+        });
+        std::size_t kept = 0;
+        for (std::size_t v = 0; v < items.size(); ++v)
+            if (keep[v]) items[kept++] = items[v];
+        items.resize(kept);
         ctx.stats.visible_wires = visible.size();
         ctx.stats.draw_items = list.items.size();
         return;
