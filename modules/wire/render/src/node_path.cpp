@@ -62,7 +62,7 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
 std::size_t NodePath::gl_buffers() const {
     std::size_t n = 0;
     for (const gfx::Buffer* b : {&slot_headers_, &slot_state_, &segments_, &counts_, &scratch_, &jobs_, &draws_, &chunks_,
-                                 &rings_, &buckets_, &commands_, &counter_, &templates_, &readback_}) {
+                                 &rings_, &buckets_, &commands_, &counter_, &templates_, &readback_, &visible_kept_}) {
         n += b->id() != 0 ? 1 : 0;
     }
     return n;
@@ -281,9 +281,14 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
     std::memcpy(base + node_at, up.nodes.data(), node_bytes);
     std::memcpy(base + extra_at, up.extras.data(), extra_bytes);
-    if (!visible_slots_.empty()) std::memcpy(base + visible_at, visible_slots_.data(), visible_slots_.size() * 4);
+    // The list of unchanged visible wires stays on the GPU while it is the same (a still scene, or still wires
+    // under a camera that keeps them in view): then nothing is sent for them.
+    const bool same_list = visible_slots_ == last_visible_ && visible_kept_.id() != 0;
+    if (!same_list && !visible_slots_.empty()) {
+        std::memcpy(base + visible_at, visible_slots_.data(), visible_slots_.size() * 4);
+    }
     stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + node_bytes : 0) +
-                           real_extra_bytes + visible_slots_.size() * 4;
+                           real_extra_bytes + (same_list ? 0 : visible_slots_.size() * 4);
     const auto range = [&](GLuint binding, std::size_t offset, std::size_t bytes) {
         glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, region.buffer,
                           static_cast<GLintptr>(region.offset_bytes + offset), static_cast<GLsizeiptr>(bytes));
@@ -350,7 +355,14 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, slot_state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
-    range(11, visible_at, visible_bytes);
+    if (!same_list) {
+        // Kept for the next frames: copied on the GPU out of the region.
+        if (!ensure(visible_kept_, visible_kept_bytes_, visible_bytes, "wire nodes: visible slots", false)) return false;
+        glCopyNamedBufferSubData(region.buffer, visible_kept_.id(), static_cast<GLintptr>(region.offset_bytes + visible_at), 0,
+                                 static_cast<GLsizeiptr>(visible_bytes));
+        last_visible_ = visible_slots_;
+    }
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 11, visible_kept_.id(), 0, static_cast<GLsizeiptr>(visible_bytes));
     range(17, 0, header_bytes);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, draws_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, chunks_.id());

@@ -100,6 +100,9 @@ private:
     std::vector<uint8_t> changed_item_;  ///< per item of the list upload_bytes() saw: it sends its nodes
     std::vector<Slot*> item_slot_;       ///< per item: its slot when upload_bytes() found one (map nodes are stable)
     std::vector<uint32_t> visible_slots_;
+    std::vector<uint32_t> last_visible_;  ///< the list kept on the GPU (visible_kept_): unchanged, it is not sent
+    engine::gfx::Buffer visible_kept_;
+    std::size_t visible_kept_bytes_ = 0;
 };
 
 }  // namespace wire::render::detail

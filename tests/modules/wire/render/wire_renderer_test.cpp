@@ -483,7 +483,8 @@ EdgeComparison compare_off_edges(const platform::Image& a, const platform::Image
 // and the draw's arguments on the GPU) against the gpu-rings path fed by the CPU reference at the same LOD
 // (update_lod with keep_node_resolution, place_rings, build_rings): the same picture within 2/255 off
 // silhouettes (compare_off_edges), in three views, on the first frame and on a second one (carried state:
-// counts, sides, normals). The upload: 16 bytes a node and 64 a wire on the first frame, 4 a wire after (its slot).
+// counts, sides, normals). The upload: 16 bytes a node and 64 a wire on the first frame, 4 a wire (the slots of the
+// unchanged wires) on the second, nothing on the third (the same list, kept on the GPU).
 TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -579,7 +580,10 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
         EXPECT_EQ(gpu_stats.draw_items, wires.size());
         EXPECT_EQ(gpu_stats.wires_uploaded, wires.size());
         EXPECT_EQ(second_stats.wires_uploaded, 0u);  // nothing changed: only the visible slots are sent
-        EXPECT_EQ(second_stats.bytes_uploaded, 4 * wires.size());
+        EXPECT_EQ(second_stats.bytes_uploaded, 4 * wires.size());  // unchanged: their slots
+        DrawStats third_stats;
+        (void)render(*ctx, renderer, gpu, view.camera, node_settings, &third_stats);
+        EXPECT_EQ(third_stats.bytes_uploaded, 0u);  // the same slots again: nothing (the list is kept on the GPU)
         std::size_t nodes = 0;
         for (const Wire& w : wires) nodes += w.nodes.size();
         EXPECT_EQ(gpu_stats.bytes_uploaded, 16 * nodes + 64 * wires.size());
