@@ -312,7 +312,12 @@ TEST(WiretoolBench, GlRowsAtScale) {
         EXPECT_EQ(number(r, "width"), 320.0);
         EXPECT_EQ(number(r, "height"), 180.0);
         EXPECT_GT(number(r, "visible"), 0.0);
-        EXPECT_GT(number(r, "bytes_per_frame"), 0.0);
+        if (r.at("path") == "gpu-nodes" && r.at("scene") == "standard") {
+            // Still wires under a moving camera: at most their slots, and only in frames where that list changes.
+            EXPECT_LE(number(r, "bytes_per_frame"), 4.0 * number(r, "visible"));
+        } else {
+            EXPECT_GT(number(r, "bytes_per_frame"), 0.0) << r.at("scene") << " " << r.at("path");
+        }
     }
     // A size that is not WxH is a usage error (exit 2).
     const int bad = std::system((std::string(WIRETOOL_PATH) + " bench --gl --size 12by7 --out " + dir.string() +
