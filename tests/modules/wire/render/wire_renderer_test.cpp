@@ -79,14 +79,16 @@ struct Scene {
     std::vector<wire::WirePipeline> pipelines;
     std::vector<wire::PipelineSettings> settings;
     std::vector<uint32_t> materials;
+    std::vector<wire::WireNodes> nodes;  ///< each wire's nodes (the nodes path draws from these)
 
-    void add(const wire::WireNodes& nodes, wire::PipelineSettings s, uint32_t material = 0) {
+    void add(const wire::WireNodes& n, wire::PipelineSettings s, uint32_t material = 0) {
         wire::WirePipeline p;
-        const engine::Status st = p.update(nodes, s);
+        const engine::Status st = p.update(n, s);
         EXPECT_TRUE(st.ok()) << st.message;
         pipelines.push_back(std::move(p));
         settings.push_back(s);
         materials.push_back(material);
+        nodes.push_back(n);
     }
 
     uint64_t generation = 1;  ///< DrawItem::rings_generation of every item (bump it when the rings change)
@@ -169,6 +171,22 @@ Scene test_scene() {
     }
     scene.add(hanging_cable({0.5, -1.0, 1.0}, {1.7, -0.7, 1.5}, 0.05, 3), wire_settings(0.18f, 16));
     return scene;
+}
+
+// The three views of the path comparisons: the whole scene, a close-up of the thick wire's end cap, a close-up
+// of the wire of varying radius (tilted normals).
+struct NamedView {
+    const char* name;
+    engine::scene::Camera camera;
+};
+std::vector<NamedView> test_views() {
+    engine::scene::Camera cap_view = scene_camera();
+    cap_view.position = {2.4f, -0.5f, 2.4f};
+    cap_view.target = {1.5f, -0.75f, 1.4f};
+    engine::scene::Camera radius_view = scene_camera();
+    radius_view.position = {-0.9f, 0.6f, 2.6f};
+    radius_view.target = {-0.9f, 0.0f, 1.1f};
+    return {{"scene", scene_camera()}, {"cap", cap_view}, {"radius", radius_view}};
 }
 
 platform::Image render(platform::Context& ctx, WireRenderer& renderer, const DrawList& list,
@@ -389,16 +407,7 @@ TEST(WireRendererTest, GpuRingsMatchCpuMesh) {
     WireRenderer renderer = make_renderer();
     const Scene scene = test_scene();
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
-    engine::scene::Camera cap_view = scene_camera();
-    cap_view.position = {2.4f, -0.5f, 2.4f};
-    cap_view.target = {1.5f, -0.75f, 1.4f};
-    engine::scene::Camera radius_view = scene_camera();
-    radius_view.position = {-0.9f, 0.6f, 2.6f};
-    radius_view.target = {-0.9f, 0.0f, 1.1f};
-    const struct {
-        const char* name;
-        engine::scene::Camera camera;
-    } views[] = {{"scene", scene_camera()}, {"cap", cap_view}, {"radius", radius_view}};
+    const std::vector<NamedView> views = test_views();
     for (const auto& view : views) {
         DrawStats cpu_stats, gpu_stats;
         const platform::Image cpu =
@@ -492,60 +501,22 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
     DrawSettings node_settings;
     node_settings.node_lod.keep_node_resolution = true;
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
-    // The scene's nodes and settings (test_scene() keeps them in its pipelines; rebuilt here with the nodes).
-    struct Wire {
-        wire::WireNodes nodes;
-        wire::SplineSettings spline;
-        bool caps = true;
-    };
-    std::vector<Wire> wires;
-    wires.push_back({hanging_cable({-2.6, 1.4, -0.5}, {2.4, 1.2, -0.8}, 0.9, 9), wire_settings(0.07f, 12).spline});
-    {
-        Wire w{{}, wire_settings(0.05f, 10).spline};
-        for (int i = 0; i <= 28; ++i) {
-            const double s = i * 0.45;
-            w.nodes.positions.push_back({-1.6 + 0.45 * std::cos(s), -1.1 + 0.08 * s, 0.3 + 0.45 * std::sin(s)});
-        }
-        wires.push_back(w);
-    }
-    {
-        Wire w{{}, wire_settings(0.06f, 12, true).spline};
-        for (int i = 0; i < 7; ++i) {
-            const double a = 2.0 * std::numbers::pi * i / 7.0;
-            w.nodes.positions.push_back({1.3 + 0.9 * std::cos(a), -0.5 + 0.35 * std::sin(a), 0.2 + 0.7 * std::sin(a)});
-        }
-        wires.push_back(w);
-    }
-    {
-        Wire w{hanging_cable({-2.2, 0.2, 1.0}, {0.6, -0.3, 1.2}, -0.3, 6), wire_settings(0.05f, 14).spline};
-        w.nodes.radius_m = {0.03f, 0.06f, 0.12f, 0.09f, 0.05f, 0.1f};
-        wires.push_back(w);
-    }
-    wires.push_back({hanging_cable({0.5, -1.0, 1.0}, {1.7, -0.7, 1.5}, 0.05, 3), wire_settings(0.18f, 16).spline});
-
-    engine::scene::Camera cap_view = scene_camera();
-    cap_view.position = {2.4f, -0.5f, 2.4f};
-    cap_view.target = {1.5f, -0.75f, 1.4f};
-    engine::scene::Camera radius_view = scene_camera();
-    radius_view.position = {-0.9f, 0.6f, 2.6f};
-    radius_view.target = {-0.9f, 0.0f, 1.1f};
-    const struct {
-        const char* name;
-        engine::scene::Camera camera;
-    } views[] = {{"scene", scene_camera()}, {"cap", cap_view}, {"radius", radius_view}};
+    const Scene scene = test_scene();
+    const std::vector<NamedView> views = test_views();
     uint64_t id = 900000;
     for (const auto& view : views) {
         // The CPU reference at the GPU's LOD.
         const wire::LodView lod_view = wire::LodView::perspective(view.camera.position, view.camera.target,
                                                                   view.camera.up, view.camera.fov_y_rad, kWidth,
                                                                   kHeight, view.camera.near_m, view.camera.far_m);
-        std::vector<wire::RingSet> sets(wires.size());
+        std::vector<wire::RingSet> sets(scene.nodes.size());
         DrawList cpu{.path = UploadPath::gpu_rings, .items = {}};
         DrawList gpu{.path = UploadPath::gpu_nodes, .items = {}};
         ++id;
-        for (std::size_t i = 0; i < wires.size(); ++i) {
+        for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+            const wire::SplineSettings& spline = scene.settings[i].spline;
             wire::Curve curve;
-            ASSERT_TRUE(wire::build_curve(wires[i].nodes, wires[i].spline, curve).ok());
+            ASSERT_TRUE(wire::build_curve(scene.nodes[i], spline, curve).ok());
             wire::WireLod lod;
             wire::update_lod(curve, lod_view, node_settings.node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
             ASSERT_TRUE(lod.visible);
@@ -558,16 +529,16 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
             item.rings = sets[i].rings;
             item.sides = lod.drawn_sides;
             item.closed = sets[i].closed;
-            item.caps = wires[i].caps;
+            item.caps = scene.settings[i].tube.caps;
             item.u_close = sets[i].closed ? static_cast<float>(sets[i].u.back()) : 0.0f;
             cpu.items.push_back(item);
             DrawItem node_item;
             node_item.wire_id = id * 16 + i;
-            node_item.nodes = &wires[i].nodes;
-            node_item.spline = wires[i].spline;
+            node_item.nodes = &scene.nodes[i];
+            node_item.spline = spline;
             node_item.nodes_generation = 1;
             node_item.sides = 32;  // the most sides: the LOD settings' (update_lod's default)
-            node_item.caps = wires[i].caps;
+            node_item.caps = scene.settings[i].tube.caps;
             gpu.items.push_back(node_item);
         }
         DrawStats cpu_stats, gpu_stats, second_stats;
@@ -577,16 +548,17 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
         save(reference, std::string("wire_render_") + view.name + "_reference_for_nodes.png");
         save(first, std::string("wire_render_") + view.name + "_gpu_nodes.png");
         EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
-        EXPECT_EQ(gpu_stats.draw_items, wires.size());
-        EXPECT_EQ(gpu_stats.wires_uploaded, wires.size());
+        const std::size_t wire_count = scene.nodes.size();
+        EXPECT_EQ(gpu_stats.draw_items, wire_count);
+        EXPECT_EQ(gpu_stats.wires_uploaded, wire_count);
         EXPECT_EQ(second_stats.wires_uploaded, 0u);  // nothing changed: only the visible slots are sent
-        EXPECT_EQ(second_stats.bytes_uploaded, 4 * wires.size());  // unchanged: their slots
+        EXPECT_EQ(second_stats.bytes_uploaded, 4 * wire_count);  // unchanged: their slots
         DrawStats third_stats;
         (void)render(*ctx, renderer, gpu, view.camera, node_settings, &third_stats);
         EXPECT_EQ(third_stats.bytes_uploaded, 0u);  // the same slots again: nothing (the list is kept on the GPU)
         std::size_t nodes = 0;
-        for (const Wire& w : wires) nodes += w.nodes.size();
-        EXPECT_EQ(gpu_stats.bytes_uploaded, 16 * nodes + 64 * wires.size());
+        for (const wire::WireNodes& n : scene.nodes) nodes += n.size();
+        EXPECT_EQ(gpu_stats.bytes_uploaded, 16 * nodes + 64 * wire_count);
         for (const platform::Image* image : {&first, &second}) {
             const Comparison c = compare(reference, *image, bg.data(), 2);
             const EdgeComparison e = compare_off_edges(reference, *image, bg.data());
