@@ -69,6 +69,20 @@ bool top_eigenvector(const double N[4][4], double upper, double q[4]) {
     return best > 0.0 && std::isfinite(best);
 }
 
+// The nodes a reference takes from a state of n nodes: 0, 1, 2, 3, then each step 1.5x the last (5, 8, 12, 18,
+// 27, ...), the last entry always the last node. Returns how many (at most kCapacity).
+uint32_t reference_indices(std::size_t n, std::size_t (&at)[MotionReference::kCapacity]) {
+    if (n == 0) return 0;
+    std::size_t i = 0, step = 1;
+    uint32_t count = 0;
+    for (;;) {
+        at[count++] = i;
+        if (i + 1 >= n || count == MotionReference::kCapacity) return count;
+        if (i >= 3) step = std::max<std::size_t>(step + 1, (step * 3) / 2);
+        i = count + 1 == MotionReference::kCapacity ? n - 1 : std::min(n - 1, i + step);
+    }
+}
+
 // Where `id` sits in `to` (or -1): the same index first (ids rarely move far), then outward from it.
 long find_id(const WireNodes& to, uint32_t id, std::size_t hint) {
     const std::size_t n = to.ids.size();
@@ -120,20 +134,20 @@ MotionReference motion_reference(const WireNodes& nodes) {
     ref.node_count = static_cast<uint32_t>(n);
     ref.by_index = nodes.ids.size() != n;
     if (n == 0) return ref;
-    // Nodes 0, 1, 2, 3, then each step 1.5x the last, and always the last node: the start dense, the whole wire
-    // spanned (a far node pins the rotation about a straight start).
+    // Nodes 0, 1, 2, 3, then each step 1.5x the last, and always the last node (reference_index): the start dense,
+    // the whole wire spanned (a far node pins the rotation about a straight start). `s`: the length of the
+    // polyline through the chosen nodes (the polyline through all nodes where they are dense, at the start; beyond,
+    // chords of the sparse ones, a little short of it: it only shapes the weights, and costs 10 nodes, not n).
     double arc[MotionReference::kCapacity];
-    std::size_t i = 0, step = 1, at = 0;  // `at`: the node whose polyline length `s` is
+    std::size_t at[MotionReference::kCapacity];
+    ref.count = reference_indices(n, at);
     double s = 0.0;
-    while (ref.count < MotionReference::kCapacity) {
-        for (; at < i; ++at) s += glm::length(nodes.positions[at + 1] - nodes.positions[at]);
-        const uint32_t k = ref.count++;
+    for (uint32_t k = 0; k < ref.count; ++k) {
+        const std::size_t i = at[k];
+        if (k != 0) s += glm::length(nodes.positions[i] - ref.position[k - 1]);
         ref.position[k] = nodes.positions[i];
         ref.id[k] = ref.by_index ? static_cast<uint32_t>(i) : nodes.ids[i];
         arc[k] = s;
-        if (i + 1 >= n) break;
-        if (i >= 3) step = std::max<std::size_t>(step + 1, (step * 3) / 2);
-        i = ref.count + 1 == MotionReference::kCapacity ? n - 1 : std::min(n - 1, i + step);
     }
     // The reach: from two elements, quadrupled until the nodes within it fix a rotation (or it spans the wire).
     const uint32_t m = ref.count;
@@ -212,8 +226,10 @@ MotionFit fit_motion(const MotionReference& from, const WireNodes& to) {
     double w[MotionReference::kCapacity];
     uint32_t m = 0;
     bool moved = false;
+    std::size_t at[MotionReference::kCapacity];  // where the reference's nodes were: ids are looked up from there
+    (void)reference_indices(from.node_count, at);
     for (uint32_t k = 0; k < from.count; ++k) {
-        const long j = by_index ? static_cast<long>(from.id[k]) : find_id(to, from.id[k], k);
+        const long j = by_index ? static_cast<long>(from.id[k]) : find_id(to, from.id[k], at[k]);
         if (j < 0) continue;
         a[m] = from.position[k];
         b[m] = to.positions[static_cast<std::size_t>(j)];
@@ -230,17 +246,21 @@ MotionFit fit_motion(const MotionReference& from, const WireNodes& to) {
     return fit_pairs(a, b, w, m, from.determinacy);
 }
 
-glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal) {
-    if (!(fit.confidence > 0.0)) return previous_normal;
-    if (fit.confidence >= 1.0) return fit.rotation * previous_normal;
+glm::dquat carried_rotation(const MotionFit& fit) {
+    if (!(fit.confidence > 0.0)) return {1.0, 0.0, 0.0, 0.0};
+    if (fit.confidence >= 1.0) return fit.rotation;
     // A fraction of the rotation: the same axis, `confidence` of its angle (q^c, q.w >= 0).
     const glm::dvec3 v(fit.rotation.x, fit.rotation.y, fit.rotation.z);
     const double sin_half = glm::length(v);
-    if (!(sin_half > 0.0)) return previous_normal;
+    if (!(sin_half > 0.0)) return {1.0, 0.0, 0.0, 0.0};
     const double half = std::atan2(sin_half, fit.rotation.w) * fit.confidence;
     const glm::dvec3 axis = v / sin_half;
-    const glm::dquat part(std::cos(half), std::sin(half) * axis);
-    return part * previous_normal;
+    return glm::dquat(std::cos(half), std::sin(half) * axis);
+}
+
+glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal) {
+    if (!(fit.confidence > 0.0)) return previous_normal;
+    return carried_rotation(fit) * previous_normal;
 }
 
 FrameSettings carried_frames(FrameMethod method, const Frame* last_first, const MotionReference& built_from,

@@ -42,8 +42,8 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
             chord2 = std::max(chord2, d.x * d.x + d.y * d.y + d.z * d.z);
         }
     }
-    out.origin_m = 0.5 * (lo + hi);
-    out.half_diagonal_m = 0.5 * glm::length(hi - lo);
+    out.origin_m = float_point(0.5 * (lo + hi));
+    out.half_diagonal_m = glm::length(glm::max(hi - out.origin_m, out.origin_m - lo));  // the box from the origin
     out.max_chord_m = std::sqrt(chord2);
     out.closed = spline.closed;
     out.kind = spline.kind;
@@ -106,6 +106,11 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
         }
     }
     return Status::success();
+}
+
+glm::dvec3 float_point(const glm::dvec3& p) {
+    volatile float x = static_cast<float>(p.x), y = static_cast<float>(p.y), z = static_cast<float>(p.z);
+    return {x, y, z};
 }
 
 BoundingSphere packed_bounding_sphere(const PackedNodes& p) {

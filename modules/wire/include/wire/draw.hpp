@@ -64,6 +64,10 @@ struct DrawItem {
     /// Changes whenever `nodes` or `spline` change; the renderer keeps the wire's curve on the GPU while
     /// (wire_id, nodes_generation) stays the same. 0: unknown (the nodes are sent every frame).
     uint64_t nodes_generation = 0;
+    /// How the wire moved since the nodes the renderer last got for it: the vector part of wire::carried_rotation
+    /// (motion.hpp), which turns the first frame kept on the GPU as the CPU path's carried_frames turns its own.
+    /// Zero: none known (the first frame is the last one projected onto the new first tangent).
+    glm::vec3 motion{};
 
     uint32_t sides = 8;      ///< radial sides of a tube (>= 3); 2 = camera-facing strip, 1 = one-pixel AA line
     bool closed = false;     ///< closed loop (the last ring connects back to the first)

@@ -59,9 +59,13 @@ struct MotionFit {
 };
 [[nodiscard]] MotionFit fit_motion(const MotionReference& from, const WireNodes& to);
 
-/// Last state's first normal carried into the new state: turned by `confidence` times the fitted rotation's angle
-/// about its axis (all of it when the fit is sure, none when it is not: the frame stage then projects the plain
-/// previous normal). Not yet orthogonal to the new first tangent: pass it as FrameSettings::previous_normal.
+/// The rotation that carries last state's first normal into the new state: the fitted rotation's axis and
+/// `confidence` times its angle (all of it when the fit is sure, identity when it is not: the frame stage then
+/// projects the plain previous normal). Unit, w >= 0. The nodes path sends its vector part to the GPU.
+[[nodiscard]] glm::dquat carried_rotation(const MotionFit& fit);
+
+/// Last state's first normal carried into the new state: carried_rotation(fit) applied to it. Not yet orthogonal
+/// to the new first tangent: pass it as FrameSettings::previous_normal.
 [[nodiscard]] glm::dvec3 carry_normal(const MotionFit& fit, const glm::dvec3& previous_normal);
 
 /// The frame settings of a wire's next ring build, the one place both drivers of the stages (the ECS systems and

@@ -1,6 +1,7 @@
 // A wire's nodes as the GPU curve pass reads them (issue 30, the nodes path): its curve nodes (coincident ones
 // merged by build_curve's rule) as float offsets from an origin kept in double (the centre of their box), 16 bytes a
-// node with the tube radius in w, plus "extras" for the wires that have them: per-node tension, bias and continuity
+// node with the tube radius in w (the origin is a point with float coordinates, so the GPU's header carries it in
+// 12 bytes: the offsets are taken from it in double, so a wire keeps its precision wherever it is), plus "extras" for the wires that have them: per-node tension, bias and continuity
 // (Catmull-Rom wires that carry them, or the curvature-driven tension, computed here with build_curve's formula; a
 // vec4 a node) and per-segment stretch (4 segments a vec4). The wire systems pack these on their worker threads, so
 // the renderer's thread only copies them (as the rings system packs ring records for the gpu-rings path).
@@ -21,7 +22,7 @@ namespace wire {
 
 /// See the file comment.
 struct PackedNodes {
-    glm::dvec3 origin_m{};          ///< what `nodes` are offsets from (world metres)
+    glm::dvec3 origin_m{};          ///< what `nodes` are offsets from (world metres; float coordinates: float_point)
     std::vector<glm::vec4> nodes;   ///< per curve node: xyz offset from origin_m, w the tube radius
     std::vector<glm::vec4> extras;  ///< per-node kb (if per_node_kb), then stretch (if stretch), 4 segments a vec4
     bool closed = false;
@@ -29,11 +30,16 @@ struct PackedNodes {
     float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;  ///< wire-wide Kochanek-Bartels values
     bool per_node_kb = false;
     bool stretch = false;
-    // For the CPU's cull (packed_bounding_sphere): the curve nodes' box half diagonal, their longest chord, the
+    // For the CPU's cull (packed_bounding_sphere): how far the curve nodes' box reaches from origin_m (its half
+    // diagonal, or a hair more: the origin is rounded to floats), their longest chord, the
     // largest tube radius and the tangent factor K (see node_bounding_sphere in lod.hpp).
     double half_diagonal_m = 0.0, max_chord_m = 0.0, max_radius_m = 0.0, tangent_factor = 1.0;
     [[nodiscard]] std::size_t segment_count() const { return closed ? nodes.size() : nodes.size() - 1; }
 };
+
+/// The point nearest `p` whose coordinates are floats (each rounded to nearest): a wire's origin on the nodes path.
+/// Rounded through memory: GCC 12 at -O3 has dropped the round trip dvec3(vec3(p)) for two of three lanes.
+[[nodiscard]] glm::dvec3 float_point(const glm::dvec3& p);
 
 /// Whether the GPU curve pass builds `kind`: every kind the CPU has (linear, Catmull-Rom / Kochanek-Bartels, c2,
 /// automatic); a kind added to the CPU later is false until the GPU has it (the systems then send its CPU curve).

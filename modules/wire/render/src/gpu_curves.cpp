@@ -347,7 +347,7 @@ std::string with_wire_header(const char* source) {
 }
 
 void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                   WireUpload& out) {
+                   const glm::vec3& motion, WireUpload& out) {
     GpuCurveHeader h;
     h.node_first = static_cast<uint32_t>(out.nodes.size());
     h.node_count = static_cast<uint32_t>(p.nodes.size());
@@ -362,28 +362,30 @@ void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, 
     h.alpha = p.alpha, h.tension = p.tension, h.bias = p.bias, h.continuity = p.continuity;
     h.extra_first = static_cast<uint32_t>(out.extras.size());
     h.slot = slot;
-    h.origin_m[0] = p.origin_m.x, h.origin_m[1] = p.origin_m.y, h.origin_m[2] = p.origin_m.z;
+    h.origin_m[0] = static_cast<float>(p.origin_m.x), h.origin_m[1] = static_cast<float>(p.origin_m.y),
+    h.origin_m[2] = static_cast<float>(p.origin_m.z);  // exact: pack_nodes made it a float_point
+    h.motion[0] = motion.x, h.motion[1] = motion.y, h.motion[2] = motion.z;
     out.headers.push_back(h);
     out.nodes.insert(out.nodes.end(), p.nodes.begin(), p.nodes.end());
     out.extras.insert(out.extras.end(), p.extras.begin(), p.extras.end());
 }
 
 Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
-                   uint32_t material, bool caps, WireUpload& out, uint32_t& segments) {
+                   uint32_t material, bool caps, const glm::vec3& motion, WireUpload& out, uint32_t& segments) {
     thread_local PackedNodes packed;
     if (Status st = pack_nodes(wn, spline, packed); !st) return st;
-    append_packed(packed, segment_first, slot, material, caps, out);
+    append_packed(packed, segment_first, slot, material, caps, motion, out);
     segments = static_cast<uint32_t>(packed.segment_count());
     return Status::success();
 }
 
 void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                     WireUpload& out) {
+                     const glm::vec3& motion, WireUpload& out) {
     glm::dvec3 lo = curve.segments.front().b0, hi = lo;
     for (const CubicBezier& c : curve.segments) {
         for (const glm::dvec3* p : {&c.b0, &c.b1, &c.b2, &c.b3}) lo = glm::min(lo, *p), hi = glm::max(hi, *p);
     }
-    const glm::dvec3 origin = 0.5 * (lo + hi);
+    const glm::dvec3 origin = float_point(0.5 * (lo + hi));
     GpuCurveHeader h;
     h.node_first = static_cast<uint32_t>(out.nodes.size());
     h.node_count = static_cast<uint32_t>(curve.closed ? curve.segment_count() : curve.segment_count() + 1);
@@ -391,7 +393,9 @@ void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, 
     h.flags = (curve.closed ? kHeaderClosed : 0u) | (caps ? kHeaderCaps : 0u) | kHeaderGivenSegments |
               (material << kHeaderMaterialShift);
     h.slot = slot;
-    h.origin_m[0] = origin.x, h.origin_m[1] = origin.y, h.origin_m[2] = origin.z;
+    h.origin_m[0] = static_cast<float>(origin.x), h.origin_m[1] = static_cast<float>(origin.y),
+    h.origin_m[2] = static_cast<float>(origin.z);
+    h.motion[0] = motion.x, h.motion[1] = motion.y, h.motion[2] = motion.z;
     out.headers.push_back(h);
     const std::size_t n = curve.radius_m.size();
     const auto radius = [&](std::size_t j) { return n == 0 ? kDefaultWireRadius_m : curve.radius_m[j % n]; };
@@ -418,7 +422,7 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
         if (wire.nodes == nullptr) return Status::error(name + "no nodes");
         uint32_t segs = 0;
         if (Status st = detail::append_wire(*wire.nodes, wire.spline, segment_first, static_cast<uint32_t>(w), 0,
-                                            true, up, segs);
+                                            true, wire.motion, up, segs);
             !st) {
             return Status::error(name + st.message);
         }

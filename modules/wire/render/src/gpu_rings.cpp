@@ -486,6 +486,14 @@ uint chunk_count_of(uint kind, uint rings, uint drawn, bool caps) {
 }
 uint bucket_of(uint material, uint drawn, uint kind) { return (material * u_side_slots + drawn) * 6u + kind; }
 
+// v turned by the unit quaternion (sqrt(1 - |m|^2), m) (Header.motion; no trigonometry: a rotation by angle a has
+// |m| = sin(a / 2), and w from it loses precision only near a half turn in one frame).
+vec3 turned(vec3 v, vec3 m) {
+    float w = sqrt(max(0.0, 1.0 - dot(m, m)));
+    vec3 t = 2.0 * cross(m, v);
+    return v + w * t + cross(m, t);
+}
+
 void load_wire(uint slot) {
     H = headers[slot];
     N = H.node_count;
@@ -521,6 +529,14 @@ void main() {
     uint n = CLOSED ? 0u : 1u;
     float radius_px = 0.0;
     uint drawn = 0u;
+    if (u_stage != 3u && w < u_changed) {
+        // Nodes that changed: the slot's last first normal turned by the wire's motion since (the header's
+        // rotation, fitted on the CPU), as the CPU path's carried_frames turns its own. Culled or not, so the next
+        // build carries it from where the wire is.
+        vec4 last = slot_state[slot].first_normal;
+        vec3 motion = vec3(H.motion[0], H.motion[1], H.motion[2]);
+        if (last.w != 0.0) slot_state[slot].first_normal = vec4(turned(last.xyz, motion), 1.0);
+    }
     if (u_stage != 3u) {
         // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
         if (u_lod) {
@@ -676,6 +692,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     std::vector<Job> job_data(jobs.size());
     std::vector<uint32_t> counts, count_first(jobs.size()), segments(jobs.size()), visible(jobs.size());
     std::size_t rings = 0, count_total = 0;
+    bool carry_last = false;
     for (std::size_t w = 0; w < jobs.size(); ++w) {
         const GpuCurveHeader& h = headers[w];
         const bool closed = (h.flags & detail::kHeaderClosed) != 0;
@@ -685,7 +702,8 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
         segments[w] = static_cast<uint32_t>(segs);
         visible[w] = h.slot;
         count_total += segs;
-        j.flags = 2u | (jobs[w].has_previous_normal ? 1u : 0u);
+        j.flags = jobs[w].carry_last ? 0u : 2u | (jobs[w].has_previous_normal ? 1u : 0u);
+        carry_last = carry_last || jobs[w].carry_last;
         j.previous_normal[0] = jobs[w].previous_normal.x;
         j.previous_normal[1] = jobs[w].previous_normal.y;
         j.previous_normal[2] = jobs[w].previous_normal.z;
@@ -712,8 +730,14 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     if (!keep) {
         if (counts.empty()) counts.assign(count_total, 0);
         auto count_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(counts), "wire gpu ring counts");
-        const std::vector<SlotState> zeros(jobs.size());
-        auto state_buffer = engine::gfx::make_buffer(std::span<const SlotState>(zeros), "wire gpu slot state");
+        std::vector<SlotState> state(jobs.size());
+        if (carry_last && state_wires_ == jobs.size()) {
+            // The first normals carry over to the same wires (the LOD's state restarts with the new layout).
+            glGetNamedBufferSubData(state_.id(), 0, static_cast<GLsizeiptr>(state.size() * sizeof(SlotState)),
+                                    state.data());
+            for (SlotState& st : state) st.lod[0] = st.lod[1] = st.lod[2] = st.lod[3] = 0;
+        }
+        auto state_buffer = engine::gfx::make_buffer(std::span<const SlotState>(state), "wire gpu slot state");
         if (!count_buffer) return Status::error(count_buffer.error().message);
         if (!state_buffer) return Status::error(state_buffer.error().message);
         counts_ = std::move(*count_buffer), state_ = std::move(*state_buffer);
@@ -740,6 +764,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
         ring_capacity_ = std::max<std::size_t>(rings, 1);
     }
     count_first_ = std::move(count_first), segments_ = std::move(segments);
+    state_wires_ = jobs.size();
     count_total_ = count_total;
     lod_ = lod != nullptr;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, curves.headers_.id());
@@ -750,11 +775,13 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, visible_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 17, curves.headers_.id());  // the "changed" wires: all (u_changed)
     program_.use();
     const auto at = [&](const char* name) { return program_.uniform_location(name); };
     glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));
     glUniform1ui(at("u_stage"), 0u);
-    glUniform1ui(at("u_changed"), 0u);
+    // Every wire is "changed" (its header's motion turns its kept first normal) when a job carries the last one.
+    glUniform1ui(at("u_changed"), carry_last ? static_cast<GLuint>(jobs.size()) : 0u);
     glUniform1i(at("u_draw"), 0);
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);

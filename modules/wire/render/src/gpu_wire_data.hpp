@@ -31,7 +31,8 @@ struct Header {
     vec4 kb;             // alpha, tension, bias, continuity (wire-wide)
     uint extra_first;    // per-node kb (a vec4 a node), then stretch (4 segments a vec4), in the extras
     uint slot;           // the wire's persistent slot (ring pass state)
-    double origin[3];    // the wire's origin, world metres
+    float origin[3];     // the wire's origin, world metres (a point with float coordinates)
+    float motion[3];     // the rotation carrying the slot's last first normal here: a unit quaternion's x, y, z
 };
 )glsl";
 
@@ -53,13 +54,13 @@ struct WireUpload {
 
 /// Appends a wire packed by wire::pack_nodes (the systems pack on their worker threads).
 void append_packed(const PackedNodes& packed, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                   WireUpload& out);
+                   const glm::vec3& motion, WireUpload& out);
 
-/// Appends one wire (validated nodes: build_curve's checks) with its header's segment_first, slot and the
-/// material and caps bits. Fails naming what is wrong (not a supported kind, too few distinct nodes); nothing is
+/// Appends one wire (validated nodes: build_curve's checks) with its header's segment_first, slot, the
+/// material and caps bits and its motion (GpuCurveHeader::motion). Fails naming what is wrong (not a supported kind, too few distinct nodes); nothing is
 /// appended then. `segments` (out): the wire's segment count.
 Status append_wire(const WireNodes& nodes, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
-                   uint32_t material, bool caps, WireUpload& out, uint32_t& segments);
+                   uint32_t material, bool caps, const glm::vec3& motion, WireUpload& out, uint32_t& segments);
 
 /// The ring program's LOD uniforms for a view and settings (LodSettings' defaults applied as update_lod does).
 void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, const LodSettings& settings);
@@ -73,6 +74,6 @@ const char* curve_source();
 /// origin with its start node's radius in w; b1 - b0 with the end node's radius; b2 - b1 with the stretch;
 /// b3 - b2), which the curve pass copies.
 void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                     WireUpload& out);
+                     const glm::vec3& motion, WireUpload& out);
 
 }  // namespace wire::render::detail

@@ -216,13 +216,15 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             uint32_t segments = 0;
             const std::size_t nodes_before = up.nodes.size(), extras_before = up.extras.size();
             if (has_curve) {
-                append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps, up);
+                append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps, item.motion,
+                                up);
                 segments = static_cast<uint32_t>(item.curve->segment_count());
             } else if (packed) {
-                append_packed(*item.packed_nodes, slot.segment_first, slot.index, item.material, item.caps, up);
+                append_packed(*item.packed_nodes, slot.segment_first, slot.index, item.material, item.caps,
+                              item.motion, up);
                 segments = static_cast<uint32_t>(item.packed_nodes->segment_count());
             } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
-                                    item.caps, up, segments)) {
+                                    item.caps, item.motion, up, segments)) {
                 ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build yet is skipped here
                 continue;
             }

@@ -621,7 +621,8 @@ void lod_system(Registry& registry, WireContext& ctx) {
         // The nodes path: the GPU chooses counts and sides. Here the cull by the sphere of the nodes (or of the
         // blended curve); a wire without a sphere (c2, automatic: unknown overshoot) is sent and culled there.
         auto& storage = registry.storage<WireLodState>();
-        const auto& curves = registry.storage<WireCurve>();  // looked up here: the workers only read it
+        const auto& curves = registry.storage<WireCurve>();
+        auto& rings = registry.storage<WireRings>();  // each item writes its own wire's motion reference  // looked up here: the workers only read it
         constexpr std::size_t kBlock = 256;  // each wire writes only its own state
         parallel_over((storage.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
             for (std::size_t i = block * kBlock; i < std::min(storage.size(), (block + 1) * kBlock); ++i) {
@@ -771,6 +772,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         constexpr std::size_t kBlock = 256;
         const auto& styles = registry.storage<Style>();  // looked up here: the workers only read them
         const auto& curves = registry.storage<WireCurve>();
+        auto& rings = registry.storage<WireRings>();  // each item writes its own wire's motion reference
         parallel_over((visible.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
           for (std::size_t v = block * kBlock; v < std::min(visible.size(), (block + 1) * kBlock); ++v) {
             const Entity e = visible[v];
@@ -791,6 +793,15 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
             }
             item.spline = spline_of(*style);
             item.nodes_generation = curve->generation;
+            WireRings* sent = rings.try_get(e);
+            if (sent != nullptr && sent->sent_curve != curve->generation) {
+                // New nodes for the renderer: how the wire moved since the last ones it got (rings_one's fit).
+                const WireNodes& nodes = curve->previous_nodes;
+                const glm::dquat q = carried_rotation(fit_motion(sent->motion, nodes));
+                item.motion = glm::vec3(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+                sent->motion = motion_reference(nodes);
+                sent->sent_curve = curve->generation;
+            }
             item.sides = style->max_sides ? std::max<uint32_t>(style->max_sides, 3) : kDefaultMaxSides;
             item.closed = style->closed;
             item.caps = caps_of(*style);

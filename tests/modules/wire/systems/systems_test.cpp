@@ -11,12 +11,15 @@
 #include <engine/ecs/registry.hpp>
 #include <engine/ecs/schedule.hpp>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -645,6 +648,54 @@ TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
     EXPECT_EQ(item_of(e)->packed_nodes->nodes, last_valid);
     w.run();
     EXPECT_TRUE(w.ctx.new_errors.empty());  // once
+}
+
+// The nodes path carries the first frame with the wire's motion: each draw item whose nodes changed holds the
+// rotation fitted from the nodes the renderer got last (carried_rotation's vector part); a rigid turn gives that
+// turn, a frame without a change (nothing sent) none, and a turn while culled is fitted across the gap.
+TEST(WireSystems, NodesPathSendsTheWiresMotion) {
+    World w;
+    w.ctx.path = UploadPath::gpu_nodes;
+    const Entity e = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.6), {.spline = {.kind = SplineKind::catmull_rom}});
+    const auto item_of = [&](Entity x) -> const DrawItem* {
+        for (const DrawItem& it : w.ctx.draw_list.items)
+            if (it.wire_id == engine::ecs::to_integral(x)) return &it;
+        return nullptr;
+    };
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    EXPECT_EQ(item_of(e)->motion, glm::vec3(0.0f));  // the first nodes: nothing to carry from
+    const glm::dvec3 pivot(-2.0, 0.0, 0.0);
+    const auto turn = [&](const glm::dquat& q, const glm::dvec3& about) {
+        for (glm::dvec3& p : edit_nodes(w.registry, e).positions) p = about + q * (p - about);
+    };
+    const glm::dquat q = glm::angleAxis(0.05, glm::normalize(glm::dvec3(1.0, 2.0, 0.5)));
+    turn(q, pivot);
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    const glm::vec3 m = item_of(e)->motion;
+    EXPECT_NEAR(m.x, q.x, 1e-6);
+    EXPECT_NEAR(m.y, q.y, 1e-6);
+    EXPECT_NEAR(m.z, q.z, 1e-6);
+    w.run();  // unchanged: not sent, no motion
+    EXPECT_EQ(item_of(e)->motion, glm::vec3(0.0f));
+    // Taken far behind the camera, turned there, brought back: the fit spans the three changes (a turn by q).
+    const auto shift = [&](double dz) {
+        for (glm::dvec3& p : edit_nodes(w.registry, e).positions) p.z += dz;
+    };
+    shift(5000.0);
+    w.run();
+    EXPECT_EQ(item_of(e), nullptr);  // culled
+    turn(q, pivot + glm::dvec3(0.0, 0.0, 5000.0));
+    w.run();
+    shift(-5000.0);
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    const glm::dquat total = q;
+    const glm::vec3 m2 = item_of(e)->motion;
+    EXPECT_NEAR(m2.x, total.x, 1e-6);
+    EXPECT_NEAR(m2.y, total.y, 1e-6);
+    EXPECT_NEAR(m2.z, total.z, 1e-6);
 }
 
 }  // namespace

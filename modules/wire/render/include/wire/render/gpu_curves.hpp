@@ -44,6 +44,9 @@ namespace wire::render {
 struct GpuCurveWire {
     const WireNodes* nodes = nullptr;  ///< validated nodes (build_curve's checks), kept alive through build()
     SplineSettings spline{};           ///< its kind and settings, closed included
+    /// The rotation carrying the wire's last first normal (kept on the GPU) to these nodes: the vector part of
+    /// wire::carried_rotation (w >= 0). Read by GpuRingPass jobs that carry the frame from the last build.
+    glm::vec3 motion{};
 };
 
 /// The per-wire record the passes read (std430, 64 bytes; its GLSL twin is in src/gpu_wire_data.hpp). Per-node
@@ -61,7 +64,10 @@ struct GpuCurveHeader {
     float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
     uint32_t extra_first = 0;  ///< first vec4 of the wire's extras
     uint32_t slot = 0;         ///< the wire's persistent slot (LOD and frame state)
-    double origin_m[3] = {0.0, 0.0, 0.0};  ///< the wire's origin (its nodes' box centre), world metres
+    float origin_m[3] = {0.0f, 0.0f, 0.0f};  ///< the wire's origin (its nodes' box centre as float_point), metres
+    /// The rotation carrying the slot's last first normal to this upload: the vector part (sin(angle / 2) axis) of
+    /// wire::carried_rotation, whose w >= 0 the GPU recovers; zero: none (the plain projection).
+    float motion[3] = {0.0f, 0.0f, 0.0f};
 };
 static_assert(sizeof(GpuCurveHeader) == 64, "GpuCurveHeader is the 64-byte std430 record");
 

@@ -11,7 +11,8 @@
 // What it computes, per ring (place_rings' placement from the per-segment counts, build_rings' quantities):
 // - centre and unit tangent from the segment (unit_tangent()'s one-sided limits where the derivative vanishes);
 // - the frame by double reflection (Wang et al. 2008) from the first normal (the carried previous normal
-//   projected onto the first tangent, else seed_normal()), through the start of every segment an interval crosses,
+//   projected onto the first tangent, else seed_normal(); on the nodes path the previous normal is the one the
+//   GPU kept, turned by the header's rotation: the wire's motion fitted on the CPU, motion.hpp), through the start of every segment an interval crosses,
 //   with compute_frames' hairpin guard (a step with an ill-conditioned second reflection or a turn over 45 degrees
 //   is bisected, at most 10 deep; an explicit stack stands in for the recursion) and, on closed loops, the
 //   holonomy spread over arc length (the loop is walked twice: first for the twist, then to write);
@@ -48,6 +49,10 @@ struct GpuRingJob {
     /// With the LOD: forget this wire's previous counts and sides (update_lod on a fresh WireLod). They are also
     /// forgotten when the build's wires or segment counts differ from the last build's.
     bool restart_lod = false;
+    /// The nodes path's carry: the previous normal is this wire's ring 0 normal of the last build (kept on the GPU
+    /// while the build has as many wires), turned by its GpuCurveWire::motion; has_previous_normal and
+    /// previous_normal are then not read. A wire without a last build is seeded.
+    bool carry_last = false;
 };
 
 /// The most radial sides the GPU LOD gives (LodSettings::max_sides above it is taken as this).
@@ -98,7 +103,7 @@ private:
     engine::gfx::Program program_;
     engine::gfx::Buffer jobs_, counts_, rings_, state_, counter_, visible_;
     std::vector<uint32_t> count_first_, segments_;  // per wire of the last build: its counts' range
-    std::size_t ring_capacity_ = 0, count_total_ = 0;
+    std::size_t ring_capacity_ = 0, count_total_ = 0, state_wires_ = 0;
     bool lod_ = false;
 };
 
