@@ -128,25 +128,47 @@ double determinacy(const dvec3* p, const double* w, uint32_t m) {
 
 }  // namespace
 
-MotionReference motion_reference(const WireNodes& nodes) {
+MotionReference motion_samples(const WireNodes& nodes) {
     MotionReference ref;
     const std::size_t n = nodes.size();
     ref.node_count = static_cast<uint32_t>(n);
     ref.by_index = nodes.ids.size() != n;
-    if (n == 0) return ref;
-    // Nodes 0, 1, 2, 3, then each step 1.5x the last, and always the last node (reference_index): the start dense,
-    // the whole wire spanned (a far node pins the rotation about a straight start). `s`: the length of the
-    // polyline through the chosen nodes (the polyline through all nodes where they are dense, at the start; beyond,
-    // chords of the sparse ones, a little short of it: it only shapes the weights, and costs 10 nodes, not n).
-    double arc[MotionReference::kCapacity];
+    // Nodes 0, 1, 2, 3, then each step 1.5x the last, and always the last node (reference_indices): the start
+    // dense, the whole wire spanned (a far node pins the rotation about a straight start).
     std::size_t at[MotionReference::kCapacity];
     ref.count = reference_indices(n, at);
+    for (uint32_t k = 0; k < ref.count; ++k) {
+        ref.position[k] = nodes.positions[at[k]];
+        ref.id[k] = ref.by_index ? static_cast<uint32_t>(at[k]) : nodes.ids[at[k]];
+    }
+    return ref;
+}
+
+bool samples_match(const MotionReference& from, const WireNodes& to) {
+    const std::size_t n = to.size();
+    if (from.count == 0 || from.node_count != n || from.by_index != (to.ids.size() != n)) return false;
+    if (from.by_index) return true;
+    std::size_t at[MotionReference::kCapacity];
+    (void)reference_indices(n, at);
+    for (uint32_t k = 0; k < from.count; ++k)
+        if (to.ids[at[k]] != from.id[k]) return false;
+    return true;
+}
+
+MotionReference motion_reference(const WireNodes& nodes) {
+    MotionReference ref = motion_samples(nodes);
+    weigh_reference(ref);
+    return ref;
+}
+
+void weigh_reference(MotionReference& ref) {
+    if (ref.count == 0) return;
+    // `s`: the length of the polyline through the reference's nodes (the polyline through all nodes where they
+    // are dense, at the start; beyond, chords of the sparse ones, a little short of it: it only shapes the weights).
+    double arc[MotionReference::kCapacity];
     double s = 0.0;
     for (uint32_t k = 0; k < ref.count; ++k) {
-        const std::size_t i = at[k];
-        if (k != 0) s += glm::length(nodes.positions[i] - ref.position[k - 1]);
-        ref.position[k] = nodes.positions[i];
-        ref.id[k] = ref.by_index ? static_cast<uint32_t>(i) : nodes.ids[i];
+        if (k != 0) s += glm::length(ref.position[k] - ref.position[k - 1]);
         arc[k] = s;
     }
     // The reach: from two elements, quadrupled until the nodes within it fix a rotation (or it spans the wire).
@@ -166,7 +188,6 @@ MotionReference motion_reference(const WireNodes& nodes) {
     }
     for (uint32_t k = 0; k < m; ++k) ref.weight[k] = static_cast<float>(w[k]);
     ref.determinacy = static_cast<float>(fixed);
-    return ref;
 }
 
 namespace {

@@ -1,6 +1,7 @@
 // The nodes path's packed nodes (packed_nodes.hpp).
 #include "wire/packed_nodes.hpp"
 
+#include "spline/merge.hpp"
 #include "spline/validate.hpp"
 
 #include <glm/common.hpp>
@@ -19,8 +20,8 @@ bool gpu_builds(SplineKind kind) {
 
 Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes& out) {
     if (!gpu_builds(spline.kind)) {
-        return Status::error("the GPU curve pass builds linear, c2 and Catmull-Rom wires (automatic wires stay on "
-                             "the CPU path for now)");
+        return Status::error("the GPU curve pass does not build this spline kind (it builds linear, Catmull-Rom, "
+                             "c2 and automatic wires)");
     }
     // check_curve_input's checks, with the merge done once (curve_nodes) for the count and the packing.
     if (Status st = curve_stage::check_settings(spline); !st) return st;
@@ -28,23 +29,23 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     const bool physics = spline.curvature_tension && !wn.theta_rad.empty() && !wn.iz_m4.empty() &&
                          !wn.length_m.empty() && !wn.delta_length_m.empty() && !wn.area_m2.empty();
     if (Status st = curve_stage::check_nodes(wn, physics); !st) return st;
-    thread_local std::vector<glm::dvec3> curve;
-    thread_local std::vector<uint32_t> source, last;
-    const std::size_t n = curve_nodes(wn, spline, curve, &source, &last);
+    // The merge as build_curve does it (curve_nodes), read in place: the merged nodes (the input's own array when
+    // nothing merges, the common case), their sources, their chords and the input's box, each computed once.
+    thread_local curve_stage::Merged merged;
+    thread_local curve_stage::Chords chords;
+    std::size_t n = 0;
+    const glm::dvec3* curve = curve_stage::merge_nodes(wn, spline, merged, chords, n);
     if (Status st = curve_stage::check_distinct(wn.size(), n, spline.closed); !st) return st;
-    // The origin: the centre of the nodes' box (float offsets then span at most half the wire).
-    glm::dvec3 lo = curve.front(), hi = curve.front();
-    double chord2 = 0.0;
-    for (std::size_t j = 0; j < n; ++j) {
-        lo = glm::min(lo, curve[j]), hi = glm::max(hi, curve[j]);
-        if (j + 1 < n || spline.closed) {
-            const glm::dvec3 d = curve[j + 1 == n ? 0 : j + 1] - curve[j];
-            chord2 = std::max(chord2, d.x * d.x + d.y * d.y + d.z * d.z);
-        }
-    }
+    const uint32_t* source = merged.first.data();
+    const uint32_t* last = merged.last.data();
+    // The origin: the centre of the nodes' box (float offsets then span at most half the wire). The input's box:
+    // the merged nodes are among the input's, so it holds them (and is theirs up to the merge tolerance).
+    const glm::dvec3 lo = merged.lo, hi = merged.hi;
+    double chord = 0.0;
+    for (std::size_t k = 1; k <= chords.segs; ++k) chord = std::max(chord, chords.len[k]);
     out.origin_m = float_point(0.5 * (lo + hi));
     out.half_diagonal_m = glm::length(glm::max(hi - out.origin_m, out.origin_m - lo));  // the box from the origin
-    out.max_chord_m = std::sqrt(chord2);
+    out.max_chord_m = chord;
     out.closed = spline.closed;
     out.kind = spline.kind;
     out.alpha = static_cast<float>(spline.alpha);
@@ -60,7 +61,8 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     if (out.per_node_kb) {
         // The per-node values build_curve reads (catmull_rom_tangents), its tension combined with the
         // curvature-driven one: t = 1 - (1 - t_user)(1 - t_curv).
-        for (const uint32_t src : source) {
+        for (std::size_t j = 0; j < n; ++j) {
+            const uint32_t src = source[j];
             const double t_user = wn.kb_tension.empty() ? spline.tension : wn.kb_tension[src];
             const double b = wn.kb_bias.empty() ? spline.bias : wn.kb_bias[src];
             const double c = wn.kb_continuity.empty() ? spline.continuity : wn.kb_continuity[src];

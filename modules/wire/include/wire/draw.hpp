@@ -68,6 +68,9 @@ struct DrawItem {
     /// (motion.hpp), which turns the first frame kept on the GPU as the CPU path's carried_frames turns its own.
     /// Zero: none known (the first frame is the last one projected onto the new first tangent).
     glm::vec3 motion{};
+    /// Instead of `motion`: the GPU fits it against the nodes it got last for this wire, by index (wire::
+    /// samples_match says when that equals fit_motion's match by id; the nodes must be packed without merging).
+    bool fit_motion = false;
 
     uint32_t sides = 8;      ///< radial sides of a tube (>= 3); 2 = camera-facing strip, 1 = one-pixel AA line
     bool closed = false;     ///< closed loop (the last ring connects back to the first)

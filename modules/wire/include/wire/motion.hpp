@@ -47,8 +47,19 @@ struct MotionReference {
     bool by_index = false;                          ///< the state had no ids: nodes are matched by index
 };
 
-/// The reference of `nodes` (positions finite; any count, 0 gives an empty reference).
+/// The reference of `nodes` (positions finite; any count, 0 gives an empty reference): motion_samples, then
+/// weigh_reference.
 [[nodiscard]] MotionReference motion_reference(const WireNodes& nodes);
+
+/// The reference's nodes alone (positions, ids, counts), weights and determinacy left 0: a copy of 10 nodes, for a
+/// caller that fits only now and then (the nodes path, whose GPU fits the common case).
+[[nodiscard]] MotionReference motion_samples(const WireNodes& nodes);
+/// The weights and determinacy of a reference made by motion_samples (they depend on its nodes only).
+void weigh_reference(MotionReference& reference);
+
+/// Whether the nodes of `to` at the reference's node indices carry the reference's ids (or, without ids, whether
+/// `to` has as many nodes): then matching by index is fit_motion's match by id.
+[[nodiscard]] bool samples_match(const MotionReference& from, const WireNodes& to);
 
 /// The rotation fitted from `from` to the matching nodes of `to`, and how well the nodes determine it.
 struct MotionFit {

@@ -31,8 +31,14 @@ layout(std430, binding = 3) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per n
 layout(std430, binding = 4) readonly buffer Extras { vec4 extras[]; };
 // u_persist: each wire's header goes on to its slot (the ring pass reads it there every frame).
 layout(std430, binding = 6) writeonly buffer SlotHeaders { Header slot_headers[]; };
+// u_motion: per slot, the motion reference of its last upload (motion_reference's samples of its curve nodes:
+// origin.xyz the upload's origin, origin.w the determinacy; counts.x samples, counts.y nodes, 0 samples: none;
+// p[k].xyz the sample's offset from the origin, p[k].w its weight).
+struct MotionRef { vec4 origin; uvec4 counts; vec4 p[10]; };
+layout(std430, binding = 7) buffer MotionRefs { MotionRef refs[]; };
 uniform uint u_wires;
 uniform bool u_persist;
+uniform bool u_motion;
 
 vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
 
@@ -247,10 +253,168 @@ void put_segment(Header h, uint k, vec3 p0, vec3 t0, vec3 t1, vec3 chord_k) {
     segments[s + 3u] = vec4(t1 / 3.0, 0.0);
 }
 
+// The wire's motion since its last upload (kFitMotion), as wire/motion.cpp fits it on the CPU: the reference
+// (motion_reference: nodes 0, 1, 2, 3, then steps growing 1.5x, the last node; weights (1 + s / 4l)^-4 with the
+// reach l grown 4x from two elements until the determinacy 2 e2 / e1^2 reaches 1e-3), Horn's weighted fit (the
+// top eigenvector of his 4x4 matrix by Theobald's characteristic polynomial: Newton from the spread, then the
+// adjugate's largest column), the confidence smoothstep(1e-4, 1e-3, determinacy) and carried_rotation's fraction
+// of the angle. In double, from the float offsets (differences of two uploads' origins in double). Matched by
+// index: the CPU asks for this only when the nodes were not merged and the ids at the samples sat where they sit.
+uint ref_indices(uint n, out uint at[10]) {
+    uint i = 0u, step = 1u, count = 0u;
+    for (;;) {
+        at[count++] = i;
+        if (i + 1u >= n || count == 10u) return count;
+        if (i >= 3u) step = max(step + 1u, (step * 3u) / 2u);
+        i = count + 1u == 10u ? n - 1u : min(n - 1u, i + step);
+    }
+}
+double determinacy(dvec3 p[10], double wt[10], uint m) {
+    double wsum = 0.0lf;
+    dvec3 c = dvec3(0.0lf);
+    for (uint k = 0u; k < m; ++k) wsum += wt[k], c += wt[k] * p[k];
+    if (!(wsum > 0.0lf)) return 0.0lf;
+    c /= wsum;
+    double xx = 0.0lf, yy = 0.0lf, zz = 0.0lf, xy = 0.0lf, xz = 0.0lf, yz = 0.0lf;
+    for (uint k = 0u; k < m; ++k) {
+        dvec3 d = p[k] - c;
+        xx += wt[k] * d.x * d.x, yy += wt[k] * d.y * d.y, zz += wt[k] * d.z * d.z;
+        xy += wt[k] * d.x * d.y, xz += wt[k] * d.x * d.z, yz += wt[k] * d.y * d.z;
+    }
+    double e1 = xx + yy + zz, e2 = xx * yy - xy * xy + xx * zz - xz * xz + yy * zz - yz * yz;
+    if (!(e1 > 0.0lf)) return 0.0lf;
+    return max(0.0lf, 2.0lf * e2 / (e1 * e1));
+}
+MotionRef make_ref(Header h) {
+    MotionRef r;
+    uint at[10];
+    uint m = ref_indices(h.node_count, at);
+    r.counts = uvec4(m, h.node_count, 0u, 0u);
+    dvec3 p[10];
+    double arc[10], wt[10];
+    double s = 0.0lf;
+    for (uint k = 0u; k < 10u; ++k) {
+        p[k] = dvec3(0.0lf), arc[k] = 0.0lf, wt[k] = 0.0lf;
+        if (k >= m) continue;
+        p[k] = dvec3(node(h, at[k]));
+        if (k != 0u) s += length(p[k] - p[k - 1u]);
+        arc[k] = s;
+    }
+    double whole = arc[m - 1u], reach = max(arc[min(2u, m - 1u)], 1e-300lf), det = 0.0lf;
+    for (;;) {
+        for (uint k = 0u; k < m; ++k) {
+            double q = 1.0lf / (1.0lf + arc[k] / (4.0lf * reach));
+            wt[k] = (q * q) * (q * q);
+        }
+        det = determinacy(p, wt, m);
+        if (det >= 1e-3lf || !(reach < whole)) break;
+        reach *= 4.0lf;
+    }
+    r.origin = vec4(h.origin[0], h.origin[1], h.origin[2], float(det));
+    for (uint k = 0u; k < 10u; ++k) r.p[k] = vec4(vec3(p[k]), float(wt[k]));
+    return r;
+}
+double minor3(dmat4 a, int r, int c) {
+    dmat3 s;
+    int ii = 0;
+    for (int i = 0; i < 4; ++i) {
+        if (i == r) continue;
+        int jj = 0;
+        for (int j = 0; j < 4; ++j) {
+            if (j == c) continue;
+            s[ii][jj] = a[i][j];
+            ++jj;
+        }
+        ++ii;
+    }
+    return determinant(s);
+}
+// The unit quaternion (x, y, z, w) turning the state `from` into `to` (identity where fit_motion gives none).
+vec4 fit_motion(MotionRef from, MotionRef to) {
+    const vec4 none = vec4(0.0, 0.0, 0.0, 1.0);
+    uint m = from.counts.x;
+    if (m < 3u || from.counts.y != to.counts.y || to.counts.x != m) return none;
+    dvec3 shift = dvec3(to.origin.xyz) - dvec3(from.origin.xyz);
+    bool moved = false;
+    for (uint k = 0u; k < m; ++k) moved = moved || dvec3(to.p[k].xyz) + shift != dvec3(from.p[k].xyz);
+    if (!moved) return none;
+    double t = clamp((double(from.origin.w) - 1e-4lf) / (1e-3lf - 1e-4lf), 0.0lf, 1.0lf);
+    double confidence = t * t * (3.0lf - 2.0lf * t);
+    if (!(confidence > 0.0lf)) return none;
+    double wsum = 0.0lf;
+    dvec3 ca = dvec3(0.0lf), cb = dvec3(0.0lf);
+    for (uint k = 0u; k < m; ++k) {
+        double wk = double(from.p[k].w);
+        wsum += wk, ca += wk * dvec3(from.p[k].xyz), cb += wk * (dvec3(to.p[k].xyz) + shift);
+    }
+    if (!(wsum > 0.0lf)) return none;
+    ca /= wsum, cb /= wsum;
+    dmat3 S = dmat3(0.0lf);  // S[r][c] = sum w x_r y_c
+    double spread = 0.0lf;
+    for (uint k = 0u; k < m; ++k) {
+        double wk = double(from.p[k].w);
+        dvec3 x = dvec3(from.p[k].xyz) - ca, y = dvec3(to.p[k].xyz) + shift - cb;
+        spread += 0.5lf * wk * (dot(x, x) + dot(y, y));
+        for (int r = 0; r < 3; ++r) S[r] += wk * x[r] * y;
+    }
+    if (!(spread > 0.0lf)) return none;
+    double sxx = S[0][0], sxy = S[0][1], sxz = S[0][2], syx = S[1][0], syy = S[1][1], syz = S[1][2],
+           szx = S[2][0], szy = S[2][1], szz = S[2][2];
+    dmat4 N = dmat4(sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,
+                    syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,
+                    szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy,
+                    sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz);
+    dmat4 N2 = N * N;
+    double tr2 = 0.0lf, tr3 = 0.0lf;
+    dmat4 N3 = N2 * N;
+    for (int i = 0; i < 4; ++i) tr2 += N2[i][i], tr3 += N3[i][i];
+    double c2 = -0.5lf * tr2, c1 = -tr3 / 3.0lf, c0 = determinant(N);
+    double x = spread;
+    for (int it = 0; it < 60; ++it) {
+        double x2 = x * x;
+        double p = (x2 + c2) * x2 + c1 * x + c0, dp = 4.0lf * x2 * x + 2.0lf * c2 * x + c1;
+        if (!(dp != 0.0lf)) break;
+        double step = p / dp;
+        x -= step;
+        if (!(abs(step) > 1e-15lf * abs(x))) break;
+    }
+    dmat4 A = N - x * dmat4(1.0lf);
+    int j = 0;
+    double diag = -1.0lf;
+    for (int k = 0; k < 4; ++k) {
+        double d = abs(minor3(A, k, k));
+        if (d > diag) diag = d, j = k;
+    }
+    dvec4 q;
+    for (int i = 0; i < 4; ++i) q[i] = (((i + j) & 1) != 0 ? -1.0lf : 1.0lf) * minor3(A, j, i);
+    double len = length(q);
+    if (!(len > 0.0lf)) return none;
+    q /= len;
+    if (q.x < 0.0lf) q = -q;  // (w, x, y, z): the shorter way round
+    vec4 rot = vec4(vec3(q.yzw), float(q.x));
+    if (confidence >= 1.0lf) return rot;
+    // carried_rotation: a fraction of the angle about the same axis.
+    float sin_half = length(rot.xyz);
+    if (!(sin_half > 0.0)) return none;
+    float half_angle = atan(sin_half, rot.w) * float(confidence);
+    return vec4(sin(half_angle) * (rot.xyz / sin_half), cos(half_angle));
+}
+
 void main() {
     uint w = gl_GlobalInvocationID.x;
     if (w >= u_wires) return;
     Header h = headers[w];
+    if (u_persist && u_motion) {
+        // This upload's reference (none for given segments) and, when asked, the motion fitted against the last.
+        MotionRef to;
+        to.counts = uvec4(0u);
+        if ((h.flags & kGivenSegments) == 0u) to = make_ref(h);
+        if ((h.flags & kFitMotion) != 0u) {
+            vec4 q = fit_motion(refs[h.slot], to);
+            h.motion[0] = q.x, h.motion[1] = q.y, h.motion[2] = q.z;
+        }
+        refs[h.slot] = to;
+    }
     if (u_persist) slot_headers[h.slot] = h;
     if ((h.flags & kGivenSegments) != 0u) {  // a blended curve: its segments as they came
         uint segs = (h.flags & 1u) != 0u ? h.node_count : h.node_count - 1u;
@@ -346,10 +510,10 @@ std::string with_wire_header(const char* source) {
     return s;
 }
 
-void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                   const glm::vec3& motion, WireUpload& out) {
+GpuCurveHeader packed_header(const PackedNodes& p, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
+                             const WireMotion& motion, uint32_t node_first, uint32_t extra_first) {
     GpuCurveHeader h;
-    h.node_first = static_cast<uint32_t>(out.nodes.size());
+    h.node_first = node_first;
     h.node_count = static_cast<uint32_t>(p.nodes.size());
     h.segment_first = segment_first;
     const uint32_t kind = p.kind == SplineKind::linear      ? kKindLinear
@@ -358,20 +522,27 @@ void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, 
                                                             : kKindCatmullRom;
     h.flags = (p.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
               (p.per_node_kb ? kHeaderPerNode : 0u) | (p.stretch ? kHeaderStretch : 0u) |
-              (material << kHeaderMaterialShift);
+              (motion.fit ? kHeaderFitMotion : 0u) | (material << kHeaderMaterialShift);
     h.alpha = p.alpha, h.tension = p.tension, h.bias = p.bias, h.continuity = p.continuity;
-    h.extra_first = static_cast<uint32_t>(out.extras.size());
+    h.extra_first = extra_first;
     h.slot = slot;
     h.origin_m[0] = static_cast<float>(p.origin_m.x), h.origin_m[1] = static_cast<float>(p.origin_m.y),
     h.origin_m[2] = static_cast<float>(p.origin_m.z);  // exact: pack_nodes made it a float_point
-    h.motion[0] = motion.x, h.motion[1] = motion.y, h.motion[2] = motion.z;
-    out.headers.push_back(h);
+    h.motion[0] = motion.rotation.x, h.motion[1] = motion.rotation.y, h.motion[2] = motion.rotation.z;
+    return h;
+}
+
+void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
+                   const WireMotion& motion, WireUpload& out) {
+    out.headers.push_back(packed_header(p, segment_first, slot, material, caps, motion,
+                                        static_cast<uint32_t>(out.nodes.size()),
+                                        static_cast<uint32_t>(out.extras.size())));
     out.nodes.insert(out.nodes.end(), p.nodes.begin(), p.nodes.end());
     out.extras.insert(out.extras.end(), p.extras.begin(), p.extras.end());
 }
 
 Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
-                   uint32_t material, bool caps, const glm::vec3& motion, WireUpload& out, uint32_t& segments) {
+                   uint32_t material, bool caps, const WireMotion& motion, WireUpload& out, uint32_t& segments) {
     thread_local PackedNodes packed;
     if (Status st = pack_nodes(wn, spline, packed); !st) return st;
     append_packed(packed, segment_first, slot, material, caps, motion, out);
@@ -380,7 +551,7 @@ Status append_wire(const WireNodes& wn, const SplineSettings& spline, uint32_t s
 }
 
 void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                     const glm::vec3& motion, WireUpload& out) {
+                     const WireMotion& motion, WireUpload& out) {
     glm::dvec3 lo = curve.segments.front().b0, hi = lo;
     for (const CubicBezier& c : curve.segments) {
         for (const glm::dvec3* p : {&c.b0, &c.b1, &c.b2, &c.b3}) lo = glm::min(lo, *p), hi = glm::max(hi, *p);
@@ -395,7 +566,7 @@ void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, 
     h.slot = slot;
     h.origin_m[0] = static_cast<float>(origin.x), h.origin_m[1] = static_cast<float>(origin.y),
     h.origin_m[2] = static_cast<float>(origin.z);
-    h.motion[0] = motion.x, h.motion[1] = motion.y, h.motion[2] = motion.z;
+    h.motion[0] = motion.rotation.x, h.motion[1] = motion.rotation.y, h.motion[2] = motion.rotation.z;
     out.headers.push_back(h);
     const std::size_t n = curve.radius_m.size();
     const auto radius = [&](std::size_t j) { return n == 0 ? kDefaultWireRadius_m : curve.radius_m[j % n]; };
@@ -422,7 +593,7 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
         if (wire.nodes == nullptr) return Status::error(name + "no nodes");
         uint32_t segs = 0;
         if (Status st = detail::append_wire(*wire.nodes, wire.spline, segment_first, static_cast<uint32_t>(w), 0,
-                                            true, wire.motion, up, segs);
+                                            true, {wire.motion, wire.fit_motion}, up, segs);
             !st) {
             return Status::error(name + st.message);
         }
@@ -452,14 +623,26 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     }
     headers_ = std::move(*headers), nodes_ = std::move(*nodes), segments_ = std::move(*segments);
     scratch_ = std::move(*scratch), extras_ = std::move(*extra_buffer);
+    if (motion_ref_wires_ != wires.size() || !motion_refs_) {  // the wires' references, kept for the next build
+        auto refs = engine::gfx::make_buffer({.size_bytes = wires.size() * detail::kMotionRefBytes,
+                                              .label = "wire gpu curve motion references"});
+        if (!refs) return Status::error(refs.error().message);
+        motion_refs_ = std::move(*refs);
+        glClearNamedBufferData(motion_refs_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        motion_ref_wires_ = wires.size();
+    }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, extras_.id());
+    // Slot w is wire w: the headers go back onto themselves (with the motion the GPU fitted), the references stay.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, motion_refs_.id());
     program_.use();
     glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(wires.size()));
-    glUniform1i(program_.uniform_location("u_persist"), 0);
+    glUniform1i(program_.uniform_location("u_persist"), 1);
+    glUniform1i(program_.uniform_location("u_motion"), 1);
     glDispatchCompute(static_cast<GLuint>((wires.size() + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);

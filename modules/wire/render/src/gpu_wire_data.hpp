@@ -9,6 +9,7 @@
 
 #include "engine/gfx/resources.hpp"
 
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 #include <cstdint>
@@ -19,14 +20,15 @@ namespace wire::render::detail {
 
 /// GpuCurveHeader in GLSL (std430, 64 bytes) and its flag bits; `GPU_WIRE_HEADER` in a source is replaced by it.
 inline constexpr const char* kWireHeaderGlsl = R"glsl(
-const uint kClosed = 1u, kCaps = 8u, kHasPerNode = 16u, kHasStretch = 32u, kGivenSegments = 64u;
+const uint kClosed = 1u, kCaps = 8u, kHasPerNode = 16u, kHasStretch = 32u, kGivenSegments = 64u, kFitMotion = 128u;
 struct Header {
     uint node_first;     // this frame's curve nodes (the curve pass reads them)
     uint node_count;     // curve nodes (merged)
     uint segment_first;  // the wire's segments, and its per-segment ring counts
     uint flags;          // bit 0 closed; 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2, 3 automatic); 3 caps; 4 per-node
                          // values (kb, or the automatic spline's weights);
-                         // 5 stretch; 6 the segments are given (4 vec4 each at node_first); 8-15 the wire's
+                         // 5 stretch; 6 the segments are given (4 vec4 each at node_first); 7 the motion is
+                         // fitted on the GPU (the curve pass writes it); 8-15 the wire's
                          // most sides (0: the LOD settings'); 16-31 material
     vec4 kb;             // alpha, tension, bias, continuity (wire-wide)
     uint extra_first;    // per-node kb (a vec4 a node), then stretch (4 segments a vec4), in the extras
@@ -40,9 +42,17 @@ struct Header {
 std::string with_wire_header(const char* source);
 
 inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u,
-                          kHeaderGivenSegments = 64u;
+                          kHeaderGivenSegments = 64u, kHeaderFitMotion = 128u;
+/// The curve pass's per-slot motion reference (GLSL MotionRef): 12 vec4.
+inline constexpr std::size_t kMotionRefBytes = 192;
 inline constexpr uint32_t kHeaderKindShift = 1u, kHeaderMaterialShift = 16u;
 inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u, kKindAutomatic = 3u;
+
+/// A wire's motion since its last upload: the rotation (GpuCurveHeader::motion), or the GPU fits it.
+struct WireMotion {
+    glm::vec3 rotation{};
+    bool fit = false;
+};
 
 /// One frame's upload of wires for the curve pass.
 struct WireUpload {
@@ -52,15 +62,19 @@ struct WireUpload {
     void clear() { headers.clear(), nodes.clear(), extras.clear(); }
 };
 
+/// The header of a wire packed by wire::pack_nodes, its nodes and extras at node_first and extra_first.
+GpuCurveHeader packed_header(const PackedNodes& packed, uint32_t segment_first, uint32_t slot, uint32_t material,
+                             bool caps, const WireMotion& motion, uint32_t node_first, uint32_t extra_first);
+
 /// Appends a wire packed by wire::pack_nodes (the systems pack on their worker threads).
 void append_packed(const PackedNodes& packed, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                   const glm::vec3& motion, WireUpload& out);
+                   const WireMotion& motion, WireUpload& out);
 
 /// Appends one wire (validated nodes: build_curve's checks) with its header's segment_first, slot, the
 /// material and caps bits and its motion (GpuCurveHeader::motion). Fails naming what is wrong (not a supported kind, too few distinct nodes); nothing is
 /// appended then. `segments` (out): the wire's segment count.
 Status append_wire(const WireNodes& nodes, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
-                   uint32_t material, bool caps, const glm::vec3& motion, WireUpload& out, uint32_t& segments);
+                   uint32_t material, bool caps, const WireMotion& motion, WireUpload& out, uint32_t& segments);
 
 /// The ring program's LOD uniforms for a view and settings (LodSettings' defaults applied as update_lod does).
 void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, const LodSettings& settings);
@@ -74,6 +88,6 @@ const char* curve_source();
 /// origin with its start node's radius in w; b1 - b0 with the end node's radius; b2 - b1 with the stretch;
 /// b3 - b2), which the curve pass copies.
 void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
-                     const glm::vec3& motion, WireUpload& out);
+                     const WireMotion& motion, WireUpload& out);
 
 }  // namespace wire::render::detail

@@ -8,6 +8,8 @@
 #include "wire/render/upload_plan.hpp"
 
 #include <epoxy/gl.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstring>
@@ -61,7 +63,7 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
 
 std::size_t NodePath::gl_buffers() const {
     std::size_t n = 0;
-    for (const gfx::Buffer* b : {&slot_headers_, &slot_state_, &segments_, &counts_, &scratch_, &jobs_, &draws_, &chunks_,
+    for (const gfx::Buffer* b : {&slot_headers_, &slot_state_, &motion_refs_, &segments_, &counts_, &scratch_, &jobs_, &draws_, &chunks_,
                                  &rings_, &buckets_, &commands_, &counter_, &templates_, &readback_, &visible_kept_}) {
         n += b->id() != 0 ? 1 : 0;
     }
@@ -90,6 +92,12 @@ Status NodePath::grow_slots(std::size_t slots) {
     const std::size_t old = slot_state_bytes_;
     if (Status st = ensure(slot_state_, slot_state_bytes_, want * kSlotStateBytes, "wire nodes: slot state", true); !st) return st;
     if (slot_state_bytes_ > old) clear_range(slot_state_, old, slot_state_bytes_ - old);
+    const std::size_t old_refs = motion_ref_bytes_;
+    if (Status st = ensure(motion_refs_, motion_ref_bytes_, want * kMotionRefBytes, "wire nodes: motion references", true);
+        !st) {
+        return st;
+    }
+    if (motion_ref_bytes_ > old_refs) clear_range(motion_refs_, old_refs, motion_ref_bytes_ - old_refs);
     slot_capacity_ = want;
     return Status::success();
 }
@@ -178,8 +186,10 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         const auto* seen = static_cast<const uint32_t*>(readback_map_) + 2 * (frame_ % kReadbackSlots);
         if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::size_t{seen[0]} * 3 / 2;
     }
-    thread_local WireUpload up;
+    thread_local WireUpload up;  // headers, and the nodes made here (not packed by the systems)
     up.clear();
+    node_pieces_.clear(), extra_pieces_.clear();
+    std::size_t node_total = 0, extra_total = 0;  // vec4s in the region's node and extra arrays
     visible_slots_.clear();
     material_used_.assign(ctx.materials.size(), 0);
     std::size_t segments_visible = 0;
@@ -209,24 +219,45 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
                 free_slots_.pop_back();
             }
             clear_range(slot_state_, slot.index * kSlotStateBytes, kSlotStateBytes);
+            clear_range(motion_refs_, slot.index * kMotionRefBytes, 32);  // no reference: nothing to fit against
         }
         slot.last_frame = frame_;
         const bool changed = i < changed_item_.size() && changed_item_[i] != 0;
         if (changed) {
             uint32_t segments = 0;
             const std::size_t nodes_before = up.nodes.size(), extras_before = up.extras.size();
-            if (has_curve) {
-                append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps, item.motion,
-                                up);
-                segments = static_cast<uint32_t>(item.curve->segment_count());
-            } else if (packed) {
-                append_packed(*item.packed_nodes, slot.segment_first, slot.index, item.material, item.caps,
-                              item.motion, up);
-                segments = static_cast<uint32_t>(item.packed_nodes->segment_count());
-            } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
-                                    item.caps, item.motion, up, segments)) {
-                ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build yet is skipped here
-                continue;
+            const std::size_t node_pieces_before = node_pieces_.size(), extra_pieces_before = extra_pieces_.size();
+            const std::size_t node_total_before = node_total, extra_total_before = extra_total;
+            if (packed) {
+                // Packed by the systems: the header here, the nodes copied straight from them into the region.
+                const PackedNodes& p = *item.packed_nodes;
+                up.headers.push_back(packed_header(p, slot.segment_first, slot.index, item.material, item.caps,
+                                                   {item.motion, item.fit_motion}, static_cast<uint32_t>(node_total),
+                                                   static_cast<uint32_t>(extra_total)));
+                node_pieces_.push_back({p.nodes.data(), 0, p.nodes.size(), node_total});
+                node_total += p.nodes.size();
+                if (!p.extras.empty()) {
+                    extra_pieces_.push_back({p.extras.data(), 0, p.extras.size(), extra_total});
+                    extra_total += p.extras.size();
+                }
+                segments = static_cast<uint32_t>(p.segment_count());
+            } else {
+                // Made here (a blended curve's segments; nodes not packed by the systems): into `up`, then copied.
+                if (has_curve) {
+                    append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps,
+                                    {item.motion, false}, up);
+                    segments = static_cast<uint32_t>(item.curve->segment_count());
+                } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
+                                        item.caps, {item.motion, item.fit_motion}, up, segments)) {
+                    ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build is skipped here
+                    continue;
+                }
+                GpuCurveHeader& h = up.headers.back();
+                h.node_first = static_cast<uint32_t>(node_total), h.extra_first = static_cast<uint32_t>(extra_total);
+                node_pieces_.push_back({nullptr, nodes_before, up.nodes.size() - nodes_before, node_total});
+                node_total += up.nodes.size() - nodes_before;
+                extra_pieces_.push_back({nullptr, extras_before, up.extras.size() - extras_before, extra_total});
+                extra_total += up.extras.size() - extras_before;
             }
             // The wire's most sides (the LOD's max_sides for it; its Style's): header bits 8-15.
             up.headers.back().flags |= std::min<uint32_t>(std::max<uint32_t>(item.sides, 3u), 255u) << 8;
@@ -236,6 +267,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
                 if (!allocate_segments(segments, first)) {
                     up.headers.pop_back();
                     up.nodes.resize(nodes_before), up.extras.resize(extras_before);
+                    node_pieces_.resize(node_pieces_before), extra_pieces_.resize(extra_pieces_before);
+                    node_total = node_total_before, extra_total = extra_total_before;
                     slot.segments = 0, slot.built = false;
                     ++stats.wires_skipped;
                     continue;
@@ -270,26 +303,41 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     if (visible_ == 0) return false;
 
     // The region: headers | nodes | extras | visible slots of the unchanged wires.
-    const std::size_t real_extra_bytes = up.extras.size() * sizeof(glm::vec4);
-    if (up.extras.empty()) up.extras.emplace_back(0.0f);
-    if (up.nodes.empty()) up.nodes.emplace_back(0.0f);
+    const std::size_t real_node_bytes = node_total * sizeof(glm::vec4);
+    const std::size_t real_extra_bytes = extra_total * sizeof(glm::vec4);
     const std::size_t header_bytes = std::max<std::size_t>(up.headers.size() * sizeof(GpuCurveHeader), 64);
-    const std::size_t node_bytes = up.nodes.size() * sizeof(glm::vec4);
-    const std::size_t extra_bytes = up.extras.size() * sizeof(glm::vec4);
+    const std::size_t node_bytes = std::max<std::size_t>(real_node_bytes, sizeof(glm::vec4));
+    const std::size_t extra_bytes = std::max<std::size_t>(real_extra_bytes, sizeof(glm::vec4));
     const std::size_t visible_bytes = std::max<std::size_t>(visible_slots_.size() * 4, 4);
     const std::size_t node_at = align_up(header_bytes), extra_at = node_at + align_up(node_bytes);
     const std::size_t visible_at = extra_at + align_up(extra_bytes);
     std::byte* base = region.data;
     if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
-    std::memcpy(base + node_at, up.nodes.data(), node_bytes);
-    std::memcpy(base + extra_at, up.extras.data(), extra_bytes);
+    // The nodes, copied once from where they are (the systems' packed nodes) into the region: on worker threads
+    // when there are many (the one per-byte cost of the frame on the render thread).
+    const auto copy = [&](const std::vector<Piece>& pieces, const std::vector<glm::vec4>& own, std::byte* to,
+                          std::size_t first, std::size_t last) {
+        for (std::size_t k = first; k < last; ++k) {
+            const Piece& piece = pieces[k];
+            const glm::vec4* from = piece.src != nullptr ? piece.src : own.data() + piece.own;
+            if (piece.count != 0) std::memcpy(to + piece.dst * sizeof(glm::vec4), from, piece.count * sizeof(glm::vec4));
+        }
+    };
+    if (real_node_bytes >= (std::size_t{256} << 10) && node_pieces_.size() >= 64) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_pieces_.size(), 32), [&](const auto& r) {
+            copy(node_pieces_, up.nodes, base + node_at, r.begin(), r.end());
+        });
+    } else {
+        copy(node_pieces_, up.nodes, base + node_at, 0, node_pieces_.size());
+    }
+    copy(extra_pieces_, up.extras, base + extra_at, 0, extra_pieces_.size());
     // The list of unchanged visible wires stays on the GPU while it is the same (a still scene, or still wires
     // under a camera that keeps them in view): then nothing is sent for them.
     const bool same_list = visible_slots_ == last_visible_ && visible_kept_.id() != 0;
     if (!same_list && !visible_slots_.empty()) {
         std::memcpy(base + visible_at, visible_slots_.data(), visible_slots_.size() * 4);
     }
-    stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + node_bytes : 0) +
+    stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + real_node_bytes : 0) +
                            real_extra_bytes + (same_list ? 0 : visible_slots_.size() * 4);
     const auto range = [&](GLuint binding, std::size_t offset, std::size_t bytes) {
         glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, region.buffer,
@@ -302,7 +350,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     materials_ = ctx.materials.size();
     const std::size_t buckets = materials_ * side_slots_ * 6;
     const std::size_t chunk_capacity = ring_capacity_ / kChunkBands + 6 * visible_ + 1;
-    std::size_t scratch_nodes = changed_ ? up.nodes.size() : 1;
+    std::size_t scratch_nodes = changed_ ? std::max<std::size_t>(node_total, 1) : 1;
     const bool ok = ensure(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch", false) &&
                     ensure(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs", false) &&
                     ensure(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws", false) &&
@@ -343,8 +391,10 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
         range(4, extra_at, extra_bytes);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, slot_headers_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, motion_refs_.id());
         glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(changed_));
         glUniform1i(curve_program_.uniform_location("u_persist"), 1);
+        glUniform1i(curve_program_.uniform_location("u_motion"), 1);
         glDispatchCompute(static_cast<GLuint>((changed_ + 63) / 64), 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }

@@ -81,9 +81,10 @@ private:
     std::vector<std::pair<uint32_t, uint32_t>> free_ranges_;  ///< (first, count), sorted by first
     uint32_t segment_top_ = 0;                                 ///< segments in use or freed below this
     // Persistent (GPU only).
-    engine::gfx::Buffer slot_headers_, slot_state_, segments_, counts_;
+    engine::gfx::Buffer slot_headers_, slot_state_, motion_refs_, segments_, counts_;
     std::size_t slot_capacity_ = 0, segment_capacity_ = 0;
-    std::size_t slot_header_bytes_ = 0, slot_state_bytes_ = 0, segment_bytes_ = 0, count_bytes_ = 0;
+    std::size_t slot_header_bytes_ = 0, slot_state_bytes_ = 0, motion_ref_bytes_ = 0, segment_bytes_ = 0,
+                count_bytes_ = 0;
     // Per frame (GPU only; regrown as needed).
     engine::gfx::Buffer scratch_, jobs_, draws_, chunks_, rings_, buckets_, commands_, counter_, templates_, readback_;
     std::size_t scratch_bytes_ = 0, job_bytes_ = 0, draw_bytes_ = 0, chunk_bytes_ = 0, ring_bytes_ = 0,
@@ -99,6 +100,13 @@ private:
     std::vector<uint8_t> material_used_;
     std::vector<uint8_t> changed_item_;  ///< per item of the list upload_bytes() saw: it sends its nodes
     std::vector<Slot*> item_slot_;       ///< per item: its slot when upload_bytes() found one (map nodes are stable)
+    /// A run of vec4s the frame copies into the region's node (or extra) array at `dst`: from `src`, or (src null)
+    /// from the frame's own nodes at `own` (those made on the render thread).
+    struct Piece {
+        const glm::vec4* src = nullptr;
+        std::size_t own = 0, count = 0, dst = 0;
+    };
+    std::vector<Piece> node_pieces_, extra_pieces_;
     std::vector<uint32_t> visible_slots_;
     std::vector<uint32_t> last_visible_;  ///< the list kept on the GPU (visible_kept_): unchanged, it is not sent
     engine::gfx::Buffer visible_kept_;

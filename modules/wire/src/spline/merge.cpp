@@ -94,6 +94,7 @@ const dvec3* merge_nodes(const WireNodes& w, const SplineSettings& s, Merged& m,
     const std::size_t n = w.positions.size();
     dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
     bbox_kernel(n ? &w.positions[0].x : nullptr, n, &lo.x, &hi.x);
+    m.lo = lo, m.hi = hi;
     const double diag = n ? glm::length(hi - lo) : 0.0;
     const double max_abs = n ? std::max(glm::length(lo), glm::length(hi)) : 0.0;
     const double rel = s.merge_epsilon_rel > 0.0 ? s.merge_epsilon_rel : 1e-9;

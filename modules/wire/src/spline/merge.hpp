@@ -19,6 +19,7 @@ struct Merged {
     std::vector<dvec3> p;
     std::vector<uint32_t> first, last;
     bool identity = false;  // first and last hold 0 .. size-1 (nothing merged): kept for the next wire of that size
+    dvec3 lo{0.0}, hi{0.0};  // the input nodes' box (merge_nodes' last call)
 };
 
 // Segment chords, structure of arrays. Segment k is at index k + 1; index 0 repeats the last segment and index

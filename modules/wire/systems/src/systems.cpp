@@ -494,6 +494,22 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         // The nodes path: the GPU builds the curve from the nodes. Here only build_curve's checks, the sphere the
         // CPU culls with (from the nodes), and the pop-free blend, whose blended curve is drawn while it lasts.
         parallel_over(jobs.size(), [&](std::size_t i) {
+            // Memory, not arithmetic, bounds this path: the components of the wire 4 ahead, then the arrays of
+            // the wire 2 ahead (through its components, fetched 2 wires ago), come in while this one packs.
+            if (i + 4 < jobs.size()) {
+                prefetch_lines<false>(jobs[i + 4].nodes, sizeof(WireNodes));
+                prefetch_lines<true>(&jobs[i + 4].curve->previous_nodes, sizeof(WireNodes));
+                prefetch_lines<true>(&jobs[i + 4].curve->packed, sizeof(PackedNodes));
+                prefetch_lines<true>(jobs[i + 4].curve, 64);
+            }
+            if (i + 2 < jobs.size()) {
+                const WireCurve& ahead = *jobs[i + 2].curve;
+                const WireNodes& nodes = *jobs[i + 2].nodes;
+                prefetch_lines<false>(nodes.positions.data(), nodes.positions.size() * sizeof(glm::dvec3));
+                prefetch_lines<true>(ahead.previous_nodes.positions.data(),
+                                     ahead.previous_nodes.positions.size() * sizeof(glm::dvec3));
+                prefetch_lines<true>(ahead.packed.nodes.data(), ahead.packed.nodes.size() * sizeof(glm::vec4));
+            }
             CurveJob& job = jobs[i];
             Step step;
             prepare(job, step);
@@ -621,8 +637,7 @@ void lod_system(Registry& registry, WireContext& ctx) {
         // The nodes path: the GPU chooses counts and sides. Here the cull by the sphere of the nodes (or of the
         // blended curve); a wire without a sphere (c2, automatic: unknown overshoot) is sent and culled there.
         auto& storage = registry.storage<WireLodState>();
-        const auto& curves = registry.storage<WireCurve>();
-        auto& rings = registry.storage<WireRings>();  // each item writes its own wire's motion reference  // looked up here: the workers only read it
+        const auto& curves = registry.storage<WireCurve>();  // looked up here: the workers only read it
         constexpr std::size_t kBlock = 256;  // each wire writes only its own state
         parallel_over((storage.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
             for (std::size_t i = block * kBlock; i < std::min(storage.size(), (block + 1) * kBlock); ++i) {
@@ -774,7 +789,19 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         const auto& curves = registry.storage<WireCurve>();
         auto& rings = registry.storage<WireRings>();  // each item writes its own wire's motion reference
         parallel_over((visible.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
-          for (std::size_t v = block * kBlock; v < std::min(visible.size(), (block + 1) * kBlock); ++v) {
+          const std::size_t end = std::min(visible.size(), (block + 1) * kBlock);
+          for (std::size_t v = block * kBlock; v < end; ++v) {
+            // The components of the wire 4 ahead (out of the cache since the curve stage): fetched meanwhile.
+            if (v + 4 < end) {
+                const Entity ahead = visible[v + 4];
+                if (const WireCurve* c = curves.try_get(ahead)) {
+                    prefetch_lines<false>(c, 64);
+                    prefetch_lines<false>(&c->previous_nodes, sizeof(WireNodes));
+                    prefetch_lines<false>(&c->packed, sizeof(PackedNodes));
+                }
+                if (const WireRings* r = rings.try_get(ahead)) prefetch_lines<true>(&r->motion, sizeof(MotionReference) + 16);
+                if (const Style* s = styles.try_get(ahead)) prefetch_lines<false>(s, sizeof(Style));
+            }
             const Entity e = visible[v];
             const Style* style = styles.try_get(e);
             const WireCurve* curve = curves.try_get(e);
@@ -795,11 +822,21 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
             item.nodes_generation = curve->generation;
             WireRings* sent = rings.try_get(e);
             if (sent != nullptr && sent->sent_curve != curve->generation) {
-                // New nodes for the renderer: how the wire moved since the last ones it got (rings_one's fit).
+                // New nodes for the renderer: how the wire moved since the last ones it got (rings_one's fit). The
+                // GPU fits it where matching by index is matching by id (packed nodes, none merged, now and the
+                // last time); here otherwise (an id event, merged nodes, a blended curve).
                 const WireNodes& nodes = curve->previous_nodes;
-                const glm::dquat q = carried_rotation(fit_motion(sent->motion, nodes));
-                item.motion = glm::vec3(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
-                sent->motion = motion_reference(nodes);
+                const bool unmerged = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() == nodes.size();
+                if (unmerged && sent->sent_unmerged && samples_match(sent->motion, nodes)) {
+                    item.fit_motion = true;
+                } else if (sent->motion.count != 0) {
+                    MotionReference from = sent->motion;
+                    weigh_reference(from);
+                    const glm::dquat q = carried_rotation(fit_motion(from, nodes));
+                    item.motion = glm::vec3(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+                }
+                sent->motion = motion_samples(nodes);
+                sent->sent_unmerged = unmerged;
                 sent->sent_curve = curve->generation;
             }
             item.sides = style->max_sides ? std::max<uint32_t>(style->max_sides, 3) : kDefaultMaxSides;

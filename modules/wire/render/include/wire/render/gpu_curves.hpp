@@ -47,6 +47,9 @@ struct GpuCurveWire {
     /// The rotation carrying the wire's last first normal (kept on the GPU) to these nodes: the vector part of
     /// wire::carried_rotation (w >= 0). Read by GpuRingPass jobs that carry the frame from the last build.
     glm::vec3 motion{};
+    /// Instead of `motion`: fit it on the GPU against this wire's nodes of the last build (by index: the same
+    /// number of wires and of curve nodes; else no rotation), as wire::fit_motion would.
+    bool fit_motion = false;
 };
 
 /// The per-wire record the passes read (std430, 64 bytes; its GLSL twin is in src/gpu_wire_data.hpp). Per-node
@@ -59,7 +62,8 @@ struct GpuCurveHeader {
     uint32_t segment_first = 0;  ///< first segment (and per-segment ring count) in the persistent storage
     /// bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); bit 3 caps; bit 4 per-node kb in the extras
     /// (a vec4 a node: tension, bias, continuity); bit 5 stretch in the extras (4 segments a vec4, after the kb);
-    /// bits 16-31 material
+    /// bit 6 the segments are given (a blend); bit 7 the curve pass fits the motion (and writes it here, on the slot's
+    /// copy); bits 8-15 the wire's most sides; bits 16-31 material
     uint32_t flags = 0;
     float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
     uint32_t extra_first = 0;  ///< first vec4 of the wire's extras
@@ -104,7 +108,8 @@ public:
 private:
     friend class GpuRingPass;  // reads the headers, nodes, segments and stretch this pass keeps on the GPU
     engine::gfx::Program program_;
-    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, extras_;
+    engine::gfx::Buffer headers_, nodes_, segments_, scratch_, extras_, motion_refs_;
+    std::size_t motion_ref_wires_ = 0;  // wires motion_refs_ holds (kept between builds of as many wires)
     std::vector<GpuCurveHeader> header_data_;
     std::vector<glm::dvec3> origins_;
     std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, extra_bytes_ = 0;
