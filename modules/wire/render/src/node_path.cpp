@@ -286,8 +286,9 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         segments_visible += slot.segments;
         if (item.material < material_used_.size()) material_used_[item.material] = 1;
     }
-    // Wires not drawn for a while give their slot and segments back.
-    for (auto it = slots_.begin(); it != slots_.end();) {
+    // Wires not drawn for a while give their slot and segments back: looked for every 16th frame (a walk over
+    // every resident wire; evicted up to 15 frames after retain_frames, which changes nothing that is drawn).
+    for (auto it = frame_ % 16 == 0 ? slots_.begin() : slots_.end(); it != slots_.end();) {
         if (it->second.last_frame + retain_frames_ < frame_) {
             free_segments(it->second.segment_first, it->second.segments);
             free_slots_.push_back(it->second.index);
