@@ -174,7 +174,9 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
         nodes += 16 * n;
         extras += 16 * n + 16 * ((n + 3) / 4);
     }
-    return align_up(headers) + align_up(nodes) + align_up(extras) + align_up(4 * visible) + kAlign;
+    // prepare()'s layout: each array at least one record (a buffer range of 0 bytes cannot be bound).
+    return align_up(std::max<std::size_t>(headers, 64)) + align_up(std::max<std::size_t>(nodes, 16)) +
+           align_up(std::max<std::size_t>(extras, 16)) + align_up(std::max<std::size_t>(4 * visible, 4)) + kAlign;
 }
 
 bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera, const gfx::StreamRegion& region,
@@ -312,6 +314,11 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     const std::size_t visible_bytes = std::max<std::size_t>(visible_slots_.size() * 4, 4);
     const std::size_t node_at = align_up(header_bytes), extra_at = node_at + align_up(node_bytes);
     const std::size_t visible_at = extra_at + align_up(extra_bytes);
+    if (visible_at + visible_bytes > region.size_bytes) {
+        // Never (upload_bytes() sized the region for this layout); were it to, nothing is written past the region.
+        stats.wires_skipped += visible_;
+        return false;
+    }
     std::byte* base = region.data;
     if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
     // The nodes, copied once from where they are (the systems' packed nodes) into the region: on worker threads

@@ -653,6 +653,9 @@ TEST(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
                 side_threshold = 0, visibility_threshold = 0, changed = 0, strips = 0, lines = 0;
     std::size_t failures = 0;
     std::string first_failure;
+    std::vector<double> screen_ratios;  // per visible wire frame: screen error / tolerance
+    double worst_screen = 0.0;
+    std::string worst_screen_where;
     const int shots = 32, frames = 8;
     for (int shot = 0; shot < shots; ++shot) {
         const std::size_t target_wire = static_cast<std::size_t>(rng.integer(0, static_cast<int>(wires.size()) - 1));
@@ -706,6 +709,14 @@ TEST(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
                 std::vector<RingParam> params;
                 place_rings(cpu[i], g.counts, params);
                 if (params.size() != g.rings.size()) fail("ring count " + std::to_string(g.rings.size()) + " for counts of " + std::to_string(params.size()));
+                // The LOD's promise (LodProof.ScreenErrorWithinTolerance on the CPU path): the drawn centre line
+                // within the tolerance of the curve on screen.
+                const ScreenError e = measure_screen_error(cpu[i], params, view, 32);
+                screen_ratios.push_back(e.max_px / ls.tolerance_px);
+                if (e.max_px / ls.tolerance_px > worst_screen) {
+                    worst_screen = e.max_px / ls.tolerance_px;
+                    worst_screen_where = where + ", segment " + std::to_string(e.worst_segment);
+                }
                 const WireLod up_tol = from_previous(ls.tolerance_px * (1.0 + 1e-4));
                 const WireLod down_tol = from_previous(ls.tolerance_px * (1.0 - 1e-4));
                 for (std::size_t k = 0; k < ref.counts.size(); ++k, ++compared_segments) {
@@ -742,6 +753,11 @@ TEST(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
                 "differences: %zu%s%s\n",
                 compared_wires, visible_wires, strips, lines, compared_segments, changed, count_threshold, side_threshold,
                 visibility_threshold, failures, failures ? ", first: " : "", first_failure.c_str());
+    std::sort(screen_ratios.begin(), screen_ratios.end());
+    std::printf("gpu lod screen error / tolerance per visible wire frame: median %.3g, p90 %.3g, max %.3g (%s)\n",
+                screen_ratios[screen_ratios.size() / 2], screen_ratios[screen_ratios.size() * 9 / 10], worst_screen,
+                worst_screen_where.c_str());
+    EXPECT_LE(worst_screen, 1.0 + 1e-9) << worst_screen_where;
     EXPECT_EQ(failures, 0u) << first_failure;
     EXPECT_GT(changed, 0u);  // the shots exercise the hysteresis
     EXPECT_GT(visible_wires, compared_wires / 10);
