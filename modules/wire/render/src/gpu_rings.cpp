@@ -23,8 +23,9 @@ GPU_WIRE_HEADER
 struct Job {
     uint ring_first;     // out: first ring record (allocated by the LOD stage)
     uint ring_count;     // out: rings (0: culled, or the ring buffer was full)
-    uint flags;          // in: bit 1 the job gives the previous normal (bit 0: previous_normal is one); else
-                         // the slot's last frame's ring 0 normal is carried
+    uint flags;          // in (stage 0): bit 1 the job gives the previous normal (bit 0: previous_normal is one);
+                         // else the slot's last frame's ring 0 normal is carried. Out: bit 2 the rings came from
+                         // the reserve (one a segment)
     uint sides;          // out: drawn sides (3.. a tube, 2 a strip, 1 a line)
     vec4 previous_normal;
     vec4 first_normal;   // out: ring 0's r
@@ -40,7 +41,10 @@ layout(std430, binding = 6) buffer Jobs { Job jobs[]; };
 layout(std430, binding = 7) buffer Counts { uint counts[]; };
 layout(std430, binding = 8) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
 layout(std430, binding = 9) buffer Slots { SlotState slot_state[]; };
-layout(std430, binding = 10) buffer Counter { uint ring_counter; uint overflow; };
+// Rings allocated, wires that did not fit, rings allocated from the reserve (u_ring_reserve records after
+// u_ring_capacity: one ring a segment for every listed wire, so a wire that does not fit is drawn coarse, not
+// missing, until the ring buffer has grown).
+layout(std430, binding = 10) buffer Counter { uint ring_counter; uint overflow; uint reserve_counter; };
 // The slot of each dispatched wire: the first u_changed are this frame's curve headers' (their nodes changed), the
 // others listed.
 layout(std430, binding = 11) readonly buffer Visible { uint visible[]; };
@@ -55,6 +59,7 @@ layout(std430, binding = 16) readonly buffer Templates { uvec2 templates[]; };  
 uniform uint u_wires;
 uniform uint u_changed;
 uniform uint u_ring_capacity;
+uniform uint u_ring_reserve;
 uniform uint u_stage;  // 0: LOD (or the caller's counts) and rings; 1: LOD only; 2: the commands; 3: rings only
 uniform bool u_draw;
 uniform uint u_buckets, u_side_slots;
@@ -407,7 +412,9 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
 }
 
 // ---- the walk ----
+bool FEWEST = false;  // the wire's rings came from the reserve: one a segment (the LOD's counts are kept)
 uint count_of(uint k) {
+    if (FEWEST) return 1u;
     uint c = counts[H.segment_first + k];
     return k == 0u ? max(c, 1u) : c;
 }
@@ -538,6 +545,9 @@ void main() {
         if (last.w != 0.0) slot_state[slot].first_normal = vec4(turned(last.xyz, motion), 1.0);
     }
     if (u_stage != 3u) {
+        // Stage 0 (GpuRingPass) has the caller's job flags; the nodes path (stage 1) carries from the slot.
+        uint flags = u_stage == 0u ? jobs[w].flags & 3u : 0u;
+        jobs[w].flags = flags;
         // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
         if (u_lod) {
             vec3 offset = vec3(dvec3(H.origin[0], H.origin[1], H.origin[2]) - u_eye);
@@ -555,7 +565,13 @@ void main() {
         jobs[w].ring_first = first;
         if (first + n > u_ring_capacity) {
             atomicAdd(overflow, 1u);
-            return;
+            // One ring a segment from the reserve (sized for every listed wire): coarse for a frame, not missing.
+            uint fewest = SEGS + (CLOSED ? 0u : 1u);
+            first = u_ring_capacity + atomicAdd(reserve_counter, fewest);
+            if (first + fewest > u_ring_capacity + u_ring_reserve) return;
+            n = fewest;
+            jobs[w].ring_first = first;
+            jobs[w].flags = flags | 4u;
         }
         jobs[w].ring_count = n;
         if (u_draw) {
@@ -573,6 +589,7 @@ void main() {
         if (n == 0u) return;
     }
     RING_FIRST = job.ring_first;
+    FEWEST = (job.flags & 4u) != 0u;
     // The first normal: the carried previous one projected onto the first tangent, else seeded from an axis.
     vec3 t0 = unit_tangent(load_seg(0u), 0.0);
     if (t0 == vec3(0.0)) t0 = vec3(0.0, 0.0, 1.0);
@@ -749,7 +766,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
         }
     }
     auto job_buffer = engine::gfx::make_buffer(std::span<const Job>(job_data), "wire gpu ring jobs");
-    const uint32_t zero_counter[2] = {0, 0};
+    const uint32_t zero_counter[3] = {0, 0, 0};
     auto counter = engine::gfx::make_buffer(std::span<const uint32_t>(zero_counter), "wire gpu ring counter");
     auto visible_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(visible), "wire gpu visible slots");
     if (!job_buffer) return Status::error(job_buffer.error().message);
@@ -784,6 +801,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     glUniform1ui(at("u_changed"), carry_last ? static_cast<GLuint>(jobs.size()) : 0u);
     glUniform1i(at("u_draw"), 0);
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
+    glUniform1ui(at("u_ring_reserve"), 0u);  // a wire that does not fit is reported (GpuRingResult::overflow)
     glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);
     if (lod != nullptr) detail::set_lod_uniforms(program_, lod->view, lod->settings);
     glDispatchCompute(static_cast<GLuint>((jobs.size() + 63) / 64), 1, 1);

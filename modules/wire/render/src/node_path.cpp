@@ -187,6 +187,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     if (frame_ > kReadbackSlots) {
         const auto* seen = static_cast<const uint32_t*>(readback_map_) + 2 * (frame_ % kReadbackSlots);
         if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::size_t{seen[0]} * 3 / 2;
+        stats.wires_coarse = seen[1];
     }
     thread_local WireUpload up;  // headers, and the nodes made here (not packed by the systems)
     up.clear();
@@ -357,16 +358,20 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     side_slots_ = max_sides_ + 1;
     materials_ = ctx.materials.size();
     const std::size_t buckets = materials_ * side_slots_ * 6;
-    const std::size_t chunk_capacity = ring_capacity_ / kChunkBands + 6 * visible_ + 1;
+    // The reserve after the ring buffer's estimate: one ring a segment for every visible wire (what a wire that
+    // does not fit is drawn with, until the buffer has grown from the count read back).
+    const std::size_t reserve = segments_visible + visible_;
+    const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
     std::size_t scratch_nodes = changed_ ? std::max<std::size_t>(node_total, 1) : 1;
     const bool ok = ensure(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch", false) &&
                     ensure(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs", false) &&
                     ensure(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws", false) &&
-                    ensure(rings_, ring_bytes_, ring_capacity_ * sizeof(PackedRing), "wire nodes: rings", false) &&
+                    ensure(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings",
+                           false) &&
                     ensure(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks", false) &&
                     ensure(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets", false) &&
                     ensure(commands_, command_bytes_, buckets * 20, "wire nodes: commands", false) &&
-                    ensure(counter_, counter_bytes_, 8, "wire nodes: ring counter", false);
+                    ensure(counter_, counter_bytes_, 12, "wire nodes: ring counter", false);
     if (!ok) return false;
     if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
         // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
@@ -387,7 +392,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         template_sides_ = side_slots_;
         template_patterns_ = ctx.pattern_first.size();
     }
-    clear_range(counter_, 0, 8);
+    clear_range(counter_, 0, 12);
     clear_range(buckets_, 0, buckets * 4);
 
     // (1) Curves of the wires whose nodes changed, into their slots' segments and headers.
@@ -441,6 +446,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
     glUniform1ui(at("u_changed"), static_cast<GLuint>(changed_));
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
+    glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, 0xffffffffu)));
     glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
     glUniform1ui(at("u_side_slots"), side_slots_);
     const auto groups = static_cast<GLuint>((visible_ + 63) / 64);

@@ -488,6 +488,47 @@ EdgeComparison compare_off_edges(const platform::Image& a, const platform::Image
     return e;
 }
 
+// The nodes path's ring buffer is sized from the ring count read back 3 frames late: a frame whose rings outgrow it
+// (here the first, at a 0.0002 px tolerance) draws the wires that do not fit with one ring a segment from a reserve
+// sized for every visible wire, not without them, and the buffer has grown when the count comes back.
+TEST(WireRendererTest, GpuNodesRingOverflowDrawsCoarseNotMissing) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer renderer = make_renderer();
+    const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
+    const Scene scene = test_scene();
+    DrawSettings settings;
+    settings.node_lod = {.tolerance_px = 0.0002, .max_rings_per_segment = 1024, .keep_node_resolution = true};
+    DrawList gpu{.path = UploadPath::gpu_nodes, .items = {}};
+    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+        DrawItem item;
+        item.wire_id = 700000 + i;
+        item.nodes = &scene.nodes[i];
+        item.spline = scene.settings[i].spline;
+        item.nodes_generation = 1;
+        item.sides = 32;
+        item.caps = scene.settings[i].tube.caps;
+        gpu.items.push_back(item);
+    }
+    std::vector<std::size_t> covered, coarse;
+    for (int frame = 0; frame < 8; ++frame) {
+        DrawStats stats;
+        const platform::Image image = render(*ctx, renderer, gpu, scene_camera(), settings, &stats);
+        covered.push_back(covered_pixels(image, bg.data()));
+        coarse.push_back(stats.wires_coarse);
+        if (frame == 0) save(image, "wire_render_nodes_overflow_first.png");
+    }
+    std::printf("ring overflow: covered pixels per frame %zu %zu %zu %zu %zu %zu %zu %zu; wires drawn coarse (read "
+                "back 3 frames late) %zu %zu %zu %zu %zu %zu %zu %zu\n",
+                covered[0], covered[1], covered[2], covered[3], covered[4], covered[5], covered[6], covered[7],
+                coarse[0], coarse[1], coarse[2], coarse[3], coarse[4], coarse[5], coarse[6], coarse[7]);
+    // Frames 0-2 drew before the first count came back (reported at 3-5); frame 3 had the grown buffer.
+    EXPECT_GT(coarse[3], 0u) << "the first frame's rings did not outgrow the buffer: the test shows nothing";
+    EXPECT_EQ(coarse[6], 0u) << "the ring buffer did not grow";
+    // Coarse (one ring a segment) covers nearly what the fine rings cover; a missing wire would not.
+    for (int frame = 0; frame < 3; ++frame) EXPECT_GT(covered[frame], covered[7] * 98 / 100) << "frame " << frame;
+}
+
 // The nodes path (issue 30): the test scene from its nodes alone (curve, LOD at node resolution, frames, rings
 // and the draw's arguments on the GPU) against the gpu-rings path fed by the CPU reference at the same LOD
 // (update_lod with keep_node_resolution, place_rings, build_rings): the same picture within 2/255 off

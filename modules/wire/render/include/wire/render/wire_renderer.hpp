@@ -109,6 +109,9 @@ struct DrawStats {
     std::size_t wires_streamed = 0;  ///< gpu-rings retained: of those, moving wires streamed with the frame
     std::size_t wires_evicted = 0;        ///< gpu-rings retained, gpu-nodes: ranges freed (wires not drawn for a while)
     std::size_t wires_skipped = 0;  ///< gpu-nodes: items not drawn (a spline kind the GPU does not build yet)
+    /// gpu-nodes: wires whose rings did not fit the ring buffer (sized from a count read back 3 frames late) and
+    /// were drawn with one ring a segment from its reserve; reported as read back, 3 frames late.
+    std::size_t wires_coarse = 0;
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
     std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
     std::size_t triangles = 0;          ///< triangles drawn
