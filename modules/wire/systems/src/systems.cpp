@@ -799,7 +799,9 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
                     prefetch_lines<false>(&c->previous_nodes, sizeof(WireNodes));
                     prefetch_lines<false>(&c->packed, sizeof(PackedNodes));
                 }
-                if (const WireRings* r = rings.try_get(ahead)) prefetch_lines<true>(&r->motion, sizeof(MotionReference) + 16);
+                if (const WireRings* r = rings.try_get(ahead)) {
+                    prefetch_lines<true>(&r->motion, sizeof(MotionReference) + sizeof(r->sent_curve));
+                }
                 if (const Style* s = styles.try_get(ahead)) prefetch_lines<false>(s, sizeof(Style));
             }
             const Entity e = visible[v];
