@@ -88,7 +88,7 @@ public:
     /// Compiles the compute program. Fails (with the driver's log) without GL 4.3 compute.
     static engine::Expected<GpuCurvePass> create();
 
-    /// Whether this pass builds `spline` (see the file comment for what it does not yet).
+    /// Whether this pass builds `spline` (wire::gpu_builds: every kind the CPU has).
     [[nodiscard]] static bool supported(const SplineSettings& spline, const WireNodes& nodes);
 
     /// Builds every wire's segments on the GPU (one dispatch). A wire this pass cannot build (build_curve's checks:

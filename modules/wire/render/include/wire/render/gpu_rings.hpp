@@ -25,7 +25,9 @@
 // at node resolution: Wang's count at each segment's nearest hull depth and off-axis factor, coarse off-screen
 // segments, the side count, strips and lines, hysteresis on counts and sides kept on the GPU between builds of the
 // same wires). A wire's rings get a range of the ring buffer by an atomic counter (no scan).
-// Not here yet: LOD below node resolution (spans), the draw arguments (steps 4-5).
+// The renderer's nodes path (src/node_path.cpp) runs the same program in stages (LOD, the indirect commands, the
+// rings with their draw and chunk records) and draws a wire that does not fit the ring buffer with one ring a
+// segment from a reserve. Not here: LOD below node resolution (the CPU's spans).
 #pragma once
 
 #include "wire/lod.hpp"
