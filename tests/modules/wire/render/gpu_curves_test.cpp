@@ -30,7 +30,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,6 +68,45 @@ std::vector<WireNodes> loops(uint64_t seed, int count) {
 struct Kind {
     const char* name;
     SplineSettings spline;
+};
+
+// The nodes the GPU holds: each rounded to float relative to the wire's origin.
+WireNodes rounded_to(const WireNodes& w, const glm::dvec3& origin_m) {
+    WireNodes rounded = w;
+    for (glm::dvec3& p : rounded.positions) p = origin_m + wire::testing::float_rounded(p - origin_m);
+    return rounded;
+}
+
+// A ring's frame read back against the CPU's: the largest distance of its three unit vectors (radians, to first
+// order).
+double frame_error(const DecodedFrame& g, const Frame& f) {
+    return std::max({glm::length(glm::dvec3(g.normal) - f.r), glm::length(glm::dvec3(g.binormal) - f.s),
+                     glm::length(glm::dvec3(g.tangent) - f.t)});
+}
+
+// Median, p90 and max.
+std::array<double, 3> quantiles(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const auto q = [&](double f) { return v[static_cast<std::size_t>(f * (v.size() - 1))]; };
+    return {q(0.5), q(0.9), q(1.0)};
+}
+
+// The ring tests' GL context and passes (the curve pass builds what the ring pass reads).
+class GpuRings : public ::testing::Test {
+protected:
+    void SetUp() override {
+        context = make_context();
+        ASSERT_TRUE(context);
+        auto c = GpuCurvePass::create();
+        ASSERT_TRUE(c) << c.error().message;
+        auto r = GpuRingPass::create();
+        ASSERT_TRUE(r) << r.error().message;
+        curves.emplace(std::move(*c));
+        rings.emplace(std::move(*r));
+    }
+    std::unique_ptr<engine::platform::Context> context;
+    std::optional<GpuCurvePass> curves;
+    std::optional<GpuRingPass> rings;
 };
 
 TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
@@ -187,10 +228,8 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
             // wire's origin), so the comparison measures the GPU's arithmetic. How far that rounding itself moves
             // the curve is reported beside it: the c2 spline's not-a-knot ends amplify it by the ratio of the
             // first two chords (a 4-node wire with 100:1 chords moves 1e-4 of its extent), whatever computes it.
-            WireNodes rounded = wires[i];
-            for (glm::dvec3& p : rounded.positions) p = gpu.origin_m + wire::testing::float_rounded(p - gpu.origin_m);
             Curve cpu, exact;
-            ASSERT_TRUE(build_curve(rounded, settings[i], cpu).ok()) << labels[i];
+            ASSERT_TRUE(build_curve(rounded_to(wires[i], gpu.origin_m), settings[i], cpu).ok()) << labels[i];
             ASSERT_TRUE(build_curve(wires[i], settings[i], exact).ok()) << labels[i];
             ASSERT_EQ(gpu.segments.size(), cpu.segments.size()) << labels[i];
             double extent = 0.0;
@@ -255,13 +294,7 @@ TEST(GpuCurves, RefusesWiresWithTooFewNodesNamingTheWire) {
 // is 1.35e-6); u within 1e-4 of a period + 8 float roundings of u (each interval's u is float, summed in
 // double); radius within 1e-5 of itself (the Hermite's float coefficients cancel where node radii differ 25:1);
 // length within 1e-5.
-TEST(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
-    const auto context = make_context();
-    ASSERT_TRUE(context);
-    auto curves = GpuCurvePass::create();
-    ASSERT_TRUE(curves) << curves.error().message;
-    auto rings = GpuRingPass::create();
-    ASSERT_TRUE(rings) << rings.error().message;
+TEST_F(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
 
     wire::testing::Random rng{4001};
     std::vector<WireNodes> wires;
@@ -330,9 +363,7 @@ TEST(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
         std::vector<GpuRingJob> jobs(wires.size());
         std::vector<std::string> how(wires.size());
         for (std::size_t i = 0; i < wires.size(); ++i) {
-            WireNodes rounded = wires[i];
-            for (glm::dvec3& p : rounded.positions) p = segs[i].origin_m + wire::testing::float_rounded(p - segs[i].origin_m);
-            ASSERT_TRUE(build_curve(rounded, settings[i], cpu[i]).ok()) << labels[i];
+            ASSERT_TRUE(build_curve(rounded_to(wires[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
             const std::size_t n = cpu[i].segment_count();
             const int mode = rng.integer(0, 2);
             if (mode == 0) {
@@ -381,10 +412,7 @@ TEST(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
                 const double ce = glm::length(cpu_centre - gpu_centre) / (1e-4 * R + 1e-6 + 8.0 * std::ldexp(extent, -24));
                 centre.take(ce, where + ", ring " + std::to_string(r));
                 wire_centre = std::max(wire_centre, glm::length(cpu_centre - gpu_centre) / R);
-                const DecodedFrame f = unpack_frame(g);
-                const double fe = std::max({glm::length(glm::dvec3(f.normal) - ref.frames[r].r),
-                                            glm::length(glm::dvec3(f.binormal) - ref.frames[r].s),
-                                            glm::length(glm::dvec3(f.tangent) - ref.frames[r].t)});
+                const double fe = frame_error(unpack_frame(g), ref.frames[r]);
                 frame.take(fe, where + ", ring " + std::to_string(r));
                 wire_frame = std::max(wire_frame, fe);
                 const double ue = std::abs(static_cast<double>(g.u) - ref.u[r]) / (1e-4 + 8.0 * std::ldexp(std::abs(ref.u[r]), -24));
@@ -401,11 +429,6 @@ TEST(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
             ring_total += ref.rings.size();
         }
     }
-    const auto quantiles = [](std::vector<double> v) {
-        std::sort(v.begin(), v.end());
-        const auto q = [&](double f) { return v[static_cast<std::size_t>(f * (v.size() - 1))]; };
-        return std::array<double, 3>{q(0.5), q(0.9), q(1.0)};
-    };
     const auto fq = quantiles(frame_errors), cq = quantiles(centre_errors);
     std::printf("gpu rings: %zu wires, %zu rings | frame error (rad) per wire: median %.3g, p90 %.3g, max %.3g | "
                 "centre error / radius per wire: median %.3g, p90 %.3g, max %.3g\n",
@@ -432,13 +455,7 @@ TEST(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
 // the GPU's own chain is also compared with an independent CPU chain over all 16 frames (float against double, the
 // difference a random walk: reported and held within 1e-4 rad too). The test can fail: the frames the GPU would
 // give without the motion (the plain projection) are measured against the reference and must differ by far more.
-TEST(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
-    const auto context = make_context();
-    ASSERT_TRUE(context);
-    auto curves = GpuCurvePass::create();
-    ASSERT_TRUE(curves) << curves.error().message;
-    auto rings = GpuRingPass::create();
-    ASSERT_TRUE(rings) << rings.error().message;
+TEST_F(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
 
     wire::testing::Random rng{4077};
     struct Moving {
@@ -526,9 +543,8 @@ TEST(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
         std::vector<Curve> cpu(wires.size());
         std::vector<GpuRingJob> jobs(wires.size());
         for (std::size_t i = 0; i < wires.size(); ++i) {
-            WireNodes rounded = nodes[i];
-            for (glm::dvec3& p : rounded.positions) p = segs[i].origin_m + wire::testing::float_rounded(p - segs[i].origin_m);
-            ASSERT_TRUE(build_curve(rounded, wires[i].spline, cpu[i]).ok()) << wires[i].label;
+            ASSERT_TRUE(build_curve(rounded_to(nodes[i], segs[i].origin_m), wires[i].spline, cpu[i]).ok())
+                << wires[i].label;
             if (f == 0) wires[i].counts.assign(cpu[i].segment_count(), static_cast<uint32_t>(rng.integer(1, 6)));
             jobs[i].counts = wires[i].counts;
             jobs[i].carry_last = true;
@@ -556,11 +572,7 @@ TEST(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
             double wire_frame = 0.0, wire_chain = 0.0, wire_plain = 0.0;
             for (std::size_t r = 0; r < ref.rings.size(); ++r) {
                 const DecodedFrame g = unpack_frame(gpu[i].rings[r]);
-                const auto off = [&](const RingSet& set) {
-                    return std::max({glm::length(glm::dvec3(g.normal) - set.frames[r].r),
-                                     glm::length(glm::dvec3(g.binormal) - set.frames[r].s),
-                                     glm::length(glm::dvec3(g.tangent) - set.frames[r].t)});
-                };
+                const auto off = [&](const RingSet& set) { return frame_error(g, set.frames[r]); };
                 wire_frame = std::max(wire_frame, off(ref));
                 wire_chain = std::max(wire_chain, off(own));
                 wire_plain = std::max(wire_plain, off(plain));
@@ -577,11 +589,6 @@ TEST(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
             sent[i] = motion_reference(nodes[i]);
         }
     }
-    const auto quantiles = [](std::vector<double> v) {
-        std::sort(v.begin(), v.end());
-        const auto q = [&](double f) { return v[static_cast<std::size_t>(f * (v.size() - 1))]; };
-        return std::array<double, 3>{q(0.5), q(0.9), q(1.0)};
-    };
     const auto fq = quantiles(per_frame), cq = quantiles(chain_drift);
     std::printf("gpu carry: %zu wires x %d frames, %zu rings | frame error (rad) per wire and frame: median %.3g, p90 "
                 "%.3g, max %.3g (%s) | against an independent CPU chain: median %.3g, p90 %.3g, max %.3g (%s) | "
@@ -602,13 +609,7 @@ TEST(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
 // rounding sits on a threshold: a difference counts as that when update_lod with the tolerance moved by 1e-4
 // (either way) gives the GPU's value, or a visibility that differs (a control hull on a frustum plane); those
 // are counted, reported and allowed at 1 in 1000, any other difference fails. Measured: none at all.
-TEST(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
-    const auto context = make_context();
-    ASSERT_TRUE(context);
-    auto curves = GpuCurvePass::create();
-    ASSERT_TRUE(curves) << curves.error().message;
-    auto rings = GpuRingPass::create();
-    ASSERT_TRUE(rings) << rings.error().message;
+TEST_F(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
 
     wire::testing::Random rng{5001};
     std::vector<WireNodes> wires;
@@ -644,9 +645,7 @@ TEST(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
     curves->read_segments(segs);
     std::vector<Curve> cpu(wires.size());
     for (std::size_t i = 0; i < wires.size(); ++i) {
-        WireNodes rounded = wires[i];
-        for (glm::dvec3& p : rounded.positions) p = segs[i].origin_m + wire::testing::float_rounded(p - segs[i].origin_m);
-        ASSERT_TRUE(build_curve(rounded, settings[i], cpu[i]).ok()) << labels[i];
+        ASSERT_TRUE(build_curve(rounded_to(wires[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
     }
 
     std::size_t compared_segments = 0, compared_wires = 0, visible_wires = 0, count_threshold = 0,
@@ -765,13 +764,7 @@ TEST(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
     EXPECT_LE(side_threshold + visibility_threshold, compared_wires / 1000);
 }
 
-TEST(GpuRings, RefusesJobsThatDoNotMatchTheCurves) {
-    const auto context = make_context();
-    ASSERT_TRUE(context);
-    auto curves = GpuCurvePass::create();
-    ASSERT_TRUE(curves) << curves.error().message;
-    auto rings = GpuRingPass::create();
-    ASSERT_TRUE(rings) << rings.error().message;
+TEST_F(GpuRings, RefusesJobsThatDoNotMatchTheCurves) {
     WireNodes w;
     w.positions = {{0, 0, 0}, {1, 0, 0}, {2, 1, 0}};
     const GpuCurveWire inputs[] = {{&w, {}}, {&w, {}}};
