@@ -37,8 +37,9 @@ struct PackedNodes {
     [[nodiscard]] std::size_t segment_count() const { return closed ? nodes.size() : nodes.size() - 1; }
 };
 
-/// The point nearest `p` whose coordinates are floats (each rounded to nearest): a wire's origin on the nodes path.
-/// Rounded through memory: GCC 12 at -O3 has dropped the round trip dvec3(vec3(p)) for two of three lanes.
+/// The point nearest `p` whose coordinates are floats (each rounded to nearest): a wire's origin on the nodes path,
+/// and what references that must see what the GPU holds round with. Rounded through memory: GCC 12 at -O3
+/// vectorized the round trip dvec3(vec3(p)) for two lanes of a loop and dropped it (x and y kept every bit).
 [[nodiscard]] glm::dvec3 float_point(const glm::dvec3& p);
 
 /// Whether the GPU curve pass builds `kind`: every kind the CPU has (linear, Catmull-Rom / Kochanek-Bartels, c2,

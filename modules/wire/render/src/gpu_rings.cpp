@@ -538,7 +538,8 @@ void main() {
     uint drawn = 0u;
     if (u_stage != 3u && w < u_changed) {
         // Nodes that changed: the slot's last first normal turned by the wire's motion since (the header's
-        // rotation, fitted on the CPU), as the CPU path's carried_frames turns its own. Culled or not, so the next
+        // rotation: fitted by the curve pass, or by the CPU on id events and blends), as the CPU path's
+        // carried_frames turns its own. Culled or not, so the next
         // build carries it from where the wire is.
         vec4 last = slot_state[slot].first_normal;
         vec3 motion = vec3(H.motion[0], H.motion[1], H.motion[2]);

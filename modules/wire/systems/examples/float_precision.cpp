@@ -14,7 +14,7 @@
 //                           the same 3-point Gauss rule
 // Usage: example_float_precision [cases_per_family=60]
 #include "wire/testing/families.hpp"
-#include "wire/testing/float_round.hpp"
+#include "wire/packed_nodes.hpp"  // float_point
 #include "wire/rings.hpp"
 #include "wire/spline.hpp"
 #include "wire/tessellate.hpp"
@@ -153,9 +153,9 @@ int main(int argc, char** argv) {
             const double exact_dev = wire::families::max_deviation_m(shifted, curve);
             wire::WireNodes wf = nodes, rf = nodes;
             const dvec3 first = nodes.positions.front();
-            // wire::testing::float_rounded, not dvec3(vec3(p)): GCC 12 -O3 drops that round trip for two lanes.
-            for (dvec3& p : wf.positions) p = wire::testing::float_rounded(p);
-            for (dvec3& p : rf.positions) p = first + wire::testing::float_rounded(p - first);
+            // wire::float_point, not dvec3(vec3(p)): GCC 12 -O3 drops that round trip for two lanes.
+            for (dvec3& p : wf.positions) p = wire::float_point(p);
+            for (dvec3& p : rf.positions) p = first + wire::float_point(p - first);
             wire::Curve cw, cr;
             if (wire::build_curve(wf, settings, cw).ok() && cw.segment_count() == curve.segment_count()) {
                 world.push_back(std::max(0.0, wire::families::max_deviation_m(shifted, cw) - exact_dev));

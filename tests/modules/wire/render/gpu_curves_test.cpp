@@ -12,11 +12,11 @@
 #include "wire/rings.hpp"
 #include "wire/lod.hpp"
 #include "wire/motion.hpp"
+#include "wire/packed_nodes.hpp"  // float_point
 #include "wire/tessellate.hpp"
 
 #include "wire/spline.hpp"
 #include "wire/testing/families.hpp"
-#include "wire/testing/float_round.hpp"
 #include "wire/testing/random.hpp"
 
 #include "engine/platform/context.hpp"
@@ -73,7 +73,7 @@ struct Kind {
 // The nodes the GPU holds: each rounded to float relative to the wire's origin.
 WireNodes rounded_to(const WireNodes& w, const glm::dvec3& origin_m) {
     WireNodes rounded = w;
-    for (glm::dvec3& p : rounded.positions) p = origin_m + wire::testing::float_rounded(p - origin_m);
+    for (glm::dvec3& p : rounded.positions) p = origin_m + float_point(p - origin_m);
     return rounded;
 }
 
