@@ -105,9 +105,8 @@ wire::SplineSettings spline_of(const std::string& name) {
 }
 
 wire::UploadPath path_of(const std::string& name) {
-    if (name == "cpu") return wire::UploadPath::cpu_mesh;
-    if (name == "gpu") return wire::UploadPath::gpu_rings;
-    value_error("path: expected 'cpu' or 'gpu', got '" + name + "'");
+    if (const std::optional<wire::UploadPath> p = wire::parse_upload_path(name)) return *p;
+    value_error("path: expected 'cpu', 'gpu' or 'nodes', got '" + name + "'");
 }
 
 glm::dvec3 vec3_of(const std::vector<double>& v, const char* what) {
@@ -305,7 +304,10 @@ public:
         const auto t0 = std::chrono::steady_clock::now();
         wire::render::DrawSettings settings;
         settings.light = light_;
+        settings.node_lod = ctx_.lod;
         drawn_ = renderer_.draw(ctx_.draw_list, ctx_.camera, settings);
+        gpu_rings_read_ = false;
+        rendered_ = true;
         render_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         engine::platform::Image image = engine::platform::read_pixels(*gl_);
         gl_->end_frame();
@@ -335,6 +337,22 @@ public:
 
     py::object rings(Entity w) {
         check(w);
+        if (ctx_.path == wire::UploadPath::gpu_nodes) {
+            // The GPU computes them when render() draws: read back once per drawn frame.
+            if (!rendered_)
+                throw std::runtime_error("rings: on the 'nodes' path the GPU computes the rings when render() draws; "
+                                         "call render() first");
+            if (!gpu_rings_read_) {
+                gl_->make_current();
+                if (engine::Status st = renderer_.read_drawn_rings(gpu_rings_); !st)
+                    throw std::runtime_error("rings: " + st.message);
+                gpu_rings_read_ = true;
+            }
+            for (const wire::render::DrawnRings& d : gpu_rings_) {
+                if (d.wire_id == engine::ecs::to_integral(w)) return rings_dict(d.rings);
+            }
+            return py::none();  // culled
+        }
         if (!wire::systems::wire_ring_set(registry_, w, ring_set_)) return py::none();
         return rings_dict(ring_set_);
     }
@@ -416,6 +434,8 @@ private:
     wire::systems::WireContext ctx_;
     std::vector<wire::systems::ErrorReport> errors_;
     wire::RingSet ring_set_;
+    std::vector<wire::render::DrawnRings> gpu_rings_;  ///< the nodes path: the last render()'s, read back
+    bool gpu_rings_read_ = false, rendered_ = false;
     wire::render::Light light_{.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
     wire::render::DrawStats drawn_{};
     double render_ms_ = 0.0;
@@ -471,7 +491,8 @@ PYBIND11_MODULE(wires, m) {
         .def(py::init<int, int, bool, const std::string&, int, bool>(), py::arg("width") = 1280,
              py::arg("height") = 720, py::arg("headless") = true, py::arg("path") = "cpu",
              py::arg("threads") = 0, py::arg("pop_free") = true,
-             "path: 'cpu' (meshes) or 'gpu' (ring records); threads: worker threads of the systems (0: all "
+             "path: 'cpu' (meshes), 'gpu' (ring records) or 'nodes' (nodes only: curve, LOD and rings computed on "
+             "the GPU); threads: worker threads of the systems (0: all "
              "cores)")
         .def("spawn", &Runtime::spawn, py::arg("positions"), py::arg("ids") = py::none(),
              py::arg("stretch") = py::none(), py::arg("radii") = py::none(), py::arg("radius") = 0.01f,
@@ -517,7 +538,8 @@ PYBIND11_MODULE(wires, m) {
         .def("rings", &Runtime::rings, py::arg("wire"),
              "The wire's current rings as numpy arrays (centres, tangents, normals, binormals, radius, u, "
              "segment, t); "
-             "None while it is culled or not updated yet")
+             "None while it is culled or not updated yet. On the 'nodes' path: the rings the GPU computed and the "
+             "last render() drew, read back (an error before the first render())")
         .def("error", &Runtime::error, py::arg("wire"), "The wire's current error message, or None")
         .def_property_readonly("stats", &Runtime::stats)
         .def("memory", &Runtime::memory, py::arg("wire") = py::none(),

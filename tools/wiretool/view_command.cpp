@@ -9,6 +9,7 @@
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
 #include <wire/io/wire_json.hpp>
+#include <wire/lod.hpp>
 #include <wire/render/wire_renderer.hpp>
 #include <wire/spline.hpp>
 #include <wire/systems/api.hpp>
@@ -259,9 +260,7 @@ int run_view(const ViewOptions& o) try {
     if (!o.camera.empty()) cli_camera = parse_camera_option(o.camera);
     const double cli_fov = o.fov_deg.value_or(kDefaultFovDeg);
     wire::UploadPath path = wire::systems::WireContext{}.path;
-    if (o.path == "cpu") path = wire::UploadPath::cpu_mesh;
-    if (o.path == "gpu") path = wire::UploadPath::gpu_rings;
-    if (o.path == "nodes") path = wire::UploadPath::gpu_nodes;
+    if (!o.path.empty()) path = wire::parse_upload_path(o.path).value_or(path);  // CLI11 checked the name
 
     wire::io::SceneSpec scene;
     if (engine::Status st = wire::io::load_wire_json(o.input, scene); !st.ok()) throw BadInput{st.message};
@@ -331,6 +330,7 @@ int run_view(const ViewOptions& o) try {
         settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
         settings.node_lod = ctx.lod;
         drawn = renderer.draw(ctx.draw_list, ctx.camera, settings);
+        if (!drawn.status.ok()) throw Failure{exit_failure, "the wire renderer could not draw: " + drawn.status.message};
     });
 
     std::vector<Entity> entities;
@@ -346,6 +346,8 @@ int run_view(const ViewOptions& o) try {
     const bool png_every_frame = o.png_out.find(kPerFrameToken) != std::string::npos;
     std::string csv = std::string(kRingCsvHeader) + ",sides\n";
     wire::RingSet ring_set;  // per wire, for the CSV (reused)
+    std::vector<wire::render::DrawnRings> gpu_rings;  // the nodes path's, read back per frame
+    wire::Curve gpu_curve;                            // the nodes path: a wire's curve, for its screen error
     nlohmann::ordered_json frame_records = nlohmann::ordered_json::array();
     for (std::size_t f = 0; f < frames; ++f) {
         if (f > 0) {
@@ -385,11 +387,21 @@ int run_view(const ViewOptions& o) try {
             throw BadInput{where(o.input, f, frames, it == wire_of_entity.end() ? 0 : it->second) + ": " + e.message};
         }
 
-        // What the LOD chose and what it drew, per wire in file order.
+        // What the LOD chose and what it drew, per wire in file order. On the nodes path the rings are the GPU's,
+        // read back (what the draw used); the others build them on the CPU.
         std::vector<const wire::DrawItem*> item_of(wires, nullptr);
         for (const wire::DrawItem& item : ctx.draw_list.items) {
             const auto it = wire_of_entity.find(item.wire_id);
             if (it != wire_of_entity.end()) item_of[it->second] = &item;
+        }
+        std::vector<const wire::render::DrawnRings*> gpu_of(wires, nullptr);
+        if (path == wire::UploadPath::gpu_nodes) {
+            if (engine::Status st = renderer.read_drawn_rings(gpu_rings); !st)
+                throw Failure{exit_failure, "cannot read back the rings the GPU drew: " + st.message};
+            for (const wire::render::DrawnRings& d : gpu_rings) {
+                const auto it = wire_of_entity.find(d.wire_id);
+                if (it != wire_of_entity.end()) gpu_of[it->second] = &d;
+            }
         }
         nlohmann::ordered_json wire_records = nlohmann::ordered_json::array();
         double frame_error = 0.0;
@@ -398,7 +410,23 @@ int run_view(const ViewOptions& o) try {
             double error_px = 0.0;
             std::size_t rings = 0;
             long sides = 0;
-            if (item != nullptr) {
+            if (path == wire::UploadPath::gpu_nodes) {
+                // Culled on the GPU: no rings, 0 sides (as a wire the CPU culls).
+                if (const wire::render::DrawnRings* d = gpu_of[w]; d != nullptr) {
+                    rings = d->rings.params.size();
+                    sides = static_cast<long>(d->sides);
+                    if (!o.csv_out.empty()) append_ring_rows(csv, f, w, d->rings, sides);
+                    // The screen error of the GPU's rings (its LOD's counts) on the curve through the wire's nodes
+                    // (the CPU's build of what the GPU built).
+                    wire::SplineSettings spline = styles[f][w].spline;
+                    spline.closed = styles[f][w].closed;
+                    spline.radius_m = styles[f][w].radius_m;
+                    if (wire::build_curve(wire::io::to_wire_nodes(scene.frames[f].wires[w]), spline, gpu_curve).ok() &&
+                        !d->rings.params.empty() && d->rings.params.back().segment < gpu_curve.segment_count())
+                        error_px = wire::measure_screen_error(gpu_curve, d->rings.params, ctx.view, kErrorSamplesPerSegment)
+                                       .max_px;
+                }
+            } else if (item != nullptr) {
                 error_px = wire::systems::wire_screen_error(registry, ctx, entities[w], kErrorSamplesPerSegment).max_px;
                 rings = item->rings.size();
                 sides = static_cast<long>(item->sides);

@@ -17,7 +17,8 @@ constexpr GLbitfield kMapFlags = GL_MAP_WRITE_BIT | GL_MAP_PERSISTENT_BIT | GL_M
 
 bool signalled(GLsync fence) {
     if (fence == nullptr) return true;
-    const GLenum r = glClientWaitSync(fence, 0, 0);
+    // With the flush bit: a fence never flushed may never report signalled to a poll on some drivers.
+    const GLenum r = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 0);
     return r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED;
 }
 }  // namespace

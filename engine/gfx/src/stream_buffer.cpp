@@ -22,7 +22,8 @@ std::size_t round_up(std::size_t v, std::size_t a) {
 /// True when the fence has signalled (a null fence has nothing pending).
 bool signalled(GLsync fence) {
     if (fence == nullptr) return true;
-    const GLenum r = glClientWaitSync(fence, 0, 0);
+    // With the flush bit: a fence never flushed may never report signalled to a poll on some drivers.
+    const GLenum r = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 0);
     return r == GL_ALREADY_SIGNALED || r == GL_CONDITION_SATISFIED;
 }
 

@@ -43,7 +43,11 @@ std::size_t ring_count(std::span<const uint32_t> counts, bool closed) {
 
 void place_rings(const Curve& curve, std::span<const uint32_t> counts, std::vector<RingParam>& out) {
     assert(counts.size() == curve.segment_count() && "place_rings: one count per segment");
-    out.resize(ring_count(counts, curve.closed));
+    place_rings(counts, curve.closed, out);
+}
+
+void place_rings(std::span<const uint32_t> counts, bool closed, std::vector<RingParam>& out) {
+    out.resize(ring_count(counts, closed));
     std::size_t k = 0;
     const std::size_t size = out.size();
     for (std::size_t i = 0; i < counts.size(); ++i) {
@@ -60,7 +64,7 @@ void place_rings(const Curve& curve, std::span<const uint32_t> counts, std::vect
             out[k++] = RingParam{static_cast<uint32_t>(i), j == 0 ? 0.0 : static_cast<double>(j) / n};
         }
     }
-    if (!curve.closed && !counts.empty()) {
+    if (!closed && !counts.empty()) {
         out[k++] = RingParam{static_cast<uint32_t>(counts.size() - 1), 1.0};
     }
 }

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace wire {
@@ -29,6 +30,24 @@ enum class UploadPath : uint8_t {
     /// computed on the GPU (wire/render's nodes path), the gpu-rings vertex shader draws them
     gpu_nodes,
 };
+
+/// The name of an upload path on command lines, in Python and in reports: "cpu" (cpu_mesh), "gpu" (gpu_rings),
+/// "nodes" (gpu_nodes).
+[[nodiscard]] constexpr std::string_view upload_path_name(UploadPath path) {
+    switch (path) {
+        case UploadPath::cpu_mesh: return "cpu";
+        case UploadPath::gpu_rings: return "gpu";
+        case UploadPath::gpu_nodes: return "nodes";
+    }
+    return "?";
+}
+/// The path named `name` (upload_path_name's names); nullopt for any other name.
+[[nodiscard]] constexpr std::optional<UploadPath> parse_upload_path(std::string_view name) {
+    for (UploadPath p : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+        if (upload_path_name(p) == name) return p;
+    }
+    return std::nullopt;
+}
 
 /// One visible wire this frame. Positions inside are relative to origin_m (double, world), so the renderer can
 /// draw camera-relative: offset = origin_m - camera position, computed in double, sent as float.

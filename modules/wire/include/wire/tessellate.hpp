@@ -40,6 +40,8 @@ void segment_ring_counts(const Curve& curve, const TessellateSettings& settings,
 /// its last segment, a closed wire does not (its first ring closes the loop). `out` is resized; no allocation when its capacity suffices.
 /// counts.size() must equal curve.segment_count().
 void place_rings(const Curve& curve, std::span<const uint32_t> counts, std::vector<RingParam>& out);
+/// The same placement for a wire known only by its counts (one a segment) and whether it is closed.
+void place_rings(std::span<const uint32_t> counts, bool closed, std::vector<RingParam>& out);
 
 /// Number of rings place_rings() produces for these counts.
 [[nodiscard]] std::size_t ring_count(std::span<const uint32_t> counts, bool closed);

@@ -637,18 +637,8 @@ void main() {
 }
 )glsl";
 
-struct Job {
-    uint32_t ring_first = 0, ring_count = 0, flags = 0, sides = 0;
-    float previous_normal[4] = {0, 0, 0, 0};
-    float first_normal[4] = {0, 0, 0, 0};
-    float totals[4] = {0, 0, 0, 0};
-};
-static_assert(sizeof(Job) == 64, "the ring pass's std430 job record");
-struct SlotState {
-    uint32_t lod[4] = {0, 0, 0, 0};
-    float first_normal[4] = {0, 0, 0, 0};
-};
-static_assert(sizeof(SlotState) == 32, "the ring pass's std430 slot record");
+using detail::Job;
+using detail::SlotState;
 
 }  // namespace
 

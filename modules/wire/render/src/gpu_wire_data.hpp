@@ -48,6 +48,24 @@ inline constexpr std::size_t kMotionRefBytes = 192;
 inline constexpr uint32_t kHeaderKindShift = 1u, kHeaderMaterialShift = 16u;
 inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u, kKindAutomatic = 3u;
 
+/// The ring pass's per-dispatched-wire record (GLSL Job in ring_source(), std430).
+struct Job {
+    uint32_t ring_first = 0, ring_count = 0;
+    uint32_t flags = 0;  ///< out bit 2: the rings came from the reserve (one a segment)
+    uint32_t sides = 0;  ///< out: drawn sides
+    float previous_normal[4] = {0, 0, 0, 0};
+    float first_normal[4] = {0, 0, 0, 0};
+    float totals[4] = {0, 0, 0, 0};  ///< u where a closed loop closes, length, holonomy, radius in pixels
+};
+static_assert(sizeof(Job) == 64, "the ring pass's std430 job record");
+inline constexpr uint32_t kJobFromReserve = 4u;
+/// The ring pass's per-slot state kept between frames (GLSL SlotState, std430).
+struct SlotState {
+    uint32_t lod[4] = {0, 0, 0, 0};
+    float first_normal[4] = {0, 0, 0, 0};
+};
+static_assert(sizeof(SlotState) == 32, "the ring pass's std430 slot record");
+
 /// A wire's motion since its last upload: the rotation (GpuCurveHeader::motion), or the GPU fits it.
 struct WireMotion {
     glm::vec3 rotation{};

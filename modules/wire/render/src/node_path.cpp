@@ -55,10 +55,21 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
                                       .label = "wire nodes: ring counter readback"});
     if (!readback) return readback.error();
     path->readback_ = std::move(*readback);
+    // New buffers hold whatever the driver's pool held: zero, so a slot never written reads as no rings.
+    glClearNamedBufferData(path->readback_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    GLint64 max_block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    if (max_block > 0) path->max_block_bytes_ = static_cast<std::size_t>(max_block);
     path->readback_map_ = glMapNamedBufferRange(path->readback_.id(), 0, kReadbackSlots * 8,
                                                 GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT);
     if (path->readback_map_ == nullptr) return Error{"wire nodes: could not map the ring counter readback"};
     return path;
+}
+
+NodePath::~NodePath() {
+    for (GLsync& fence : readback_fence_) {
+        if (fence != nullptr) glDeleteSync(fence);
+    }
 }
 
 std::size_t NodePath::gl_buffers() const {
@@ -182,18 +193,26 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
 bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera, const gfx::StreamRegion& region,
                        const NodeDrawContext& ctx, DrawStats& stats) {
     ++frame_;
-    // The ring buffer's size: the counts the GPU reported kReadbackSlots frames ago (the stream region's fence of
-    // that frame has signalled before this region could begin).
-    if (frame_ > kReadbackSlots) {
-        const auto* seen = static_cast<const uint32_t*>(readback_map_) + 2 * (frame_ % kReadbackSlots);
-        if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::size_t{seen[0]} * 3 / 2;
-        stats.wires_coarse = seen[1];
+    // The ring buffer's size: the counts the GPU reported kReadbackSlots frames ago, read only once the fence
+    // after their copy has signalled (else the capacity stays: a late GPU delays growth, never feeds it garbage),
+    // and kept within what one shader storage block may hold.
+    if (GLsync& fence = readback_fence_[frame_ % kReadbackSlots]; fence != nullptr) {
+        const GLenum waited = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 0);
+        if (waited == GL_ALREADY_SIGNALED || waited == GL_CONDITION_SATISFIED) {
+            const auto* seen = static_cast<const uint32_t*>(readback_map_) + 2 * (frame_ % kReadbackSlots);
+            const std::size_t most = max_block_bytes_ / sizeof(PackedRing) * 2 / 3;
+            if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::min(std::size_t{seen[0]} * 3 / 2, most);
+            stats.wires_coarse = seen[1];
+            glDeleteSync(fence);
+            fence = nullptr;
+        }
     }
     thread_local WireUpload up;  // headers, and the nodes made here (not packed by the systems)
     up.clear();
     node_pieces_.clear(), extra_pieces_.clear();
     std::size_t node_total = 0, extra_total = 0;  // vec4s in the region's node and extra arrays
     visible_slots_.clear();
+    dispatched_.clear(), listed_.clear();
     material_used_.assign(ctx.materials.size(), 0);
     std::size_t segments_visible = 0;
     for (std::size_t i = 0; i < list.items.size(); ++i) {
@@ -201,6 +220,14 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
         const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
+        if (item.material >= ctx.materials.size()) {
+            // The other paths assert this; here the GPU would index past its buckets: skipped, said once.
+            ++stats.wires_skipped;
+            stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": material " +
+                                         std::to_string(item.material) + " is out of range (" +
+                                         std::to_string(ctx.materials.size()) + " materials): not drawn");
+            continue;
+        }
         Slot* known = i < item_slot_.size() ? item_slot_[i] : nullptr;
         bool fresh = false;
         auto it = slots_.end();
@@ -209,6 +236,13 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             known = &it->second;
         }
         Slot& slot = *known;
+        if (slot.last_frame == frame_) {
+            // A second item with this wire_id: both would write one slot's curve and state. The first is drawn.
+            ++stats.wires_skipped;
+            stats.status = Status::error("wire " + std::to_string(item.wire_id) +
+                                         ": listed twice in the draw list (ids must be unique): drawn once");
+            continue;
+        }
         if (fresh) {
             if (free_slots_.empty()) {
                 const auto index = static_cast<uint32_t>(slots_.size() - 1 + free_slots_.size());
@@ -282,12 +316,16 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             }
             slot.generation = item.nodes_generation;
             slot.built = true;
+            dispatched_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
         }
         if (!slot.built) continue;
         // The ring pass takes the changed wires' slots from their headers: only the others are listed.
-        if (!changed) visible_slots_.push_back(slot.index);
+        if (!changed) {
+            visible_slots_.push_back(slot.index);
+            listed_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
+        }
         segments_visible += slot.segments;
-        if (item.material < material_used_.size()) material_used_[item.material] = 1;
+        material_used_[item.material] = 1;
     }
     // Wires not drawn for a while give their slot and segments back: looked for every 16th frame (a walk over
     // every resident wire; evicted up to 15 frames after retain_frames, which changes nothing that is drawn).
@@ -304,7 +342,19 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     changed_ = up.headers.size();
     visible_ = changed_ + visible_slots_.size();
     stats.wires_uploaded = changed_;
+    dispatched_.insert(dispatched_.end(), listed_.begin(), listed_.end());
     if (visible_ == 0) return false;
+    // A frame that cannot be computed draws nothing and says why; the wires it would have uploaded stay unbuilt
+    // (their slots hold no curve), so the next frame sends them again.
+    const auto fail = [&](const Status& why) {
+        for (std::size_t k = 0; k < changed_; ++k) {
+            if (auto it = slots_.find(dispatched_[k].wire_id); it != slots_.end()) it->second.built = false;
+        }
+        dispatched_.clear();
+        stats.wires_skipped += visible_;
+        stats.status = Status::error("wire nodes: " + why.message);
+        return false;
+    };
 
     // The region: headers | nodes | extras | visible slots of the unchanged wires.
     const std::size_t real_node_bytes = node_total * sizeof(glm::vec4);
@@ -317,8 +367,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     const std::size_t visible_at = extra_at + align_up(extra_bytes);
     if (visible_at + visible_bytes > region.size_bytes) {
         // Never (upload_bytes() sized the region for this layout); were it to, nothing is written past the region.
-        stats.wires_skipped += visible_;
-        return false;
+        return fail(Status::error("the stream region holds " + std::to_string(region.size_bytes) + " bytes, the frame needs " +
+                                  std::to_string(visible_at + visible_bytes)));
     }
     std::byte* base = region.data;
     if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
@@ -363,16 +413,17 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     const std::size_t reserve = segments_visible + visible_;
     const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
     std::size_t scratch_nodes = changed_ ? std::max<std::size_t>(node_total, 1) : 1;
-    const bool ok = ensure(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch", false) &&
-                    ensure(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs", false) &&
-                    ensure(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws", false) &&
-                    ensure(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings",
-                           false) &&
-                    ensure(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks", false) &&
-                    ensure(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets", false) &&
-                    ensure(commands_, command_bytes_, buckets * 20, "wire nodes: commands", false) &&
-                    ensure(counter_, counter_bytes_, 12, "wire nodes: ring counter", false);
-    if (!ok) return false;
+    for (Status st : {ensure(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch", false),
+                      ensure(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs", false),
+                      ensure(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws", false),
+                      ensure(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings",
+                             false),
+                      ensure(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks", false),
+                      ensure(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets", false),
+                      ensure(commands_, command_bytes_, buckets * 20, "wire nodes: commands", false),
+                      ensure(counter_, counter_bytes_, 12, "wire nodes: ring counter", false)}) {
+        if (!st) return fail(st);
+    }
     if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
         // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
         std::vector<uint32_t> t(2 * 6 * side_slots_, 0);
@@ -387,7 +438,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             }
         }
         auto made = gfx::make_buffer(std::span<const uint32_t>(t), "wire nodes: command templates");
-        if (!made) return false;
+        if (!made) return fail(made.error());
         templates_ = std::move(*made);
         template_sides_ = side_slots_;
         template_patterns_ = ctx.pattern_first.size();
@@ -422,7 +473,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
     if (!same_list) {
         // Kept for the next frames: copied on the GPU out of the region.
-        if (!ensure(visible_kept_, visible_kept_bytes_, visible_bytes, "wire nodes: visible slots", false)) return false;
+        if (Status st = ensure(visible_kept_, visible_kept_bytes_, visible_bytes, "wire nodes: visible slots", false); !st)
+            return fail(st);
         glCopyNamedBufferSubData(region.buffer, visible_kept_.id(), static_cast<GLintptr>(region.offset_bytes + visible_at), 0,
                                  static_cast<GLsizeiptr>(visible_bytes));
         last_visible_ = visible_slots_;
@@ -461,6 +513,9 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     // The counter, read kReadbackSlots frames later (the ring buffer's size).
     glCopyNamedBufferSubData(counter_.id(), readback_.id(), 0, static_cast<GLintptr>(8 * (frame_ % kReadbackSlots)), 8);
+    GLsync& fence = readback_fence_[frame_ % kReadbackSlots];
+    if (fence != nullptr) glDeleteSync(fence);  // an older copy into the slot, not read: this one supersedes it
+    fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     glUseProgram(0);
     buckets_used_ = buckets;
     stats.draw_items = visible_;
@@ -499,6 +554,63 @@ void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats) {
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+}
+
+Status NodePath::read_rings(std::vector<DrawnRings>& out) const {
+    out.clear();
+    if (dispatched_.empty()) return Status::success();
+    // glGetNamedBufferSubData waits for the dispatches; the last stage's barrier has BUFFER_UPDATE.
+    std::vector<Job> jobs(dispatched_.size());
+    glGetNamedBufferSubData(jobs_.id(), 0, static_cast<GLsizeiptr>(jobs.size() * sizeof(Job)), jobs.data());
+    std::vector<uint32_t> counts;
+    std::vector<PackedRing> packed;
+    for (std::size_t w = 0; w < dispatched_.size(); ++w) {
+        const Dispatched& d = dispatched_[w];
+        const Job& job = jobs[w];
+        if (job.ring_count == 0) continue;  // culled on the GPU (or, past the reserve, not drawn)
+        GpuCurveHeader header;
+        glGetNamedBufferSubData(slot_headers_.id(), static_cast<GLintptr>(std::size_t{d.slot} * sizeof(header)),
+                                sizeof(header), &header);
+        const bool closed = (header.flags & kHeaderClosed) != 0;
+        const bool coarse = (job.flags & kJobFromReserve) != 0;
+        counts.assign(d.segments, 1u);  // the reserve's one ring a segment
+        if (!coarse && d.segments != 0) {
+            glGetNamedBufferSubData(counts_.id(), static_cast<GLintptr>(std::size_t{d.segment_first} * 4),
+                                    static_cast<GLsizeiptr>(std::size_t{d.segments} * 4), counts.data());
+        }
+        DrawnRings& drawn = out.emplace_back();
+        drawn.wire_id = d.wire_id;
+        drawn.sides = job.sides;
+        drawn.coarse = coarse;
+        RingSet& r = drawn.rings;
+        place_rings(counts, closed, r.params);
+        if (r.params.size() != job.ring_count) {
+            out.clear();
+            return Status::error("wire " + std::to_string(d.wire_id) + ": the GPU drew " +
+                                 std::to_string(job.ring_count) + " rings, its counts place " +
+                                 std::to_string(r.params.size()));
+        }
+        packed.resize(job.ring_count);
+        glGetNamedBufferSubData(rings_.id(), static_cast<GLintptr>(std::size_t{job.ring_first} * sizeof(PackedRing)),
+                                static_cast<GLsizeiptr>(packed.size() * sizeof(PackedRing)), packed.data());
+        r.closed = closed;
+        r.origin_m = glm::dvec3(header.origin_m[0], header.origin_m[1], header.origin_m[2]);
+        r.length_m = job.totals[1];
+        const std::size_t n = packed.size();
+        r.rings.resize(n), r.frames.resize(n), r.centre_m.resize(n), r.u.resize(n + (closed ? 1 : 0));
+        r.arc_length_m.clear();
+        for (std::size_t i = 0; i < n; ++i) {
+            const PackedRing& p = packed[i];
+            const DecodedFrame f = unpack_frame(p);
+            const glm::vec3 centre(p.centre_m[0], p.centre_m[1], p.centre_m[2]);
+            r.rings[i] = Ring{centre, p.radius_m, f.normal, p.u, f.binormal, r.params[i].segment};
+            r.frames[i] = Frame{glm::dvec3(f.tangent), glm::dvec3(f.normal), glm::dvec3(f.binormal)};
+            r.centre_m[i] = glm::dvec3(centre);
+            r.u[i] = p.u;
+        }
+        if (closed) r.u[n] = job.totals[0];
+    }
+    return Status::success();
 }
 
 }  // namespace wire::render::detail

@@ -14,6 +14,9 @@
 #include "engine/gfx/stream_buffer.hpp"
 #include "engine/scene/camera.hpp"
 
+#include <epoxy/gl.h>
+
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -36,6 +39,10 @@ struct NodeDrawContext {
 class NodePath {
 public:
     static Expected<std::unique_ptr<NodePath>> create(uint32_t retain_frames);
+    NodePath() = default;
+    NodePath(const NodePath&) = delete;
+    NodePath& operator=(const NodePath&) = delete;
+    ~NodePath();  ///< deletes its fences (context current)
     /// The LOD of the next frames (keep_node_resolution implied, max_sides clamped to 3 .. 256).
     void set_lod(const LodSettings& lod);
 
@@ -48,6 +55,8 @@ public:
     void submit(const NodeDrawContext& ctx, DrawStats& stats);
     /// Bytes prepare() writes into the region for `list` (an upper bound; computed per frame).
     std::size_t upload_bytes(const DrawList& list);
+    /// The rings the last prepare() computed and submit() drew (WireRenderer::read_drawn_rings); waits for the GPU.
+    Status read_rings(std::vector<DrawnRings>& out) const;
     /// The most sides the frame's LOD can give (the patterns must cover it).
     [[nodiscard]] uint32_t max_sides() const { return max_sides_; }
 
@@ -90,7 +99,10 @@ private:
     std::size_t scratch_bytes_ = 0, job_bytes_ = 0, draw_bytes_ = 0, chunk_bytes_ = 0, ring_bytes_ = 0,
                 bucket_bytes_ = 0, command_bytes_ = 0, counter_bytes_ = 0, template_bytes_ = 0;
     std::size_t ring_capacity_ = 0;  ///< rings the ring buffer holds
-    void* readback_map_ = nullptr;   ///< per frame in flight: the ring counter and overflow, read 3 frames later
+    void* readback_map_ = nullptr;   ///< per readback slot: the ring counter and overflow, read 3 frames later
+    /// Per readback slot: the fence after the copy into it (null: nothing in flight), read only once signalled.
+    std::array<GLsync, 3> readback_fence_{};
+    std::size_t max_block_bytes_ = std::size_t{1} << 27;  ///< GL_MAX_SHADER_STORAGE_BLOCK_SIZE
     uint32_t template_sides_ = 0;    ///< side slots the templates were built for
     std::size_t template_patterns_ = 0;
     // This frame.
@@ -108,6 +120,13 @@ private:
     };
     std::vector<Piece> node_pieces_, extra_pieces_;
     std::vector<uint32_t> visible_slots_;
+    /// Per wire the last prepare() dispatched, in dispatch order (the changed wires' headers, then the listed):
+    /// what read_rings() needs to find its records.
+    struct Dispatched {
+        uint64_t wire_id = 0;
+        uint32_t slot = 0, segment_first = 0, segments = 0;
+    };
+    std::vector<Dispatched> dispatched_, listed_;
     std::vector<uint32_t> last_visible_;  ///< the list kept on the GPU (visible_kept_): unchanged, it is not sent
     engine::gfx::Buffer visible_kept_;
     std::size_t visible_kept_bytes_ = 0;

@@ -21,8 +21,10 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <numbers>
+#include <string>
 #include <numeric>
 
 namespace wire::render {
@@ -101,6 +103,20 @@ struct WireRenderer::State {
     std::vector<uint8_t> streamed;     ///< retained path, per drawn item (order): rings streamed this frame
     std::size_t retained_ring_bytes = 0;  ///< retained path: bytes written into the ring storage this frame
     std::unique_ptr<detail::NodePath> nodes;  ///< gpu-nodes: made on its first frame
+    Status nodes_failed{};                    ///< why the nodes path could not be made (not retried)
+    std::vector<std::string> logged;          ///< failures draw() has logged (each once)
+    UploadPath last_path = UploadPath::cpu_mesh;
+    bool drawn_any = false;                   ///< a draw() has run
+
+    /// `stats` with the failure recorded, logged to stderr the first time this message is seen.
+    DrawStats& failed(DrawStats& stats, const Status& why) {
+        stats.status = why;
+        if (std::find(logged.begin(), logged.end(), why.message) == logged.end()) {
+            logged.push_back(why.message);
+            std::fprintf(stderr, "wire renderer: %s\n", why.message.c_str());
+        }
+        return stats;
+    }
 
     /// The frame's GL state and the wire program's per-frame uniforms (both paths that draw rings, and cpu-mesh).
     void begin_wires(const gfx::Program& program, const engine::scene::Camera& camera, const DrawSettings& settings) {
@@ -130,16 +146,20 @@ struct WireRenderer::State {
     /// The gpu-nodes frame (node_path.hpp).
     DrawStats draw_nodes(const DrawList& list, const engine::scene::Camera& camera, const DrawSettings& settings) {
         DrawStats stats;
+        if (!nodes_failed.ok()) return failed(stats, nodes_failed);
         if (!nodes) {
             Expected<std::unique_ptr<detail::NodePath>> made = detail::NodePath::create(desc.retain_frames);
-            if (!made) return stats;
+            if (!made) {
+                nodes_failed = Status::error("the nodes path cannot be used: " + made.error().message);
+                return failed(stats, nodes_failed);
+            }
             nodes = std::move(*made);
         }
         nodes->set_lod(settings.node_lod);
-        if (Status st = ensure_patterns(nodes->max_sides()); !st) return stats;
+        if (Status st = ensure_patterns(nodes->max_sides()); !st) return failed(stats, st);
         const std::size_t bytes = nodes->upload_bytes(list);
         Expected<StreamRegion> begun = stream.begin(bytes);
-        if (!begun) return stats;
+        if (!begun) return failed(stats, begun.error());
         stats.buffer_grew = begun->grew;
         stats.waited_for_gpu = begun->waited;
         const detail::NodeDrawContext ctx{rings_program, rings_vao, circle.id(), pattern_first, materials, textures,
@@ -149,7 +169,10 @@ struct WireRenderer::State {
         at_eye.target += eye - camera.position;
         at_eye.position = eye;
         const bool drawn = nodes->prepare(list, at_eye, *begun, ctx, stats);
-        if (drawn && ensure_draw_index_capacity(nodes->chunk_capacity())) {
+        if (!stats.status.ok()) failed(stats, stats.status);
+        Status index_capacity = drawn ? ensure_draw_index_capacity(nodes->chunk_capacity()) : Status::success();
+        if (!index_capacity) failed(stats, index_capacity);
+        if (drawn && index_capacity) {
             begin_wires(rings_program, camera, settings);
             nodes->submit(ctx, stats);
             glBindVertexArray(0);
@@ -410,9 +433,23 @@ std::size_t WireRenderer::node_path_buffers() const { return state_->nodes ? sta
 std::size_t WireRenderer::node_path_programs() const { return state_->nodes ? 2 : 0; }
 std::size_t WireRenderer::node_path_wires() const { return state_->nodes ? state_->nodes->resident_wires() : 0; }
 
+Status WireRenderer::read_drawn_rings(std::vector<DrawnRings>& out) const {
+    out.clear();
+    const State& s = *state_;
+    if (!s.drawn_any) return Status::error("read_drawn_rings: nothing has been drawn yet");
+    if (s.last_path != UploadPath::gpu_nodes) {
+        return Status::error("read_drawn_rings: the last draw was on the '" + std::string(upload_path_name(s.last_path)) +
+                             "' path, which builds its rings on the CPU (wire::systems::wire_ring_set has them)");
+    }
+    if (!s.nodes) return Status::error("read_drawn_rings: " + s.nodes_failed.message);
+    return s.nodes->read_rings(out);
+}
+
 DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& camera,
                               const DrawSettings& settings) {
     State& s = *state_;
+    s.last_path = list.path;
+    s.drawn_any = true;
     if (list.path == UploadPath::gpu_nodes) return s.draw_nodes(list, camera, settings);
     DrawStats stats;
     const bool cpu = list.path == UploadPath::cpu_mesh;
@@ -448,7 +485,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     }
     const std::size_t n = s.order.size();
     if (!cpu) {
-        if (Status st = s.ensure_patterns(max_sides); !st) return stats;
+        if (Status st = s.ensure_patterns(max_sides); !st) return s.failed(stats, st);
     }
 
     // (2) Prepare: runs of equal (class, material), one multi-draw each, and their commands. cpu-mesh: one

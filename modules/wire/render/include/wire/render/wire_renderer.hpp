@@ -24,6 +24,7 @@
 
 #include "wire/draw.hpp"
 #include "wire/lod.hpp"
+#include "wire/rings.hpp"
 
 #include "engine/gfx/resources.hpp"
 #include "engine/core/expected.hpp"
@@ -121,9 +122,26 @@ struct DrawStats {
     std::size_t indirect_commands = 0;
     std::size_t multi_draw_calls = 0;  ///< glMultiDrawElementsIndirect calls: one per (class, material) in use
     std::size_t chunks = 0;            ///< gpu-rings: chunk records (instances) drawn
+    /// Success, or why the frame drew nothing of what it should have (a program that did not build, a buffer that
+    /// could not be made): draw() also logs each distinct failure once to stderr.
+    Status status{};
     bool buffer_grew = false;          ///< the stream buffer was reallocated larger this frame
     bool waited_for_gpu =
         false;  ///< the region's fence had not signalled (more frames in flight than regions)
+};
+
+/// One wire's rings as a draw() on the nodes path computed and drew them, read back from the GPU
+/// (WireRenderer::read_drawn_rings): what the vertex shader expanded, decoded as it decodes them.
+struct DrawnRings {
+    uint64_t wire_id = 0;  ///< DrawItem::wire_id
+    uint32_t sides = 0;    ///< sides drawn: >= 3 a tube, 2 a camera-facing strip, 1 a line
+    bool coarse = false;   ///< drawn with one ring a segment from the reserve (the ring buffer was short)
+    /// origin_m: the wire's origin on the GPU (centres are float offsets from it); params: each ring's (segment,
+    /// t) from the counts the GPU's LOD chose, placed as place_rings() places them; rings: the float records as
+    /// drawn (the frame decoded from its 20-bit quaternion); frames, centre_m, u: the same in double (u of a
+    /// closed loop has one more entry: where the loop closes); length_m; closed. arc_length_m, folds and
+    /// frame_stats are not read back (left empty).
+    RingSet rings;
 };
 
 /// Draws DrawLists (see the file comment). Owns GL objects: create, use and destroy it with the same context
@@ -156,6 +174,12 @@ public:
     /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
     DrawStats draw(const DrawList& list, const engine::scene::Camera& camera,
                     const DrawSettings& settings = {});
+
+    /// gpu-nodes: the rings of every wire the last draw() drew (wires culled on the GPU are absent), in the order
+    /// the GPU dispatched them; waits for the GPU. Fails, naming the reason, when the last draw() was on another
+    /// path (cpu-mesh and gpu-rings build their rings on the CPU: wire::systems::wire_ring_set has them) or drew
+    /// nothing because the nodes path failed.
+    Status read_drawn_rings(std::vector<DrawnRings>& out) const;
 
     /// True when the gpu-rings chunk index comes from gl_BaseInstanceARB + gl_InstanceID
     /// (ARB_shader_draw_parameters), false when from the instanced attribute.
