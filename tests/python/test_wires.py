@@ -162,6 +162,47 @@ def test_runtime_rings_equal_wiretool_view_csv(tmp_path):
     assert_rings_equal(rt.rings(w), read_ring_csv(out))
 
 
+def test_nodes_path_rings_are_the_gpus_and_equal_wiretool_view_csv(tmp_path):
+    """On the nodes path the rings are read back from the GPU: after render(), as `wiretool view --path nodes`
+    writes them, and close to the CPU path's (float offsets, a 20-bit frame)."""
+    path, nodes, ids, stretch = wire_file(tmp_path)
+    out = tmp_path / "view_nodes.csv"
+    eye, target = (0.4, 0.6, 4.0), (0.0, 0.0, 0.0)
+    subprocess.run([WIRETOOL, "view", str(path), "--size", "640x360", "--path", "nodes", "--camera",
+                    ",".join(map(str, eye + target)), "--csv", str(out)], check=True)
+    table = read_ring_csv(out)
+    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+    centre, radius = 0.5 * (lo + hi), 0.5 * math.sqrt(float(np.dot(hi - lo, hi - lo))) + 0.04
+    reach = 1.25 * radius
+    d = np.array(eye) - centre
+    distance = math.sqrt(float(np.dot(d, d)))
+    far = 1.01 * (distance + reach)
+    near = max(0.5 * (distance - reach), max(1e-5 * far, min(0.05, 0.01 * reach)))
+    rings = {}
+    for name in ("nodes", "cpu"):
+        rt = wires.Runtime(640, 360, path=name)
+        w = rt.spawn(nodes, ids=ids, stretch=stretch, radius=0.04)
+        rt.set_camera(eye, target, near=near, far=far)
+        rt.update()
+        if name == "nodes":
+            with pytest.raises(RuntimeError, match="render"):
+                rt.rings(w)
+        rt.render(clear=CLEAR)
+        rings[name] = rt.rings(w)
+    assert_rings_equal(rings["nodes"], table)
+    # The CPU path's LOD may leave segments without a ring (below node resolution); every ring it places is one the
+    # GPU places too, at the same point of the same curve.
+    gpu, cpu = rings["nodes"], rings["cpu"]
+    at = {(int(seg), float(t)): i for i, (seg, t) in enumerate(zip(gpu["segment"], gpu["t"]))}
+    matched = [(at[(int(seg), float(t))], k) for k, (seg, t) in enumerate(zip(cpu["segment"], cpu["t"]))
+               if (int(seg), float(t)) in at]
+    assert len(matched) == len(cpu["t"])
+    g, c = zip(*matched)
+    np.testing.assert_allclose(gpu["centres"][list(g)], cpu["centres"][list(c)], rtol=0, atol=2e-6)
+    with pytest.raises(ValueError, match="'nodes'"):
+        wires.Runtime(64, 64, path="rings")
+
+
 # ---- pixels: the wire is drawn where its nodes project ----
 
 def test_image_shows_the_wire_where_its_nodes_project(tmp_path):

@@ -26,6 +26,7 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <tuple>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -680,6 +681,70 @@ TEST_F(WiretoolView, OpenWorldCameraStepsOfOneMillimetreMoveTheImageSmoothly) {
             EXPECT_NEAR(steps_far[k], steps_origin[k], 0.1 * std::abs(median)) << p << ": step " << k + 1;
         }
     }
+}
+
+// `--path nodes --csv` writes the rings the GPU computed and drew (read back), not an empty table: every ring the
+// CPU path places (its LOD may leave a segment without a ring, below node resolution) is one the GPU places too,
+// at the same point and frame, for random cables at the origin and 1e6 m out; both list the same wires and sides.
+TEST_F(WiretoolView, NodesPathCsvHoldsTheRingsTheGpuDrew) {
+    std::vector<double> centre_err, frame_err;
+    std::size_t gpu_rows_total = 0, wire_frames = 0, sides_differ = 0;
+    for (uint32_t seed = 1; seed <= 3; ++seed) {
+        for (const double distance : {0.0, 1.0e6}) {
+            const glm::dvec3 offset = distance * glm::normalize(glm::dvec3(0.3, -0.8, 0.5));
+            const std::string in = write("cables.json", open_world_scene(open_world_cables(seed, offset), offset, 2, 0.05).dump());
+            ASSERT_EQ(run(in + " --size 640x360 --path cpu --csv " + path("cpu.csv")).status, 0);
+            const ToolRun r = run(in + " --size 640x360 --path nodes --csv " + path("nodes.csv"));
+            ASSERT_EQ(r.status, 0) << r.err;
+            std::string h1, h2;
+            const auto cpu = read_csv(path("cpu.csv"), h1);
+            const auto gpu = read_csv(path("nodes.csv"), h2);
+            EXPECT_EQ(h1, h2);
+            ASSERT_FALSE(gpu.empty());
+            gpu_rows_total += gpu.size();
+            // (frame, wire, segment, t) -> row of the nodes path.
+            std::map<std::tuple<int, int, int, double>, std::size_t> at;
+            std::map<std::pair<int, int>, int> gpu_sides, cpu_sides;
+            for (std::size_t i = 0; i < gpu.size(); ++i) {
+                const auto& g = gpu[i];
+                ASSERT_EQ(g.size(), static_cast<std::size_t>(kColumns));
+                at[{int(g[kFrame]), int(g[kWire]), int(g[3]), g[4]}] = i;
+                gpu_sides[{int(g[kFrame]), int(g[kWire])}] = int(g[kSides]);
+            }
+            for (const auto& c : cpu) {
+                cpu_sides[{int(c[kFrame]), int(c[kWire])}] = int(c[kSides]);
+                const auto it = at.find({int(c[kFrame]), int(c[kWire]), int(c[3]), c[4]});
+                ASSERT_NE(it, at.end()) << "seed " << seed << ": the GPU has no ring at frame " << c[kFrame] << " wire "
+                                        << c[kWire] << " segment " << c[3] << " t " << c[4];
+                const auto& g = gpu[it->second];
+                centre_err.push_back(glm::length(glm::dvec3(g[kX], g[kY], g[kZ]) - glm::dvec3(c[kX], c[kY], c[kZ])));
+                double frame = 0.0;
+                for (int k = 8; k < 17; ++k) frame = std::max(frame, std::abs(g[k] - c[k]));
+                frame_err.push_back(frame);
+                EXPECT_NEAR(g[kRadius], c[kRadius], 1e-6 * c[kRadius]);
+                EXPECT_NEAR(g[18], c[18], 1e-5 * std::max(1.0, c[18]));
+            }
+            // The same wires in view; the same sides but where the CPU LOD's depth bound (its bounding sphere's
+            // nearest point, not the nearest segment hull) puts the projected radius across the line/strip
+            // threshold: those are counted.
+            ASSERT_EQ(gpu_sides.size(), cpu_sides.size()) << "seed " << seed;
+            for (const auto& [key, sides] : cpu_sides) {
+                ++wire_frames;
+                ASSERT_TRUE(gpu_sides.count(key)) << "seed " << seed << ": wire " << key.second << " not read back";
+                if (gpu_sides[key] != sides) {
+                    ++sides_differ;
+                    EXPECT_LE(std::max(sides, gpu_sides[key]), 2) << "only lines and strips may differ";
+                }
+            }
+        }
+    }
+    std::printf("nodes path CSV vs cpu: %zu rows read back; centre error m median %.2e p90 %.2e max %.2e; frame "
+                "component error median %.2e max %.2e; sides differ on %zu of %zu wire frames (line vs strip)\n",
+                gpu_rows_total, percentile(centre_err, 0.5), percentile(centre_err, 0.9), percentile(centre_err, 1.0),
+                percentile(frame_err, 0.5), percentile(frame_err, 1.0), sides_differ, wire_frames);
+    EXPECT_LE(percentile(centre_err, 1.0), 1e-5);
+    EXPECT_LE(percentile(frame_err, 1.0), 5e-4);
+    EXPECT_LE(sides_differ * 10, wire_frames);
 }
 
 TEST_F(WiretoolView, HelpListsEveryOption) {

@@ -223,7 +223,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         if (item.material >= ctx.materials.size()) {
             // The other paths assert this; here the GPU would index past its buckets: skipped, said once.
             ++stats.wires_skipped;
-            stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": material " +
+            if (stats.status.ok()) stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": material " +
                                          std::to_string(item.material) + " is out of range (" +
                                          std::to_string(ctx.materials.size()) + " materials): not drawn");
             continue;
@@ -239,7 +239,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         if (slot.last_frame == frame_) {
             // A second item with this wire_id: both would write one slot's curve and state. The first is drawn.
             ++stats.wires_skipped;
-            stats.status = Status::error("wire " + std::to_string(item.wire_id) +
+            if (stats.status.ok()) stats.status = Status::error("wire " + std::to_string(item.wire_id) +
                                          ": listed twice in the draw list (ids must be unique): drawn once");
             continue;
         }

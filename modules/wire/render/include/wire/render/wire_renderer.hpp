@@ -122,8 +122,9 @@ struct DrawStats {
     std::size_t indirect_commands = 0;
     std::size_t multi_draw_calls = 0;  ///< glMultiDrawElementsIndirect calls: one per (class, material) in use
     std::size_t chunks = 0;            ///< gpu-rings: chunk records (instances) drawn
-    /// Success, or why the frame drew nothing of what it should have (a program that did not build, a buffer that
-    /// could not be made): draw() also logs each distinct failure once to stderr.
+    /// Success, or the frame's first problem: why it drew nothing (a program that did not build, a buffer that
+    /// could not be made), or which item it skipped and why (gpu-nodes: a material out of range, a wire id listed
+    /// twice; the rest is drawn). draw() also logs each distinct message once to stderr.
     Status status{};
     bool buffer_grew = false;          ///< the stream buffer was reallocated larger this frame
     bool waited_for_gpu =
