@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <vector>
 #include <cassert>
+#include <cstdlib>
 #include <glm/gtc/type_ptr.hpp>
 
 namespace engine::gfx {
@@ -70,6 +71,13 @@ Expected<Buffer> make_buffer(const BufferDesc& desc) {
         glNamedBufferStorage(id, static_cast<GLsizeiptr>(size), desc.data.data(), flags);
     } else {
         glNamedBufferStorage(id, static_cast<GLsizeiptr>(size), nullptr, flags | GL_DYNAMIC_STORAGE_BIT);
+        // WIRE_GFX_POISON_BUFFERS=1: the unwritten bytes read 0xff, as a hardware driver's pool may hand out stale
+        // memory where llvmpipe gives zeros (tests run with it to catch reads of memory never written).
+        if (const char* poison = std::getenv("WIRE_GFX_POISON_BUFFERS");
+            poison != nullptr && poison[0] == '1' && size % 4 == 0) {
+            const GLuint all_ones = 0xffffffffu;
+            glClearNamedBufferData(id, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &all_ones);
+        }
         if (!desc.data.empty())
             glNamedBufferSubData(id, 0, static_cast<GLsizeiptr>(desc.data.size()), desc.data.data());
     }

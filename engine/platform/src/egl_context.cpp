@@ -261,6 +261,7 @@ public:
     void begin_frame() override {
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
         glViewport(0, 0, width_, height_);
+        glDisable(GL_DITHER);  // on by default; a driver that dithers would make equal colours differ
     }
     void end_frame() override { glFlush(); }
 

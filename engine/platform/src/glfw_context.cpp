@@ -86,6 +86,7 @@ public:
         const Extent e = framebuffer_size();
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         glViewport(0, 0, e.width, e.height);
+        glDisable(GL_DITHER);  // on by default; a driver that dithers would make equal colours differ
     }
     void end_frame() override { glfwSwapBuffers(window_); }
 

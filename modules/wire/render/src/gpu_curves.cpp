@@ -23,19 +23,19 @@ namespace {
 constexpr const char* kCurveSource = R"glsl(#version 450 core
 layout(local_size_x = 64) in;
 GPU_WIRE_HEADER
-layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };
-layout(std430, binding = 1) readonly buffer Nodes { vec4 nodes[]; };  // xyz: offset from the origin; w: radius
-layout(std430, binding = 2) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: see put_segment
-layout(std430, binding = 3) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
+layout(std430, binding = CURVE_HEADERS) readonly buffer Headers { Header headers[]; };
+layout(std430, binding = CURVE_NODES) readonly buffer Nodes { vec4 nodes[]; };  // xyz: offset from the origin; w: radius
+layout(std430, binding = CURVE_SEGMENTS) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: see put_segment
+layout(std430, binding = CURVE_SCRATCH) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
 // Per-node tension, bias, continuity (vec4 a node), then stretch (4 segments a vec4), from Header.extra_first.
-layout(std430, binding = 4) readonly buffer Extras { vec4 extras[]; };
+layout(std430, binding = CURVE_EXTRAS) readonly buffer Extras { vec4 extras[]; };
 // u_persist: each wire's header goes on to its slot (the ring pass reads it there every frame).
-layout(std430, binding = 6) writeonly buffer SlotHeaders { Header slot_headers[]; };
+layout(std430, binding = CURVE_SLOT_HEADERS) writeonly buffer SlotHeaders { Header slot_headers[]; };
 // u_motion: per slot, the motion reference of its last upload (motion_reference's samples of its curve nodes:
 // origin.xyz the upload's origin, origin.w the determinacy; counts.x samples, counts.y nodes, 0 samples: none;
 // p[k].xyz the sample's offset from the origin, p[k].w its weight).
 struct MotionRef { vec4 origin; uvec4 counts; vec4 p[10]; };
-layout(std430, binding = 7) buffer MotionRefs { MotionRef refs[]; };
+layout(std430, binding = CURVE_MOTION_REFS) buffer MotionRefs { MotionRef refs[]; };
 uniform uint u_wires;
 uniform bool u_persist;
 uniform bool u_motion;
@@ -506,7 +506,10 @@ std::string with_wire_header(const char* source) {
     std::string s(source);
     const std::string key = "GPU_WIRE_HEADER";
     const std::size_t at = s.find(key);
-    if (at != std::string::npos) s.replace(at, key.size(), kWireHeaderGlsl);
+    if (at == std::string::npos) return s;
+    std::string text;
+    for (const BindingMacro& m : kBindingMacros) text += "#define " + std::string(m.name) + " " + std::to_string(m.binding) + "\n";
+    s.replace(at, key.size(), text + kWireHeaderGlsl);
     return s;
 }
 
@@ -631,14 +634,14 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
         glClearNamedBufferData(motion_refs_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
         motion_ref_wires_ = wires.size();
     }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, headers_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, nodes_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, extras_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveHeaders, headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveNodes, nodes_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveSegments, segments_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveScratch, scratch_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveExtras, extras_.id());
     // Slot w is wire w: the headers go back onto themselves (with the motion the GPU fitted), the references stay.
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, headers_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, motion_refs_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveSlotHeaders, headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveMotionRefs, motion_refs_.id());
     program_.use();
     glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(wires.size()));
     glUniform1i(program_.uniform_location("u_persist"), 1);

@@ -34,28 +34,28 @@ struct Job {
 // Per slot, kept between frames: the LOD's state (sides, drawn sides, 1 when it holds a previous frame's, 1
 // visible) and ring 0's normal of the last frame (w = 1 when set). A slot is zeroed when it is given to a wire.
 struct SlotState { uvec4 lod; vec4 first_normal; };
-layout(std430, binding = 0) readonly buffer Headers { Header headers[]; };  // by slot
-layout(std430, binding = 2) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2; w: see below
-layout(std430, binding = 6) buffer Jobs { Job jobs[]; };
+layout(std430, binding = RING_HEADERS) readonly buffer Headers { Header headers[]; };  // by slot
+layout(std430, binding = RING_SEGMENTS) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2; w: see below
+layout(std430, binding = RING_JOBS) buffer Jobs { Job jobs[]; };
 // Rings per segment (at Header.segment_first): the caller's, or (u_lod) the LOD's, over the previous frame's.
-layout(std430, binding = 7) buffer Counts { uint counts[]; };
-layout(std430, binding = 8) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
-layout(std430, binding = 9) buffer Slots { SlotState slot_state[]; };
+layout(std430, binding = RING_COUNTS) buffer Counts { uint counts[]; };
+layout(std430, binding = RING_RINGS) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
+layout(std430, binding = RING_SLOTS) buffer Slots { SlotState slot_state[]; };
 // Rings allocated, wires that did not fit, rings allocated from the reserve (u_ring_reserve records after
 // u_ring_capacity: one ring a segment for every listed wire, so a wire that does not fit is drawn coarse, not
 // missing, until the ring buffer has grown).
-layout(std430, binding = 10) buffer Counter { uint ring_counter; uint overflow; uint reserve_counter; };
+layout(std430, binding = RING_COUNTER) buffer Counter { uint ring_counter; uint overflow; uint reserve_counter; };
 // The slot of each dispatched wire: the first u_changed are this frame's curve headers' (their nodes changed), the
 // others listed.
-layout(std430, binding = 11) readonly buffer Visible { uint visible[]; };
-layout(std430, binding = 17) readonly buffer FrameHeaders { Header frame_headers[]; };
+layout(std430, binding = RING_VISIBLE) readonly buffer Visible { uint visible[]; };
+layout(std430, binding = RING_FRAME_HEADERS) readonly buffer FrameHeaders { Header frame_headers[]; };
 // u_draw: the single draw's records (wire::render's GpuDraw, the chunk records and the indirect commands).
 struct Draw { vec3 offset_m; uint ring_first; uint ring_count; uint sides; uint flags; float u_close; };
-layout(std430, binding = 12) writeonly buffer Draws { Draw draws[]; };
-layout(std430, binding = 13) writeonly buffer Chunks { uvec2 chunks[]; };
-layout(std430, binding = 14) buffer Buckets { uint buckets[]; };  // u_buckets chunk counts, then as many cursors
-layout(std430, binding = 15) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
-layout(std430, binding = 16) readonly buffer Templates { uvec2 templates[]; };  // (count, first index) per side slot and kind
+layout(std430, binding = RING_DRAWS) writeonly buffer Draws { Draw draws[]; };
+layout(std430, binding = RING_CHUNKS) writeonly buffer Chunks { uvec2 chunks[]; };
+layout(std430, binding = RING_BUCKETS) buffer Buckets { uint buckets[]; };  // u_buckets chunk counts, then as many cursors
+layout(std430, binding = RING_COMMANDS) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
+layout(std430, binding = RING_TEMPLATES) readonly buffer Templates { uvec2 templates[]; };  // (count, first index) per side slot and kind
 uniform uint u_wires;
 uniform uint u_changed;
 uniform uint u_ring_capacity;
@@ -775,15 +775,15 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     state_wires_ = jobs.size();
     count_total_ = count_total;
     lod_ = lod != nullptr;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, curves.headers_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, curves.segments_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, jobs_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, counts_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, state_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 11, visible_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 17, curves.headers_.id());  // the "changed" wires: all (u_changed)
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingHeaders, curves.headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingSegments, curves.segments_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingJobs, jobs_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingCounts, counts_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingRings, rings_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingSlots, state_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingCounter, counter_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingVisible, visible_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingFrameHeaders, curves.headers_.id());  // the "changed" wires: all (u_changed)
     program_.use();
     const auto at = [&](const char* name) { return program_.uniform_location(name); };
     glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));

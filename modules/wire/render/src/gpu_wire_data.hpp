@@ -38,7 +38,34 @@ struct Header {
 };
 )glsl";
 
-/// `source` with GPU_WIRE_HEADER replaced by kWireHeaderGlsl.
+/// The shader storage binding points of the curve and ring programs, dense from 0: GL guarantees 8 bindings and 8
+/// blocks a stage, NVIDIA 16 (a binding past that fails to link there, never on llvmpipe). The GLSL names them by
+/// macros of the same names in capitals (kRingJobs: RING_JOBS), defined by with_wire_header(), so both sides read
+/// one number.
+enum CurveBinding : uint32_t {
+    kCurveHeaders, kCurveNodes, kCurveSegments, kCurveScratch, kCurveExtras, kCurveSlotHeaders, kCurveMotionRefs,
+    kCurveBindings
+};
+enum RingBinding : uint32_t {
+    kRingHeaders, kRingFrameHeaders, kRingSegments, kRingJobs, kRingCounts, kRingRings, kRingSlots, kRingCounter,
+    kRingVisible, kRingDraws, kRingChunks, kRingBuckets, kRingCommands, kRingTemplates, kRingBindings
+};
+/// The binding macros with_wire_header() defines: (GLSL name, binding).
+struct BindingMacro {
+    const char* name;
+    uint32_t binding;
+};
+inline constexpr BindingMacro kBindingMacros[] = {
+    {"CURVE_HEADERS", kCurveHeaders}, {"CURVE_NODES", kCurveNodes}, {"CURVE_SEGMENTS", kCurveSegments},
+    {"CURVE_SCRATCH", kCurveScratch}, {"CURVE_EXTRAS", kCurveExtras}, {"CURVE_SLOT_HEADERS", kCurveSlotHeaders},
+    {"CURVE_MOTION_REFS", kCurveMotionRefs}, {"RING_HEADERS", kRingHeaders}, {"RING_FRAME_HEADERS", kRingFrameHeaders},
+    {"RING_SEGMENTS", kRingSegments}, {"RING_JOBS", kRingJobs}, {"RING_COUNTS", kRingCounts},
+    {"RING_RINGS", kRingRings}, {"RING_SLOTS", kRingSlots}, {"RING_COUNTER", kRingCounter},
+    {"RING_VISIBLE", kRingVisible}, {"RING_DRAWS", kRingDraws}, {"RING_CHUNKS", kRingChunks},
+    {"RING_BUCKETS", kRingBuckets}, {"RING_COMMANDS", kRingCommands}, {"RING_TEMPLATES", kRingTemplates},
+};
+
+/// `source` with GPU_WIRE_HEADER replaced by the binding macros (kBindingMacros) and kWireHeaderGlsl.
 std::string with_wire_header(const char* source);
 
 inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u,

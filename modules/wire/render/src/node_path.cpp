@@ -32,6 +32,25 @@ void clear_range(const gfx::Buffer& buffer, std::size_t offset, std::size_t byte
                               GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 }
 
+/// Fails, naming the limit, when `program` uses more shader storage blocks or bindings than this driver allows
+/// (checked at create: a link that succeeds can still exceed a limit some drivers enforce only at dispatch).
+Status check_storage_limits(const gfx::Program& program, const char* label, uint32_t bindings) {
+    GLint blocks = 0, max_blocks = 0, max_bindings = 0, max_outputs = 0;
+    glGetProgramInterfaceiv(program.id(), GL_SHADER_STORAGE_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
+    glGetIntegerv(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, &max_blocks);
+    glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &max_bindings);
+    glGetIntegerv(GL_MAX_COMBINED_SHADER_OUTPUT_RESOURCES, &max_outputs);
+    const auto fails = [&](const char* limit, GLint value, GLint need) {
+        return Status::error(std::string(label) + ": needs " + std::to_string(need) + " for " + limit + ", the driver allows " +
+                             std::to_string(value));
+    };
+    if (blocks > max_blocks) return fails("GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS", max_blocks, blocks);
+    if (static_cast<GLint>(bindings) > max_bindings)
+        return fails("GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS", max_bindings, static_cast<GLint>(bindings));
+    if (blocks > max_outputs) return fails("GL_MAX_COMBINED_SHADER_OUTPUT_RESOURCES", max_outputs, blocks);
+    return Status::success();
+}
+
 }  // namespace
 
 void NodePath::set_lod(const LodSettings& lod) {
@@ -48,6 +67,8 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     if (!rings) return rings.error();
     path->curve_program_ = std::move(*curve);
     path->ring_program_ = std::move(*rings);
+    if (Status st = check_storage_limits(path->curve_program_, "wire nodes: curves", kCurveBindings); !st) return st;
+    if (Status st = check_storage_limits(path->ring_program_, "wire nodes: rings", kRingBindings); !st) return st;
     path->set_lod({});
     path->retain_frames_ = retain_frames ? retain_frames : 180;
     auto readback = gfx::make_buffer({.size_bytes = kReadbackSlots * 8,
@@ -449,13 +470,13 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     // (1) Curves of the wires whose nodes changed, into their slots' segments and headers.
     if (changed_ != 0) {
         curve_program_.use();
-        range(0, 0, header_bytes);
-        range(1, node_at, node_bytes);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, scratch_.id());
-        range(4, extra_at, extra_bytes);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, slot_headers_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, motion_refs_.id());
+        range(kCurveHeaders, 0, header_bytes);
+        range(kCurveNodes, node_at, node_bytes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSegments, segments_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveScratch, scratch_.id());
+        range(kCurveExtras, extra_at, extra_bytes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotHeaders, slot_headers_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveMotionRefs, motion_refs_.id());
         glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(changed_));
         glUniform1i(curve_program_.uniform_location("u_persist"), 1);
         glUniform1i(curve_program_.uniform_location("u_motion"), 1);
@@ -464,13 +485,13 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     }
     // (2) LOD, (3) commands, (4) rings and records, over the visible wires.
     ring_program_.use();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, slot_headers_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, segments_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, jobs_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, counts_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, rings_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, slot_state_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, counter_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingHeaders, slot_headers_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSegments, segments_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingJobs, jobs_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounts, counts_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingRings, rings_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSlots, slot_state_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounter, counter_.id());
     if (!same_list) {
         // Kept for the next frames: copied on the GPU out of the region.
         if (Status st = ensure(visible_kept_, visible_kept_bytes_, visible_bytes, "wire nodes: visible slots", false); !st)
@@ -479,13 +500,13 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
                                  static_cast<GLsizeiptr>(visible_bytes));
         last_visible_ = visible_slots_;
     }
-    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 11, visible_kept_.id(), 0, static_cast<GLsizeiptr>(visible_bytes));
-    range(17, 0, header_bytes);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, draws_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, chunks_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, buckets_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 15, commands_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 16, templates_.id());
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kRingVisible, visible_kept_.id(), 0, static_cast<GLsizeiptr>(visible_bytes));
+    range(kRingFrameHeaders, 0, header_bytes);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingDraws, draws_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingChunks, chunks_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingBuckets, buckets_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCommands, commands_.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingTemplates, templates_.id());
     const auto at = [&](const char* name) { return ring_program_.uniform_location(name); };
     GLint viewport[4] = {0, 0, 1, 1};
     glGetIntegerv(GL_VIEWPORT, viewport);

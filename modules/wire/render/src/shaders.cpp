@@ -21,7 +21,10 @@ constexpr std::string_view kDrawAttribute = R"(layout(location = 3) in uint a_re
 uint record_index() { return a_record; }
 )";
 
+// invariant: the cpu-mesh and ring programs compute gl_Position from the same values the same way; without it GL
+// does not promise the same positions from two programs (their shared edges and depth ties could differ).
 constexpr std::string_view kCommon = R"(
+invariant gl_Position;
 struct DrawData {
   vec3 offset_m; uint ring_first;
   uint ring_count; uint sides; uint flags; float u_close;

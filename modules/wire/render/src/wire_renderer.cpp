@@ -298,7 +298,7 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     State& s = *r.state_;
     s.desc = desc;
     s.draw_parameters = !desc.force_draw_index_attribute &&
-                        (epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_shader_draw_parameters"));
+                        epoxy_has_gl_extension("GL_ARB_shader_draw_parameters");  // the 450 source's `require`
 
     const std::string fragment = detail::fragment_source(desc.shading_glsl);
     const std::string cpu_vertex = detail::vertex_source(true, s.draw_parameters);

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <array>
 #include <numbers>
@@ -20,6 +21,7 @@
 #include <glm/geometric.hpp>
 
 #include "engine/gfx/lit_renderer.hpp"
+#include "engine/platform/capture.hpp"
 #include "engine/platform/context.hpp"
 #include "engine/scene/camera.hpp"
 #include "wire/draw.hpp"
@@ -315,6 +317,83 @@ TEST_F(DrawnRingsTest, NodesPathSkipsBadItemsAndDrawsTheRest) {
     ASSERT_EQ(out.size(), 1u);
     EXPECT_EQ(out[0].wire_id, 5u);
     EXPECT_GT(out[0].rings.params.size(), 2u);
+}
+
+// New GL buffers are not zeroed on hardware drivers (pools hand out stale memory; llvmpipe gives zeros). With every
+// buffer made without data filled with 0xff (WIRE_GFX_POISON_BUFFERS=1), the nodes path draws the same pictures and
+// rings as without: three empty frames (nothing copied into the ring-count read-back yet), then 8 frames of wires
+// whose nodes move. It reads no byte it did not write.
+TEST_F(DrawnRingsTest, PoisonedNewBuffersChangeNothing) {
+    // The family's wires at the origin ((seed / 6) % 4 == 0), framed together by one camera.
+    std::vector<FamilyWire> near;
+    for (uint32_t seed = 1; near.size() < 8; ++seed) {
+        if ((seed / 6) % 4 == 0) near.push_back(family_wire(seed));
+    }
+    engine::scene::Camera camera = near[0].camera;
+    camera.position = {0.0, 3.0, 25.0};
+    camera.target = {0.0, 0.0, 0.0};
+    camera.near_m = 0.5f;
+    camera.far_m = 100.0f;
+    DrawSettings settings;
+    const auto run = [&](bool poison, std::vector<platform::Image>& images, std::vector<std::vector<DrawnRings>>& rings) {
+        if (poison) {
+            ASSERT_EQ(setenv("WIRE_GFX_POISON_BUFFERS", "1", 1), 0);
+        } else {
+            ASSERT_EQ(unsetenv("WIRE_GFX_POISON_BUFFERS"), 0);
+        }
+        auto made = WireRenderer::create();
+        ASSERT_TRUE(made.ok());
+        WireRenderer renderer = std::move(made).value();
+        for (int f = 0; f < 3; ++f) {
+            ctx_->begin_frame();
+            const wire::render::DrawStats st = renderer.draw(DrawList{.path = UploadPath::gpu_nodes, .items = {}}, camera, settings);
+            EXPECT_TRUE(st.status.ok()) << st.status.message;
+            ctx_->end_frame();
+        }
+        std::vector<wire::WireNodes> moved(near.size());
+        for (int f = 0; f < 8; ++f) {
+            DrawList list{.path = UploadPath::gpu_nodes, .items = {}};
+            for (std::size_t i = 0; i < near.size(); ++i) {
+                moved[i] = near[i].nodes;
+                for (glm::dvec3& p : moved[i].positions) p.y += 0.05 * f * std::sin(p.x + static_cast<double>(i));
+                DrawItem item;
+                item.wire_id = 77 + i;
+                item.nodes = &moved[i];
+                item.spline = near[i].spline;
+                item.nodes_generation = 1 + static_cast<uint64_t>(f);
+                item.sides = 24;
+                list.items.push_back(item);
+            }
+            ctx_->begin_frame();
+            engine::gfx::clear({0.1f, 0.1f, 0.1f, 1.0f});
+            const wire::render::DrawStats st = renderer.draw(list, camera, settings);
+            EXPECT_TRUE(st.status.ok()) << st.status.message;
+            EXPECT_EQ(st.wires_skipped, 0u);
+            images.push_back(platform::read_pixels(*ctx_));
+            rings.emplace_back();
+            EXPECT_TRUE(renderer.read_drawn_rings(rings.back()).ok());
+            ctx_->end_frame();
+        }
+    };
+    std::vector<platform::Image> clean, poisoned;
+    std::vector<std::vector<DrawnRings>> clean_rings, poisoned_rings;
+    run(false, clean, clean_rings);
+    run(true, poisoned, poisoned_rings);
+    ASSERT_EQ(unsetenv("WIRE_GFX_POISON_BUFFERS"), 0);
+    ASSERT_EQ(clean.size(), poisoned.size());
+    std::size_t drawn = 0;
+    for (std::size_t f = 0; f < clean.size(); ++f) {
+        EXPECT_TRUE(clean[f].rgba == poisoned[f].rgba) << "frame " << f;
+        ASSERT_EQ(clean_rings[f].size(), poisoned_rings[f].size()) << "frame " << f;
+        for (std::size_t w = 0; w < clean_rings[f].size(); ++w) {
+            const wire::RingSet &a = clean_rings[f][w].rings, &b = poisoned_rings[f][w].rings;
+            EXPECT_EQ(clean_rings[f][w].wire_id, poisoned_rings[f][w].wire_id);
+            ASSERT_EQ(a.centre_m.size(), b.centre_m.size()) << "frame " << f << " wire " << w;
+            for (std::size_t i = 0; i < a.centre_m.size(); ++i) EXPECT_EQ(a.centre_m[i], b.centre_m[i]);
+            drawn += a.centre_m.size();
+        }
+    }
+    EXPECT_GT(drawn, 100u) << "the scene should draw";
 }
 
 }  // namespace

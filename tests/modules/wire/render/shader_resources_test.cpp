@@ -1,0 +1,89 @@
+// The GPU programs' shader storage blocks against the limits of real drivers, read from the assembled GLSL (no GL
+// context): llvmpipe allows 32 blocks a stage, NVIDIA 16 and the GL minimum is 8, so a program that grows past
+// NVIDIA's limit would link here and fail there. Every block has its own binding, all below 16, and the bindings
+// are the ones the C++ names (kBindingMacros: one number for both sides).
+#include <gtest/gtest.h>
+
+#include "gpu_wire_data.hpp"
+#include "shaders.hpp"
+
+#include <algorithm>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace wire::render::detail;
+
+struct Blocks {
+    std::vector<int> bindings;  // one per `buffer` block, in source order
+    std::vector<std::string> unresolved;
+};
+
+/// The binding of every `layout(std430, binding = X) ... buffer` block, X a number or a macro #defined in `source`.
+Blocks storage_blocks(const std::string& source) {
+    std::map<std::string, int> defines;
+    const std::regex define(R"(#define\s+(\w+)\s+(\d+))");
+    for (auto it = std::sregex_iterator(source.begin(), source.end(), define); it != std::sregex_iterator(); ++it)
+        defines[(*it)[1]] = std::stoi((*it)[2]);
+    Blocks out;
+    const std::regex block(R"(layout\(std430,\s*binding\s*=\s*(\w+)\)\s*(readonly\s+|writeonly\s+)?buffer\s)");
+    for (auto it = std::sregex_iterator(source.begin(), source.end(), block); it != std::sregex_iterator(); ++it) {
+        const std::string b = (*it)[1];
+        if (std::isdigit(static_cast<unsigned char>(b[0]))) {
+            out.bindings.push_back(std::stoi(b));
+        } else if (defines.count(b)) {
+            out.bindings.push_back(defines[b]);
+        } else {
+            out.unresolved.push_back(b);
+        }
+    }
+    return out;
+}
+
+TEST(ShaderResources, StorageBlocksFitEveryDesktopDriver) {
+    struct Program {
+        std::string name, source;
+        std::size_t expected_bindings;  // 0: not a table of ours
+    };
+    const std::vector<Program> programs = {
+        {"curves", with_wire_header(curve_source()), kCurveBindings},
+        {"rings", with_wire_header(ring_source()), kRingBindings},
+        {"cpu-mesh vertex", vertex_source(true, true), 0},
+        {"gpu-rings vertex", vertex_source(false, true), 0},
+        {"gpu-rings vertex (attribute)", vertex_source(false, false), 0},
+    };
+    for (const Program& p : programs) {
+        const Blocks b = storage_blocks(p.source);
+        EXPECT_TRUE(b.unresolved.empty()) << p.name << ": a binding names no #define: " << b.unresolved.front();
+        ASSERT_FALSE(b.bindings.empty()) << p.name << ": no storage block found (the pattern no longer matches)";
+        EXPECT_LE(b.bindings.size(), 16u) << p.name << ": more storage blocks than NVIDIA allows a stage";
+        const std::set<int> unique(b.bindings.begin(), b.bindings.end());
+        EXPECT_EQ(unique.size(), b.bindings.size()) << p.name << ": two blocks share a binding";
+        EXPECT_LT(*unique.rbegin(), 16) << p.name << ": a binding at or past 16 fails on drivers with 16 bindings";
+        if (p.expected_bindings != 0) {
+            // Dense: exactly the enum's bindings 0 .. count - 1, each used.
+            EXPECT_EQ(unique.size(), p.expected_bindings) << p.name;
+            EXPECT_EQ(*unique.rbegin(), static_cast<int>(p.expected_bindings) - 1) << p.name;
+        }
+        std::printf("%s: %zu storage blocks, highest binding %d\n", p.name.c_str(), b.bindings.size(), *unique.rbegin());
+    }
+}
+
+TEST(ShaderResources, BindingMacrosAreDistinctWithinEachProgram) {
+    std::set<std::string> names;
+    std::set<uint32_t> curve, ring;
+    for (const BindingMacro& m : kBindingMacros) {
+        EXPECT_TRUE(names.insert(m.name).second) << m.name;
+        const std::string n = m.name;
+        auto& set = n.rfind("CURVE_", 0) == 0 ? curve : ring;
+        EXPECT_TRUE(set.insert(m.binding).second) << m.name << " repeats binding " << m.binding;
+    }
+    EXPECT_EQ(curve.size(), static_cast<std::size_t>(kCurveBindings));
+    EXPECT_EQ(ring.size(), static_cast<std::size_t>(kRingBindings));
+}
+
+}  // namespace
