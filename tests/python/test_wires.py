@@ -256,3 +256,20 @@ def test_readme_python_example_runs(tmp_path, monkeypatch):
     assert np.all(np.diff(rings["u"]) > 0)
     # The rope swung down from its horizontal start: its free end is well below the hook.
     assert scope["x"][-1, 1] < 0.0
+
+
+# ---- one version number: CMakeLists.txt's project(VERSION), the module and the installed wheel ----
+
+def test_version_is_the_projects():
+    import re
+    from importlib import metadata
+
+    cmake = (Path(__file__).resolve().parents[2] / "CMakeLists.txt").read_text()
+    project = re.search(r"project\(wires VERSION ([0-9]+\.[0-9]+\.[0-9]+)", cmake).group(1)
+    assert wires.__version__ == project
+    try:  # installed by pip (tools/test.sh's pip stage): the wheel's metadata carries the same number
+        installed = metadata.version("wires")
+    except metadata.PackageNotFoundError:
+        installed = None
+    if installed is not None:
+        assert installed == project
