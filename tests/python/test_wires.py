@@ -248,16 +248,38 @@ def test_set_positions_equals_set_nodes():
     np.testing.assert_array_equal(a.render(), b.render())
 
 
-# ---- the README's example runs as written ----
+# ---- the README's and docs/python.md's examples run as written ----
 
-def test_readme_python_example_runs(tmp_path, monkeypatch):
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    section = readme[readme.index("## Python\n"):]
-    begin = section.index("```python\n") + len("```python\n")
-    code = section[begin:section.index("```", begin)]
+def python_block(doc, section):
+    """The first ```python block after `section` (a heading line) of the repository's markdown file `doc`."""
+    text = (Path(__file__).resolve().parents[2] / doc).read_text()
+    part = text[text.index(section + "\n"):]
+    begin = part.index("```python\n") + len("```python\n")
+    return part[begin:part.index("```", begin)]
+
+
+def test_readme_python_example_renders_a_wire(tmp_path, monkeypatch):
+    code = python_block("README.md", "## Python")
     monkeypatch.chdir(tmp_path)
     scope = {}
     exec(compile(code, "README.md (## Python)", "exec"), scope)
+    image = scope["rt"].render()
+    assert image.shape == (360, 640, 4)
+    drawn = ~background(image)
+    assert drawn.sum() > 500  # a 3 m cable 6 cm thick seen from 4 m: about 230 x 5 px
+    # Where the nodes project: a drawn pixel within 2 px of each node.
+    px = scope["rt"].project(scope["nodes"])
+    for x, y in zip(px[:, 0], px[:, 1]):
+        xi, yi = int(round(x)), int(round(y))
+        assert drawn[max(yi - 2, 0):yi + 3, max(xi - 2, 0):xi + 3].any(), (x, y)
+    assert (tmp_path / "cable.png").stat().st_size > 0
+
+
+def test_docs_python_example_runs(tmp_path, monkeypatch):
+    code = python_block("docs/python.md", "## Example")
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "docs/python.md (## Example)", "exec"), scope)
     assert sorted(p.name for p in tmp_path.glob("rope_*.png")) == [f"rope_{f:04d}.png" for f in (0, 30, 60, 90)]
     rings = scope["rings"]
     assert rings["centres"].shape[1] == 3 and len(rings["u"]) == len(rings["centres"]) >= 2
