@@ -1,4 +1,4 @@
-# The installed CMake package (a contract, README "Using the installed package"):
+# The installed CMake package (a contract, docs/install.md):
 #   cmake --install build --prefix P
 # installs the libraries below with their public headers (each target's include/ folder, whole) into P/lib and
 # P/include, and P/lib/cmake/wires/{wiresConfig,wiresConfigVersion,wiresTargets,wiresDependencies}.cmake.
@@ -54,6 +54,6 @@ install(FILES
   ${CMAKE_CURRENT_LIST_DIR}/wiresDependencies.cmake
   DESTINATION ${WIRES_INSTALL_CMAKEDIR})
 
-# Programs (README "Using the installed package"): relocatable, they name no path of this machine.
+# Programs (docs/install.md): relocatable, they name no path of this machine.
 install(TARGETS wiretool tunnel RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${WIRE_ASSET_DIR}/tunnel/ DESTINATION ${TUNNEL_ASSETS_DESTINATION})

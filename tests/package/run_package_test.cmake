@@ -45,7 +45,7 @@ foreach(h wire/systems/api.hpp wire/render/wire_renderer.hpp engine/ecs/registry
     message(FATAL_ERROR "package test: header include/${h} was not installed")
   endif()
 endforeach()
-# Programs and the tunnel's assets (README "Using the installed package"); no tests, benchmarks or examples.
+# Programs and the tunnel's assets (docs/install.md); no tests, benchmarks or examples.
 file(GLOB top RELATIVE "${prefix}" "${prefix}/*")
 if(NOT top STREQUAL "bin;include;lib;share")
   message(FATAL_ERROR "package test: the prefix holds '${top}', expected bin, include, lib and share")
