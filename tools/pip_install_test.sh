@@ -35,10 +35,14 @@ trap 'rm -rf "$outside"' EXIT
 cd "$outside"
 "$venv/bin/python" -c "import wires, sys; assert wires.__file__.startswith(sys.argv[1] + '/'), wires.__file__; print('pip_install_test: wires', wires.__version__, 'from', wires.__file__)" "$venv"
 # The README's own check of the install (its `v/bin/python -c "import wires; ..."` line, v/ being this venv):
-# renders a wire headless.
+# renders a wire headless (some pixels drawn).
 readme_check="$(grep -m 1 '^v/bin/python -c ' "$here/README.md" || true)"
 if [ -z "$readme_check" ]; then echo "pip_install_test: README.md has no 'v/bin/python -c' line" >&2; exit 1; fi
-eval "\"$venv/bin/python\"${readme_check#v/bin/python}"
+readme_out="$(eval "\"$venv/bin/python\"${readme_check#v/bin/python}")"
+echo "pip_install_test: README check: $readme_out"
+if ! [[ "$readme_out" =~ [1-9][0-9]*\ wire\ pixels ]]; then
+  echo "pip_install_test: the README's check drew no wire" >&2; exit 1
+fi
 # WIRES_EXPECTED_PREFIX: test_wires.py asserts the module it tests lives there.
 # WIRETOOL: the tests that compare with wiretool run where it was built (skipped, saying so, where it was not).
 wiretool="${build_dir:-$here/build}/bin/wiretool"
