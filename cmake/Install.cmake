@@ -1,8 +1,8 @@
-# The installed CMake package (a contract, README "Using the installed package"):
+# The installed CMake package (a contract, docs/install.md):
 #   cmake --install build --prefix P
 # installs the libraries below with their public headers (each target's include/ folder, whole) into P/lib and
 # P/include, and P/lib/cmake/wires/{wiresConfig,wiresConfigVersion,wiresTargets,wiresDependencies}.cmake.
-# find_package(wires 0.2) then gives the namespaced targets wires::<export name>. Target-based: sources and
+# find_package(wires 0.3) then gives the namespaced targets wires::<export name>. Target-based: sources and
 # headers added to these targets need no change here. The libraries load nothing from disk at run time (the wire
 # shaders are compiled into wire_render).
 # Programs: P/bin/wiretool and P/bin/tunnel, with the tunnel's assets in P/share/wires/tunnel (found relative to
@@ -43,7 +43,8 @@ install(EXPORT wiresTargets NAMESPACE wires:: DESTINATION ${WIRES_INSTALL_CMAKED
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/wiresConfig.cmake.in
   ${CMAKE_BINARY_DIR}/package/wiresConfig.cmake
   INSTALL_DESTINATION ${WIRES_INSTALL_CMAKEDIR})
-# 0.x: a minor version may change the API, so 0.2 accepts only 0.2.x (stricter than SameMajorVersion).
+# 0.x: a minor version may change the API (CHANGELOG.md), so 0.3 accepts only 0.3.x (stricter than
+# SameMajorVersion): find_package(wires 0.2) is refused by this 0.3.0 package.
 write_basic_package_version_file(${CMAKE_BINARY_DIR}/package/wiresConfigVersion.cmake
   VERSION ${PROJECT_VERSION}
   COMPATIBILITY SameMinorVersion)
@@ -53,6 +54,6 @@ install(FILES
   ${CMAKE_CURRENT_LIST_DIR}/wiresDependencies.cmake
   DESTINATION ${WIRES_INSTALL_CMAKEDIR})
 
-# Programs (README "Using the installed package"): relocatable, they name no path of this machine.
+# Programs (docs/install.md): relocatable, they name no path of this machine.
 install(TARGETS wiretool tunnel RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY ${WIRE_ASSET_DIR}/tunnel/ DESTINATION ${TUNNEL_ASSETS_DESTINATION})

@@ -470,6 +470,8 @@ py::dict mesh_rings(const DoubleArray& positions, const std::optional<IdArray>& 
 PYBIND11_MODULE(wires, m) {
     m.doc() =
         "Wire rendering runtime: wires from numpy node arrays, drawn by the C++ wire systems and renderer";
+    // The project's version (CMakeLists.txt project(VERSION)), the one the CMake package and the wheel carry.
+    m.attr("__version__") = WIRES_VERSION;
     // WireError(ValueError): a wire's nodes rejected by the runtime, with its message (wire, node, problem).
     g_wire_error =
         PyErr_NewExceptionWithDoc("wires.WireError",

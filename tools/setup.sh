@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs every system package the project needs (Debian), then configures and builds.
 # Idempotent: when every package is present it skips apt-get entirely and only builds.
-# The Python module is built for and tested with Debian's /usr/bin/python3 (its numpy, pybind11 and pytest).
+# The Python module is built for and tested with Debian's /usr/bin/python3 (its numpy, pybind11 and pytest); pip and
+# venv for `pip install ./python` into a virtual environment (docs/python.md).
 # Usage: tools/setup.sh [--no-build] [--build-dir DIR] [--type Release|Debug|RelWithDebInfo] [--docs]
 #   --docs also installs Doxygen (for `cmake --build build --target docs`, the API reference).
 set -euo pipefail
@@ -13,7 +14,7 @@ do_build=1
 do_docs=0
 
 usage() {
-  sed -n '2,6p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+  sed -n '2,7p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
 }
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -56,7 +57,9 @@ packages=(
   pybind11-dev
   python3-dev
   python3-numpy
+  python3-pip
   python3-pytest
+  python3-venv
 )
 # Only when asked (--docs): the API reference generator.
 if [ "$do_docs" -eq 1 ]; then packages+=(doxygen); fi

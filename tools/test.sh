@@ -2,7 +2,8 @@
 # Builds and runs every test (README command (b); .ci/run runs exactly this).
 # Installs missing packages first (fast when all are present), so it works on a fresh machine.
 # Usage: tools/test.sh [--no-debug] [--no-asan] [--no-fuzz] [--help]
-#   Stages: 1. Release build + ctest (build/); 2. the wire module's numeric tests in a Debug build (build-debug/);
+#   Stages: 1. Release build + ctest (build/), then pip install of the Python module into a fresh venv and its
+#   pytest suite against that install (build/pip-venv/); 2. the wire module's numeric tests in a Debug build (build-debug/);
 #   3. ASan+UBSan build + ctest (build-asan/); 4. every fuzz target for 5 seconds (tools/fuzz, build-fuzz/).
 #   --no-debug / --no-asan / --no-fuzz skip 2 / 3 / 4.
 set -euo pipefail
@@ -12,7 +13,7 @@ run_asan=1
 run_fuzz=1
 while [ $# -gt 0 ]; do
   case "$1" in
-    -h|--help) sed -n '2,7p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,8p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     --no-debug) run_debug=0 ;;
     --no-asan) run_asan=0 ;;
     --no-fuzz) run_fuzz=0 ;;
@@ -33,6 +34,14 @@ if [ ! -f build/CMakeCache.txt ]; then generator=(-G Ninja); fi
 cmake -S . -B build "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DWIRE_WERROR="$werror"
 cmake --build build --parallel "$jobs"
 ctest --test-dir build --output-on-failure --parallel "$jobs"
+
+# 1b. The Python module as a user installs it: `pip install ./python` into a fresh virtual environment (reusing
+# build/, so only the module is relinked and installed), then the pytest suite against that install, from outside
+# the source tree with no PYTHONPATH (tools/pip_install_test.sh).
+if compgen -G "build/python/wires*.so" >/dev/null; then
+  echo "test.sh: pip stage (build/pip-venv/)"
+  bash tools/pip_install_test.sh --build-dir build --venv build/pip-venv
+fi
 
 # 2. The wire module's numeric tests without optimization: its wide-lane kernels are compiled under
 # `#pragma GCC target` and rely on inlining across that boundary, which -O0 does not do (a Debug build once

@@ -1,5 +1,5 @@
-// bullet_ropes: Bullet soft-body ropes and cables drawn by the wire renderer (examples/bullet_ropes/README in
-// the project README, "A physics engine feeding the wires"). In a window where there is a display, otherwise
+// bullet_ropes: Bullet soft-body ropes and cables drawn by the wire renderer (docs/bullet.md,
+// "A physics engine feeding the wires"). In a window where there is a display, otherwise
 // headless writing PNGs.
 #include "rope_scene.hpp"
 

@@ -1,4 +1,4 @@
-"""What the Python bindings add to a frame: 1,000 wires of 64 nodes moved from numpy every frame (README "Python").
+"""What the Python bindings add to a frame: 1,000 wires of 64 nodes moved from numpy every frame (docs/python.md).
 
     PYTHONPATH=build/python /usr/bin/python3 python/examples/bench_update.py [--frames 120] [--threads 1]
 

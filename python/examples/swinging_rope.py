@@ -1,4 +1,4 @@
-"""A swinging rope from a few lines of numpy physics, drawn by the wire runtime (README "Python").
+"""A swinging rope from a few lines of numpy physics, drawn by the wire runtime (docs/python.md).
 
     PYTHONPATH=build/python /usr/bin/python3 python/examples/swinging_rope.py [OUT_DIR] [FRAMES]
 

@@ -41,7 +41,8 @@ wire::WireNodes hanging_cable(int n, double sag_m) {
 }
 
 // README.md "Wires from game code", verbatim (see CMakeLists.txt). Its names: nodes, moved_nodes, midpoint,
-// renderer; it declares registry, schedule, context and w itself.
+// renderer; it declares registry, schedule, context and w itself, sets the camera (from z = 5 at the origin)
+// and the 960x540 viewport, and adds material 1.
 template <class Renderer>
 engine::scene::Camera readme_example(const wire::WireNodes& nodes, const wire::WireNodes& moved_nodes,
                                      const glm::dvec3& midpoint, Renderer& renderer) {
@@ -85,9 +86,7 @@ int main() {
     engine::platform::Context& gl = **context_or;
     auto renderer = wire::render::WireRenderer::create();
     if (!renderer) return fail("WireRenderer::create: " + renderer.error().message);
-    // The README's wire uses material 1 (material 0 is the built-in copper weave): a light blue one.
-    if (renderer->add_material({.tint = {0.4f, 0.7f, 1.0f}}) != 1)
-        return fail("add_material did not return 1");
+    // The README's example adds material 1 itself (a light blue; material 0 is the built-in copper weave).
 
     const wire::WireNodes nodes = hanging_cable(16, 0.2);
     const wire::WireNodes moved_nodes = hanging_cable(16, 0.3);

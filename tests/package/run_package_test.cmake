@@ -1,14 +1,15 @@
 # ctest package_install: the installed CMake package end to end. Run as
 #   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... -DGENERATOR=... -DCXX_COMPILER=... [-DLAUNCHER=...]
-#         [-DCONFIG=Release] -P run_package_test.cmake
-#         [-DPYTHON_MODULE_DIR=lib/python3/site-packages]
+#         -DEXPECTED_VERSION=0.3.0 [-DCONFIG=Release] [-DPYTHON_MODULE_DIR=lib/python3.11/dist-packages]
+#         -P run_package_test.cmake
 # 1. cmake --install BUILD_DIR into WORK_DIR/stage, then moves it to WORK_DIR/prefix (the package must be
 #    relocatable); 2. checks the layout (config + version files, bin/ holding wiretool and tunnel only, the tunnel's
 #    assets, the Python module when built, no tests installed, no installed file naming the source or build tree)
-#    and the version rule; 3. configures, builds and runs tests/package against
+#    and the version rule; a configure of tests/package asking for find_package(wires 0.2) must fail with CMake's
+#    version message; 3. configures, builds and runs tests/package against
 #    it with nothing but CMAKE_PREFIX_PATH pointing at the prefix: the README example (wires_consumer) and the
 #    repository's modules/wire/systems/examples/spawn_wires.cpp linking only wires::wire_systems.
-foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+foreach(var BUILD_DIR SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER EXPECTED_VERSION)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_package_test.cmake: -D${var}=... is required")
   endif()
@@ -44,7 +45,7 @@ foreach(h wire/systems/api.hpp wire/render/wire_renderer.hpp engine/ecs/registry
     message(FATAL_ERROR "package test: header include/${h} was not installed")
   endif()
 endforeach()
-# Programs and the tunnel's assets (README "Using the installed package"); no tests, benchmarks or examples.
+# Programs and the tunnel's assets (docs/install.md); no tests, benchmarks or examples.
 file(GLOB top RELATIVE "${prefix}" "${prefix}/*")
 if(NOT top STREQUAL "bin;include;lib;share")
   message(FATAL_ERROR "package test: the prefix holds '${top}', expected bin, include, lib and share")
@@ -90,8 +91,9 @@ foreach(f IN LISTS installed)
   endif()
 endforeach()
 
-# Version rule: 0.2 accepts 0.2 (and 0.2.x), not 0.1, 0.3 or 1.0.
-foreach(want 0.2:TRUE 0.2.0:TRUE 0.1:FALSE 0.3:FALSE 1.0:FALSE)
+# Version rule (semantic versioning, 0.x: a minor version may break the API): 0.3 accepts 0.3 and 0.3.x, not
+# 0.2, 0.1, 0.4 or 1.0.
+foreach(want 0.3:TRUE 0.3.0:TRUE 0.2:FALSE 0.1:FALSE 0.4:FALSE 1.0:FALSE)
   string(REPLACE ":" ";" want "${want}")
   list(GET want 0 PACKAGE_FIND_VERSION)
   list(GET want 1 expected)
@@ -107,6 +109,9 @@ foreach(want 0.2:TRUE 0.2.0:TRUE 0.1:FALSE 0.3:FALSE 1.0:FALSE)
                         "'${PACKAGE_VERSION_COMPATIBLE}', expected ${expected} (package ${PACKAGE_VERSION})")
   endif()
 endforeach()
+if(NOT PACKAGE_VERSION VERSION_EQUAL "${EXPECTED_VERSION}")
+  message(FATAL_ERROR "package test: the package says version ${PACKAGE_VERSION}, the project ${EXPECTED_VERSION}")
+endif()
 message(STATUS "layout and version ${PACKAGE_VERSION}: ok")
 
 # The consumer project, built against the prefix only.
@@ -114,6 +119,21 @@ set(launcher_args "")
 if(LAUNCHER)
   set(launcher_args "-DCMAKE_CXX_COMPILER_LAUNCHER=${LAUNCHER}")
 endif()
+# A project pinned to 0.2 (the API before Camera went double) is refused, with CMake's own version message.
+execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package" -B "${WORK_DIR}/consumer_0_2"
+                -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=${CONFIG} "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
+                "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DWIRES_FIND_VERSION=0.2
+                "-DWIRES_README=${SOURCE_DIR}/README.md"
+                "-DWIRES_SPAWN_EXAMPLE=${SOURCE_DIR}/modules/wire/systems/examples/spawn_wires.cpp"
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+string(REGEX REPLACE "[ \n]+" " " flat "${out}")
+if(rc EQUAL 0 OR NOT flat MATCHES "compatible with requested version \"0\\.2\"" OR
+   NOT flat MATCHES "wiresConfig\\.cmake, version: ${EXPECTED_VERSION}")
+  message(FATAL_ERROR "package test: find_package(wires 0.2) against ${EXPECTED_VERSION} was not refused with "
+                      "CMake's version message (status ${rc}):\n${out}")
+endif()
+message(STATUS "find_package(wires 0.2) refused: ok")
+
 run("configure tests/package" ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package" -B "${WORK_DIR}/consumer"
     -G "${GENERATOR}" -DCMAKE_BUILD_TYPE=${CONFIG} "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}" ${launcher_args}
     "-DCMAKE_PREFIX_PATH=${prefix}" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF

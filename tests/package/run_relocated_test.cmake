@@ -1,11 +1,13 @@
 # ctest package_relocated: the installed programs run from a moved prefix. Run as
-#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DCONFIG=Release] [-DPYTHON=/usr/bin/python3
-#         -DPYTHON_MODULE_DIR=lib/python3/site-packages] -P run_relocated_test.cmake
+#   cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DCONFIG=Release] [-DEXPECTED_VERSION=0.3.0]
+#         [-DPYTHON=/usr/bin/python3 -DPYTHON_MODULE_DIR=lib/python3.11/dist-packages] -P run_relocated_test.cmake
 # 1. cmake --install BUILD_DIR into WORK_DIR/stage, then moves it to WORK_DIR/moved/prefix (nothing of the stage
 #    path is left); 2. runs the moved `tunnel --headless --frames 3` from an unrelated working directory (it must find
 #    its assets beside itself) and checks its PNGs and that stats.json parses with 3 frames; `tunnel --assets` with a
 #    wrong folder must fail naming it; 3. runs the moved `wiretool view` on a wire file and checks the PNG and the
-#    stats; 4. with PYTHON: `import wires` from the moved prefix (PYTHONPATH=prefix/PYTHON_MODULE_DIR) renders a wire.
+#    stats; 4. with PYTHON: PYTHON_MODULE_DIR is a directory that interpreter searches under /usr/local or its own
+#    prefix (so an install there needs no PYTHONPATH), and `import wires` from the moved prefix
+#    (PYTHONPATH=prefix/PYTHON_MODULE_DIR) renders a wire and reports the project's version.
 foreach(var BUILD_DIR SOURCE_DIR WORK_DIR)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_relocated_test.cmake: -D${var}=... is required")
@@ -86,8 +88,17 @@ message(STATUS "moved wiretool: ok")
 
 # The Python module from the moved prefix.
 if(PYTHON AND PYTHON_MODULE_DIR)
+  # Installed where a prefix's Python looks without PYTHONPATH: PYTHON_MODULE_DIR under /usr/local (Debian) or
+  # under the interpreter's own prefix is on its sys.path as it starts.
+  unset(ENV{PYTHONPATH})
+  run("${PYTHON_MODULE_DIR} is on ${PYTHON}'s path" "${PYTHON}" -c
+      "import os, sys\nd = '${PYTHON_MODULE_DIR}'\nhits = [p for p in ('/usr/local', sys.prefix) if os.path.join(p, d) in sys.path]\nassert hits, (d, sys.path)\nprint('on sys.path under', hits)")
+  message(STATUS "${last_output}")
   set(ENV{PYTHONPATH} "${prefix}/${PYTHON_MODULE_DIR}")
   run("import wires from the moved prefix" "${PYTHON}" -c
-      "import numpy as np, wires\nassert wires.__file__.startswith('${prefix}/'), wires.__file__\nrt = wires.Runtime(160, 90)\nw = rt.spawn(np.array([[-1.0, 0, 0], [0, -0.3, 0], [1, 0, 0]]), radius=0.05)\nrt.set_camera((0, 0, 4), (0, 0, 0))\nrt.update()\nimg = rt.render()\nassert img.shape == (90, 160, 4) and (img[..., :3].max(axis=2) > 60).any()\nprint('wires', wires.__file__)")
+      "import numpy as np, wires\nassert wires.__file__.startswith('${prefix}/'), wires.__file__\nrt = wires.Runtime(160, 90)\nw = rt.spawn(np.array([[-1.0, 0, 0], [0, -0.3, 0], [1, 0, 0]]), radius=0.05)\nrt.set_camera((0, 0, 4), (0, 0, 0))\nrt.update()\nimg = rt.render()\nassert img.shape == (90, 160, 4) and (img[..., :3].max(axis=2) > 60).any()\nprint('wires', wires.__version__, wires.__file__)")
   message(STATUS "${last_output}")
+  if(EXPECTED_VERSION AND NOT last_output MATCHES "^wires ${EXPECTED_VERSION} ")
+    message(FATAL_ERROR "relocated test: wires.__version__ is not ${EXPECTED_VERSION}: ${last_output}")
+  endif()
 endif()

@@ -1,7 +1,9 @@
 """The Python module `wires` (python/wires_module.cpp) against the runtime it binds: errors, rings, pixels, memory.
 
 Run by ctest (python_wires) as PYTHONPATH=build/python /usr/bin/python3 -m pytest -q tests/python, with WIRETOOL
-pointing at build/bin/wiretool. Every test builds its own runtime.
+pointing at build/bin/wiretool, and by tools/pip_install_test.sh against the module pip installed into a fresh
+virtual environment (WIRES_EXPECTED_PREFIX: the environment the tested module must come from). Every test builds its
+own runtime.
 """
 import csv
 import json
@@ -17,6 +19,10 @@ import wires
 
 WIRETOOL = os.environ.get("WIRETOOL", str(Path(__file__).resolve().parents[2] / "build" / "bin" / "wiretool"))
 CLEAR = (0.10, 0.10, 0.12, 1.0)
+# The comparisons with wiretool need the program; ctest and tools/test.sh always name it (WIRETOOL), and then a
+# missing one fails instead of skipping.
+needs_wiretool = pytest.mark.skipif("WIRETOOL" not in os.environ and not Path(WIRETOOL).exists(),
+                                    reason=f"no wiretool at {WIRETOOL} (set WIRETOOL)")
 
 
 def hanging(n=16, sag=0.2, z=0.0):
@@ -132,6 +138,7 @@ def assert_rings_equal(rings, table):
         np.testing.assert_allclose(rings[key], csv_frame, rtol=0, atol=5e-9)  # %.9g columns
 
 
+@needs_wiretool
 def test_mesh_rings_equal_wiretool_mesh_csv(tmp_path):
     path, nodes, ids, stretch = wire_file(tmp_path)
     out = tmp_path / "rings.csv"
@@ -140,6 +147,7 @@ def test_mesh_rings_equal_wiretool_mesh_csv(tmp_path):
     assert_rings_equal(rings, read_ring_csv(out))
 
 
+@needs_wiretool
 def test_runtime_rings_equal_wiretool_view_csv(tmp_path):
     path, nodes, ids, stretch = wire_file(tmp_path)
     out = tmp_path / "view.csv"
@@ -281,19 +289,66 @@ def test_set_positions_equals_set_nodes():
     np.testing.assert_array_equal(a.render(), b.render())
 
 
-# ---- the README's example runs as written ----
+# ---- the README's and docs/python.md's examples run as written ----
 
-def test_readme_python_example_runs(tmp_path, monkeypatch):
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    section = readme[readme.index("## Python\n"):]
-    begin = section.index("```python\n") + len("```python\n")
-    code = section[begin:section.index("```", begin)]
+def python_block(doc, section):
+    """The first ```python block after `section` (a heading line) of the repository's markdown file `doc`."""
+    text = (Path(__file__).resolve().parents[2] / doc).read_text()
+    part = text[text.index(section + "\n"):]
+    begin = part.index("```python\n") + len("```python\n")
+    return part[begin:part.index("```", begin)]
+
+
+def test_readme_python_example_renders_a_wire(tmp_path, monkeypatch):
+    code = python_block("README.md", "## Python")
     monkeypatch.chdir(tmp_path)
     scope = {}
     exec(compile(code, "README.md (## Python)", "exec"), scope)
+    image = scope["rt"].render()
+    assert image.shape == (360, 640, 4)
+    drawn = ~background(image)
+    assert drawn.sum() > 500  # a 3 m cable 6 cm thick seen from 4 m: about 230 x 5 px
+    # Where the nodes project: a drawn pixel within 2 px of each node.
+    px = scope["rt"].project(scope["nodes"])
+    for x, y in zip(px[:, 0], px[:, 1]):
+        xi, yi = int(round(x)), int(round(y))
+        assert drawn[max(yi - 2, 0):yi + 3, max(xi - 2, 0):xi + 3].any(), (x, y)
+    assert (tmp_path / "cable.png").stat().st_size > 0
+
+
+def test_docs_python_example_runs(tmp_path, monkeypatch):
+    code = python_block("docs/python.md", "## Example")
+    monkeypatch.chdir(tmp_path)
+    scope = {}
+    exec(compile(code, "docs/python.md (## Example)", "exec"), scope)
     assert sorted(p.name for p in tmp_path.glob("rope_*.png")) == [f"rope_{f:04d}.png" for f in (0, 30, 60, 90)]
     rings = scope["rings"]
     assert rings["centres"].shape[1] == 3 and len(rings["u"]) == len(rings["centres"]) >= 2
     assert np.all(np.diff(rings["u"]) > 0)
     # The rope swung down from its horizontal start: its free end is well below the hook.
     assert scope["x"][-1, 1] < 0.0
+
+
+# ---- one version number: CMakeLists.txt's project(VERSION), the module and the installed wheel ----
+
+def test_version_is_the_projects():
+    import re
+    from importlib import metadata
+
+    cmake = (Path(__file__).resolve().parents[2] / "CMakeLists.txt").read_text()
+    project = re.search(r"project\(wires VERSION ([0-9]+\.[0-9]+\.[0-9]+)", cmake).group(1)
+    assert wires.__version__ == project
+    try:  # installed by pip (tools/test.sh's pip stage): the wheel's metadata carries the same number
+        installed = metadata.version("wires")
+    except metadata.PackageNotFoundError:
+        installed = None
+    if installed is not None:
+        assert installed == project
+
+
+def test_the_module_comes_from_where_it_was_installed():
+    """tools/pip_install_test.sh sets WIRES_EXPECTED_PREFIX to its virtual environment: not the build tree."""
+    prefix = os.environ.get("WIRES_EXPECTED_PREFIX")
+    if prefix is None:
+        pytest.skip("WIRES_EXPECTED_PREFIX not set (the build tree's module, ctest python_wires)")
+    assert Path(wires.__file__).resolve().is_relative_to(Path(prefix).resolve()), wires.__file__

@@ -1,5 +1,5 @@
 // `wiretool bend`: bakes the curved-space bend (a chain of arc segments, SEGS.json) into every mesh of a glTF
-// file, positions and normals, with the CPU reference. A contract: see README.
+// file, positions and normals, with the CPU reference. A contract: see docs/wiretool.md.
 #include "commands.hpp"
 
 #include <curved_space/chain.hpp>

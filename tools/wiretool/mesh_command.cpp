@@ -1,4 +1,4 @@
-// `wiretool mesh`: wire JSON -> tube meshes (binary glTF) and ring records (CSV). A contract: see README.
+// `wiretool mesh`: wire JSON -> tube meshes (binary glTF) and ring records (CSV). A contract: docs/wiretool.md.
 #include "commands.hpp"
 #include "ring_csv.hpp"
 

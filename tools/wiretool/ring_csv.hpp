@@ -1,4 +1,4 @@
-// The ring CSV of `wiretool mesh` and `wiretool view` (a contract: README): one row per ring record.
+// The ring CSV of `wiretool mesh` and `wiretool view` (a contract, docs/wiretool.md): one row per ring record.
 #pragma once
 
 #include <wire/rings.hpp>

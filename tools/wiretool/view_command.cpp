@@ -1,5 +1,6 @@
 // `wiretool view`: a wire file through the real runtime (wire entities in the ECS, the installed wire systems and
-// the wire renderer in a headless GL context) to pixels, ring records and statistics. A contract: see README.
+// the wire renderer in a headless GL context) to pixels, ring records and statistics. A contract:
+// docs/wiretool.md.
 #include "commands.hpp"
 #include "ring_csv.hpp"
 

@@ -1,6 +1,7 @@
 // The segment-list file format of `wiretool bend` (SEGS.json):
 //   {"segments": [{"length": 4.0, "angle": 0.5, "direction": 0.0}, ...]}
-// length in metres (> 0), angle and direction in radians (direction optional, default 0). A contract: see README.
+// length in metres (> 0), angle and direction in radians (direction optional, default 0). A contract: see
+// docs/wiretool.md.
 #pragma once
 
 #include <string>

@@ -1,6 +1,6 @@
 // Reader for wire description files (JSON): one wire, a list of wires, or successive frames of wires.
-// The format is a contract (README, "Wire JSON"); this reader only parses and checks the form: the
-// geometry checks (fewer than 2 distinct nodes, degenerate loops) belong to wire::build_curve.
+// The format is a contract (docs/wiretool.md, `wiretool mesh`); this reader only parses and checks the form:
+// the geometry checks (fewer than 2 distinct nodes, degenerate loops) belong to wire::build_curve.
 #pragma once
 
 #include <wire/status.hpp>
