@@ -127,6 +127,17 @@ def wire_file(tmp_path):
     return path, nodes, np.arange(10, 22), stretch.astype(np.float32)
 
 
+def view_clip_planes(nodes, eye, radius_m=0.04):
+    """wiretool view's clip planes (view_command.cpp): around the nodes' bounding sphere."""
+    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+    centre, radius = 0.5 * (lo + hi), 0.5 * math.sqrt(float(np.dot(hi - lo, hi - lo))) + radius_m
+    reach = 1.25 * radius
+    d = np.array(eye) - centre
+    distance = math.sqrt(float(np.dot(d, d)))
+    far = 1.01 * (distance + reach)
+    return max(0.5 * (distance - reach), max(1e-5 * far, min(0.05, 0.01 * reach))), far
+
+
 def assert_rings_equal(rings, table):
     np.testing.assert_array_equal(rings["segment"], table["segment"])
     np.testing.assert_array_equal(rings["t"], table["t"])  # %.17g: exact
@@ -154,14 +165,7 @@ def test_runtime_rings_equal_wiretool_view_csv(tmp_path):
     eye, target = (0.4, 0.6, 4.0), (0.0, 0.0, 0.0)
     subprocess.run([WIRETOOL, "view", str(path), "--size", "640x360", "--camera", ",".join(map(str, eye + target)),
                     "--csv", str(out)], check=True)
-    # wiretool view's clip planes (view_command.cpp): around the nodes' bounding sphere.
-    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
-    centre, radius = 0.5 * (lo + hi), 0.5 * math.sqrt(float(np.dot(hi - lo, hi - lo))) + 0.04
-    reach = 1.25 * radius
-    d = np.array(eye) - centre
-    distance = math.sqrt(float(np.dot(d, d)))
-    far = 1.01 * (distance + reach)
-    near = max(0.5 * (distance - reach), max(1e-5 * far, min(0.05, 0.01 * reach)))
+    near, far = view_clip_planes(nodes, eye)
 
     rt = wires.Runtime(640, 360)
     w = rt.spawn(nodes, ids=ids, stretch=stretch, radius=0.04)
@@ -179,13 +183,7 @@ def test_nodes_path_rings_are_the_gpus_and_equal_wiretool_view_csv(tmp_path):
     subprocess.run([WIRETOOL, "view", str(path), "--size", "640x360", "--path", "nodes", "--camera",
                     ",".join(map(str, eye + target)), "--csv", str(out)], check=True)
     table = read_ring_csv(out)
-    lo, hi = nodes.min(axis=0), nodes.max(axis=0)
-    centre, radius = 0.5 * (lo + hi), 0.5 * math.sqrt(float(np.dot(hi - lo, hi - lo))) + 0.04
-    reach = 1.25 * radius
-    d = np.array(eye) - centre
-    distance = math.sqrt(float(np.dot(d, d)))
-    far = 1.01 * (distance + reach)
-    near = max(0.5 * (distance - reach), max(1e-5 * far, min(0.05, 0.01 * reach)))
+    near, far = view_clip_planes(nodes, eye)
     rings = {}
     for name in ("nodes", "cpu"):
         rt = wires.Runtime(640, 360, path=name)

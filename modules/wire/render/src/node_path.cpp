@@ -434,17 +434,18 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     const std::size_t reserve = segments_visible + visible_;
     const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
     std::size_t scratch_nodes = changed_ ? std::max<std::size_t>(node_total, 1) : 1;
-    for (Status st : {ensure(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch", false),
-                      ensure(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs", false),
-                      ensure(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws", false),
-                      ensure(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings",
-                             false),
-                      ensure(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks", false),
-                      ensure(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets", false),
-                      ensure(commands_, command_bytes_, buckets * 20, "wire nodes: commands", false),
-                      ensure(counter_, counter_bytes_, 12, "wire nodes: ring counter", false)}) {
-        if (!st) return fail(st);
-    }
+    const auto need = [&](gfx::Buffer& b, std::size_t& capacity, std::size_t bytes, const char* label) {
+        return ensure(b, capacity, bytes, label, false);
+    };
+    Status made = need(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch");
+    if (made) made = need(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs");
+    if (made) made = need(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws");
+    if (made) made = need(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings");
+    if (made) made = need(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks");
+    if (made) made = need(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets");
+    if (made) made = need(commands_, command_bytes_, buckets * 20, "wire nodes: commands");
+    if (made) made = need(counter_, counter_bytes_, 12, "wire nodes: ring counter");
+    if (!made) return fail(made);
     if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
         // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
         std::vector<uint32_t> t(2 * 6 * side_slots_, 0);
