@@ -43,8 +43,11 @@ layout(std430, binding = RING_RINGS) writeonly buffer Rings { uint ring_words[];
 layout(std430, binding = RING_SLOTS) buffer Slots { SlotState slot_state[]; };
 // Rings allocated, wires that did not fit, rings allocated from the reserve (u_ring_reserve records after
 // u_ring_capacity: one ring a segment for every listed wire, so a wire that does not fit is drawn coarse, not
-// missing, until the ring buffer has grown).
-layout(std430, binding = RING_COUNTER) buffer Counter { uint ring_counter; uint overflow; uint reserve_counter; };
+// missing, until the ring buffer has grown), triangles the draw expands (u_draw: wire::tube_counts' and
+// strip_counts').
+layout(std430, binding = RING_COUNTER) buffer Counter {
+    uint ring_counter; uint overflow; uint reserve_counter; uint triangles;
+};
 // The slot of each dispatched wire: the first u_changed are this frame's curve headers' (their nodes changed), the
 // others listed.
 layout(std430, binding = RING_VISIBLE) readonly buffer Visible { uint visible[]; };
@@ -70,6 +73,7 @@ uniform dvec3 u_eye;
 uniform float u_focal, u_tan_x, u_tan_y, u_near, u_far, u_eps, u_band, u_strip_px, u_line_px;
 uniform uint u_max_rings, u_max_sides;  // u_max_sides <= kMaxSides
 uniform bool u_coarse;
+uniform bool u_merge;  // spans below node resolution (LodSettings::keep_node_resolution off)
 uniform float u_sagitta[257];  // 1 - cos(pi / n), n <= 256
 
 const float kPi = 3.14159265358979;
@@ -342,6 +346,131 @@ uint outside(vec3 q, float rx, float ry, float r) {
     m |= (u_far - q.z < -r) ? 32u : 0u;
     return m;
 }
+// ---- spans below node resolution (wire/lod.hpp's header comment: lod/bounds.cpp builds the hierarchy, lod/span_walk.hpp
+// walks it) ----
+// The hierarchy is built bottom-up as the walk over the segments visits them, as a binary counter: a node of level l
+// covers 2^l segments, and a level's odd last node stands alone for its parent (the same sphere and deviation:
+// the same decision), so what is left on the stack at the end merges from the top. Each node is decided when it is
+// complete; one that takes a span writes 1, 0, ..., 0 over its segments, over what its descendants wrote. A segment's
+// highest such ancestor writes last: the CPU's top-down walk, which stops at it.
+struct Span {
+    vec3 c; float r;         // the sphere around its control points (not inflated by the tube radius)
+    vec3 a; float dev;       // its chord's first point; every curve point of the span is within dev of the chord
+    vec3 b; uint s;          // its chord's last point; its first segment
+    uint e, sum, bits, level;  // one past its last segment; its counts' sum now; kOld*, kRestZero, kPattern
+};
+const uint kOldOne = 1u, kOldZero = 2u, kRestZero = 4u, kPattern = 8u;  // old first count 1 / 0, old rest 0; 1,0..0 now
+bool INSIDE;        // the wire's sphere (its control points' box, inflated) lies inside the frustum
+float SPAN_K;       // the off-axis factor bounded over that sphere (capped at the screen edge), when INSIDE
+vec3 OFFSET;        // the wire's origin - eye
+float RADIUS_MAX;   // the wire's largest tube radius
+uint TOTAL;         // rings of the wire so far
+
+// SpanMerger::ratio: the span's deviation over the tolerance at its sphere's nearest depth (<= 1: one interval).
+float span_ratio(Span nd) {
+    uint len = nd.e - nd.s;
+    if (len > 1u && CLOSED && 3u * len > SEGS) return 1.0 / 0.0;  // a loop keeps >= 3 intervals
+    vec3 q = to_view(OFFSET + nd.c);
+    float c = u_focal / u_eps;
+    if (!INSIDE) {
+        if (u_coarse) {
+            float ri = nd.r + RADIUS_MAX;
+            float sx = sqrt(1.0 + u_tan_x * u_tan_x), sy = sqrt(1.0 + u_tan_y * u_tan_y);
+            bool away = q.x + q.z * u_tan_x < -ri * sx || q.z * u_tan_x - q.x < -ri * sx ||
+                       q.y + q.z * u_tan_y < -ri * sy || q.z * u_tan_y - q.y < -ri * sy ||
+                       q.z - u_near < -ri || u_far - q.z < -ri;
+            if (away) return 0.0;  // off screen: one interval
+        }
+        float k = sqrt(1.0 + u_tan_x * u_tan_x + u_tan_y * u_tan_y);  // reaching behind the near plane: the corner's
+        if (q.z - nd.r >= u_near) {
+            float a = (abs(q.x) + nd.r) / (q.z - nd.r), b = (abs(q.y) + nd.r) / (q.z - nd.r);
+            k = sqrt(1.0 + a * a + b * b);  // the span's chord may leave the screen: not capped
+        }
+        return nd.dev * c * k / max(q.z - nd.r, u_near);
+    }
+    return nd.dev * c * SPAN_K / max(q.z - nd.r, u_near);
+}
+// Whether the span takes one interval of the counts: at the hysteresis threshold for a new span, at the tolerance
+// for one the previous frame had.
+bool takes_span(Span nd) {
+    float r = span_ratio(nd);
+    bool was = (nd.bits & (kOldOne | kRestZero)) == (kOldOne | kRestZero);
+    float new_scale = u_band < 0.0 ? 1.0 : 1.0 / (1.0 + u_band);
+    return r <= new_scale || (r <= 1.0 && was);
+}
+// Level 0: segment k (control points from the wire's origin) whose count was just written.
+Span leaf_span(Seg c, uint k, uint count, uint old_count) {
+    vec3 p1 = c.b0 + c.d0, p2 = p1 + c.d1, p3 = p2 + c.d2;
+    vec3 lo = min(min(c.b0, p1), min(p2, p3)), hi = max(max(c.b0, p1), max(p2, p3));
+    Span nd;
+    nd.c = 0.5 * (lo + hi);
+    nd.r = 0.5 * length(hi - lo) * (1.0 + 1e-6);
+    // min(the hull's distance to the chord, Wang's 3M/4 for one ring)
+    vec3 ab = p3 - c.b0, q1 = c.d0, q2 = c.d0 + c.d1;
+    float len2 = dot(ab, ab);
+    float inv = len2 > 0.0 ? 1.0 / len2 : 0.0;
+    vec3 v1 = q1 - clamp(dot(q1, ab) * inv, 0.0, 1.0) * ab, v2 = q2 - clamp(dot(q2, ab) * inv, 0.0, 1.0) * ab;
+    float hull = sqrt(max(dot(v1, v1), dot(v2, v2)));
+    float m = max(length(c.d1 - c.d0), length(c.d2 - c.d1));
+    nd.dev = min(hull, 0.75 * m);
+    if (isnan(nd.dev) || isinf(nd.dev)) nd.dev = 1.0 / 0.0;
+    nd.a = c.b0;
+    nd.b = p3;
+    nd.s = k;
+    nd.e = k + 1u;
+    nd.sum = count;
+    nd.level = 0u;
+    nd.bits = kRestZero | (old_count == 1u ? kOldOne : 0u) | (old_count == 0u ? kOldZero : 0u);
+    if (takes_span(nd)) {
+        counts[H.segment_first + k] = 1u;
+        TOTAL = TOTAL - count + 1u;
+        nd.sum = 1u;
+    }
+    if (nd.sum == 1u) nd.bits |= kPattern;
+    return nd;
+}
+void write_zeros(uint s, uint e) { for (uint i = s; i < e; ++i) counts[H.segment_first + i] = 0u; }
+// A node from its two children (merge_spheres; deviation max(d_left, d_right) + dist(M, A-B)), decided.
+Span merge_span(Span l, Span rt) {
+    Span nd;
+    vec3 d = rt.c - l.c;
+    float dist = length(d);
+    if (dist + rt.r <= l.r) {
+        nd.c = l.c, nd.r = l.r;
+    } else if (dist + l.r <= rt.r) {
+        nd.c = rt.c, nd.r = rt.r;
+    } else {
+        float rad = 0.5 * ((dist + l.r) + rt.r);
+        nd.c = l.c + d * ((rad - l.r) / dist);
+        nd.r = rad * (1.0 + 1e-6);
+    }
+    vec3 ab = rt.b - l.a, q = l.b - l.a;
+    float len2 = dot(ab, ab);
+    float t = len2 > 0.0 ? clamp(dot(q, ab) / len2, 0.0, 1.0) : 0.0;
+    nd.dev = max(l.dev, rt.dev) + length(q - t * ab);
+    if (isnan(nd.dev)) nd.dev = 1.0 / 0.0;
+    nd.a = l.a;
+    nd.b = rt.b;
+    nd.s = l.s;
+    nd.e = rt.e;
+    nd.sum = l.sum + rt.sum;
+    nd.level = max(l.level, rt.level) + 1u;
+    bool rest_zero = (l.bits & kRestZero) != 0u && (rt.bits & (kOldZero | kRestZero)) == (kOldZero | kRestZero);
+    nd.bits = (l.bits & (kOldOne | kOldZero)) | (rest_zero ? kRestZero : 0u);
+    if (takes_span(nd)) {
+        if ((l.bits & kPattern) == 0u) {
+            counts[H.segment_first + l.s] = 1u;
+            write_zeros(l.s + 1u, l.e);
+        }
+        if ((rt.bits & kPattern) == 0u) write_zeros(rt.s, rt.e);
+        else counts[H.segment_first + rt.s] = 0u;
+        TOTAL = TOTAL - nd.sum + 1u;
+        nd.sum = 1u;
+        nd.bits |= kPattern;
+    }
+    return nd;
+}
+
 // Writes the wire's counts (over the previous ones unless restart) and state; returns its ring total, 0 when
 // culled. radius_px: the projected radius.
 uint lod(uint slot, vec3 offset, out float radius_px) {
@@ -350,9 +479,37 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
     float rx = radius * sqrt(1.0 + u_tan_x * u_tan_x), ry = radius * sqrt(1.0 + u_tan_y * u_tan_y);
     uvec4 state = slot_state[slot].lod;
     bool fresh = state.z == 0u;
-    uint wire_outside = 63u, visible = 0u, total = CLOSED ? 0u : 1u;
+    uint wire_outside = 63u, visible = 0u;
+    TOTAL = CLOSED ? 0u : 1u;
     float wire_z = 1.0 / 0.0, wire_k = 1.0;
     float scale = u_eps / u_focal;
+    bool merge = u_merge && SEGS < (1u << 30);
+    if (merge) {
+        // The wire's sphere (curve_bounding_sphere: its control points' box, inflated by the largest radius) and
+        // sphere_screen_bound's inside test and off-axis factor.
+        vec3 lo = vec3(1.0 / 0.0), hi = vec3(-1.0 / 0.0);
+        for (uint k = 0u; k < SEGS; ++k) {
+            Seg c = load_seg(k);
+            vec3 p1 = c.b0 + c.d0, p2 = p1 + c.d1, p3 = p2 + c.d2;
+            lo = min(lo, min(min(c.b0, p1), min(p2, p3)));
+            hi = max(hi, max(max(c.b0, p1), max(p2, p3)));
+        }
+        float r = 0.5 * length(hi - lo) * (1.0 + 1e-6) + radius;
+        vec3 q = to_view(offset + 0.5 * (lo + hi));
+        float rxs = r * sqrt(1.0 + u_tan_x * u_tan_x), rys = r * sqrt(1.0 + u_tan_y * u_tan_y);
+        INSIDE = q.x + q.z * u_tan_x >= rxs && q.z * u_tan_x - q.x >= rxs && q.y + q.z * u_tan_y >= rys &&
+                 q.z * u_tan_y - q.y >= rys && q.z - u_near >= r && u_far - q.z >= r;
+        float a = u_tan_x, b = u_tan_y;
+        if (q.z - r > 0.0) {
+            a = min(a, (abs(q.x) + r) / (q.z - r));
+            b = min(b, (abs(q.y) + r) / (q.z - r));
+        }
+        SPAN_K = sqrt(1.0 + a * a + b * b);
+        OFFSET = offset;
+        RADIUS_MAX = radius;
+    }
+    Span stack[32];
+    int top = 0;
     for (uint k = 0u; k < SEGS; ++k) {
         Seg c = load_seg(k);
         vec3 p[4];
@@ -394,7 +551,18 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
         uint old_count = fresh ? 0u : counts[H.segment_first + k];
         uint count = min(old_count > raw ? hysteresis_count(old_count, raw, u_band) : raw, u_max_rings);
         counts[H.segment_first + k] = count;
-        total += count;
+        TOTAL += count;
+        if (merge) {
+            stack[top++] = leaf_span(c, k, count, old_count);
+            while (top >= 2 && stack[top - 1].level == stack[top - 2].level) {
+                stack[top - 2] = merge_span(stack[top - 2], stack[top - 1]);
+                --top;
+            }
+        }
+    }
+    while (top >= 2) {  // the last nodes of odd levels, up to the root
+        stack[top - 2] = merge_span(stack[top - 2], stack[top - 1]);
+        --top;
     }
     radius_px = 0.0;
     if (wire_outside != 0u) {
@@ -408,7 +576,7 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
     radius_px = visible == 0u ? 0.0 : radius * u_focal * wire_k / max(wire_z, u_near);
     uint drawn = drawn_sides_for(radius_px, sides, state.y);
     slot_state[slot].lod = uvec4(sides, drawn, 1u, 1u);
-    return total;
+    return TOTAL;
 }
 
 // ---- the walk ----
@@ -580,6 +748,9 @@ void main() {
                 uint c = chunk_count_of(kind, n, drawn, caps);
                 if (c != 0u) atomicAdd(buckets[bucket_of(material, drawn, kind)], c);
             }
+            uint bands = n - 1u + (CLOSED ? 1u : 0u);
+            uint tris = drawn <= 2u ? 2u * bands : (2u * bands + (!CLOSED && caps ? 2u : 0u)) * drawn;
+            if (tris != 0u) atomicAdd(triangles, tris);
         }
         if (u_stage == 1u) return;
         job = jobs[w];
@@ -663,6 +834,7 @@ void set_lod_uniforms(const engine::gfx::Program& program, const LodView& v, con
     glUniform1ui(at("u_max_rings"), st.max_rings_per_segment ? st.max_rings_per_segment : 256u);
     glUniform1ui(at("u_max_sides"), std::clamp<uint32_t>(st.max_sides ? st.max_sides : 32u, 3u, kMaxSides));
     glUniform1i(at("u_coarse"), st.coarse_offscreen_segments ? 1 : 0);
+    glUniform1i(at("u_merge"), st.keep_node_resolution ? 0 : 1);
     static const std::array<float, kMaxSides + 1> sagitta = [] {
         std::array<float, kMaxSides + 1> t{};
         for (uint32_t n = 3; n <= kMaxSides; ++n) t[n] = static_cast<float>(1.0 - std::cos(std::numbers::pi / n));
@@ -689,10 +861,6 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     if (jobs.size() != headers.size()) {
         return Status::error("the ring pass got " + std::to_string(jobs.size()) + " jobs for the curve pass's " +
                              std::to_string(headers.size()) + " wires");
-    }
-    if (lod != nullptr && !lod->settings.keep_node_resolution) {
-        return Status::error("the GPU LOD evaluates at node resolution only (LodSettings::keep_node_resolution): "
-                             "spans below it are not on the GPU yet");
     }
     const uint32_t max_rings = lod == nullptr || lod->settings.max_rings_per_segment == 0
                                    ? 256u
@@ -757,7 +925,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
         }
     }
     auto job_buffer = engine::gfx::make_buffer(std::span<const Job>(job_data), "wire gpu ring jobs");
-    const uint32_t zero_counter[3] = {0, 0, 0};
+    const uint32_t zero_counter[4] = {0, 0, 0, 0};
     auto counter = engine::gfx::make_buffer(std::span<const uint32_t>(zero_counter), "wire gpu ring counter");
     auto visible_buffer = engine::gfx::make_buffer(std::span<const uint32_t>(visible), "wire gpu visible slots");
     if (!job_buffer) return Status::error(job_buffer.error().message);

@@ -23,6 +23,8 @@ namespace gfx = engine::gfx;
 
 constexpr std::size_t kAlign = 256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT everywhere we know
 constexpr uint32_t kReadbackSlots = 3;
+// The ring pass's Counter: rings, wires that did not fit, reserve rings, triangles.
+constexpr std::size_t kCounterBytes = 16;
 constexpr std::size_t kJobBytes = 64, kSlotStateBytes = 32, kSegmentBytes = 64, kDrawBytes = 32;
 
 std::size_t align_up(std::size_t v) { return (v + kAlign - 1) / kAlign * kAlign; }
@@ -55,7 +57,6 @@ Status check_storage_limits(const gfx::Program& program, const char* label, uint
 
 void NodePath::set_lod(const LodSettings& lod) {
     lod_ = lod;
-    lod_.keep_node_resolution = true;
     max_sides_ = std::clamp<uint32_t>(lod.max_sides ? lod.max_sides : 32u, 3u, kMaxSides);
 }
 
@@ -71,7 +72,7 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     if (Status st = check_storage_limits(path->ring_program_, "wire nodes: rings", kRingBindings); !st) return st;
     path->set_lod({});
     path->retain_frames_ = retain_frames ? retain_frames : 180;
-    auto readback = gfx::make_buffer({.size_bytes = kReadbackSlots * 8,
+    auto readback = gfx::make_buffer({.size_bytes = kReadbackSlots * kCounterBytes,
                                       .storage_flags = GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT,
                                       .label = "wire nodes: ring counter readback"});
     if (!readback) return readback.error();
@@ -81,7 +82,7 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     GLint64 max_block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
     if (max_block > 0) path->max_block_bytes_ = static_cast<std::size_t>(max_block);
-    path->readback_map_ = glMapNamedBufferRange(path->readback_.id(), 0, kReadbackSlots * 8,
+    path->readback_map_ = glMapNamedBufferRange(path->readback_.id(), 0, kReadbackSlots * kCounterBytes,
                                                 GL_MAP_READ_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT);
     if (path->readback_map_ == nullptr) return Error{"wire nodes: could not map the ring counter readback"};
     return path;
@@ -220,10 +221,11 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     if (GLsync& fence = readback_fence_[frame_ % kReadbackSlots]; fence != nullptr) {
         const GLenum waited = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 0);
         if (waited == GL_ALREADY_SIGNALED || waited == GL_CONDITION_SATISFIED) {
-            const auto* seen = static_cast<const uint32_t*>(readback_map_) + 2 * (frame_ % kReadbackSlots);
+            const auto* seen = static_cast<const uint32_t*>(readback_map_) + kCounterBytes / 4 * (frame_ % kReadbackSlots);
             const std::size_t most = max_block_bytes_ / sizeof(PackedRing) * 2 / 3;
             if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::min(std::size_t{seen[0]} * 3 / 2, most);
             stats.wires_coarse = seen[1];
+            stats.triangles = seen[3];
             glDeleteSync(fence);
             fence = nullptr;
         }
@@ -444,7 +446,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     if (made) made = need(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks");
     if (made) made = need(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets");
     if (made) made = need(commands_, command_bytes_, buckets * 20, "wire nodes: commands");
-    if (made) made = need(counter_, counter_bytes_, 12, "wire nodes: ring counter");
+    if (made) made = need(counter_, counter_bytes_, kCounterBytes, "wire nodes: ring counter");
     if (!made) return fail(made);
     if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
         // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
@@ -465,7 +467,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         template_sides_ = side_slots_;
         template_patterns_ = ctx.pattern_first.size();
     }
-    clear_range(counter_, 0, 12);
+    clear_range(counter_, 0, kCounterBytes);
     clear_range(buckets_, 0, buckets * 4);
 
     // (1) Curves of the wires whose nodes changed, into their slots' segments and headers.
@@ -534,7 +536,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glDispatchCompute(groups, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     // The counter, read kReadbackSlots frames later (the ring buffer's size).
-    glCopyNamedBufferSubData(counter_.id(), readback_.id(), 0, static_cast<GLintptr>(8 * (frame_ % kReadbackSlots)), 8);
+    glCopyNamedBufferSubData(counter_.id(), readback_.id(), 0,
+                             static_cast<GLintptr>(kCounterBytes * (frame_ % kReadbackSlots)), kCounterBytes);
     GLsync& fence = readback_fence_[frame_ % kReadbackSlots];
     if (fence != nullptr) glDeleteSync(fence);  // an older copy into the slot, not read: this one supersedes it
     fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);

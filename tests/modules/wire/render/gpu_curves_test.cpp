@@ -609,7 +609,7 @@ TEST_F(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
 // rounding sits on a threshold: a difference counts as that when update_lod with the tolerance moved by 1e-4
 // (either way) gives the GPU's value, or a visibility that differs (a control hull on a frustum plane); those
 // are counted, reported and allowed at 1 in 1000, any other difference fails. Measured: none at all.
-TEST_F(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
+TEST_F(GpuRings, LodMatchesUpdateLod) {
 
     wire::testing::Random rng{5001};
     std::vector<WireNodes> wires;
@@ -648,120 +648,139 @@ TEST_F(GpuRings, LodMatchesUpdateLodAtNodeResolution) {
         ASSERT_TRUE(build_curve(rounded_to(wires[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
     }
 
-    std::size_t compared_segments = 0, compared_wires = 0, visible_wires = 0, count_threshold = 0,
-                side_threshold = 0, visibility_threshold = 0, changed = 0, strips = 0, lines = 0;
-    std::size_t failures = 0;
-    std::string first_failure;
-    std::vector<double> screen_ratios;  // per visible wire frame: screen error / tolerance
-    double worst_screen = 0.0;
-    std::string worst_screen_where;
-    const int shots = 32, frames = 8;
-    for (int shot = 0; shot < shots; ++shot) {
-        const std::size_t target_wire = static_cast<std::size_t>(rng.integer(0, static_cast<int>(wires.size()) - 1));
-        const glm::dvec3 target = wires[target_wire].positions[wires[target_wire].size() / 2];
-        const glm::dvec3 dir = rng.unit();
-        double distance = rng.log_uniform(0.1, 100.0);
-        const double step = rng.uniform(0.0, 1.0) < 0.5 ? 1.25 : 0.8;
-        const double fov = rng.uniform(30.0, 90.0) * std::numbers::pi / 180.0;
-        LodSettings ls{.tolerance_px = rng.log_uniform(0.25, 2.0), .keep_node_resolution = true};
-        std::vector<GpuRingJob> jobs(wires.size());
-        std::vector<GpuRingResult> previous;
-        for (int frame = 0; frame < frames; ++frame, distance *= step) {
-            const glm::dvec3 eye = target + distance * dir;
-            const glm::dvec3 up = std::abs(dir.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
-            const LodView view = LodView::perspective(eye, target, up, fov, 1920, 1080, 0.05, 1e4);
-            for (GpuRingJob& j : jobs) j.restart_lod = frame == 0;
-            const GpuLodFrame lod{view, ls, 0};
-            ASSERT_TRUE(rings->build(*curves, jobs, &lod).ok());
-            std::vector<GpuRingResult> gpu;
-            rings->read(gpu);
-            ASSERT_EQ(gpu.size(), wires.size());
-            for (std::size_t i = 0; i < wires.size(); ++i) {
-                // The CPU from the GPU's previous state.
-                const auto from_previous = [&](double tolerance) {
-                    WireLod w;
-                    if (frame > 0 && previous[i].visible) {
-                        w.counts = previous[i].counts;
-                        w.sides = previous[i].sides;
-                        w.drawn_sides = previous[i].drawn_sides;
-                        w.visible = true;
+    // Both LODs, the same shots for each: at node resolution, and below it (the spans).
+    for (const bool keep : {true, false}) {
+        SCOPED_TRACE(keep ? "at node resolution" : "below node resolution (spans)");
+        wire::testing::Random shot_rng{6001};
+        std::size_t compared_segments = 0, compared_wires = 0, visible_wires = 0, count_threshold = 0,
+                    side_threshold = 0, visibility_threshold = 0, changed = 0, strips = 0, lines = 0;
+        std::size_t failures = 0, gpu_rings_total = 0, cpu_rings_total = 0, spanned_segments = 0;
+        std::string first_failure;
+        std::vector<double> screen_ratios;  // per visible wire frame: screen error / tolerance
+        double worst_screen = 0.0;
+        std::string worst_screen_where;
+        const int shots = 32, frames = 8;
+        for (int shot = 0; shot < shots; ++shot) {
+            const std::size_t target_wire = static_cast<std::size_t>(shot_rng.integer(0, static_cast<int>(wires.size()) - 1));
+            const glm::dvec3 target = wires[target_wire].positions[wires[target_wire].size() / 2];
+            const glm::dvec3 dir = shot_rng.unit();
+            double distance = shot_rng.log_uniform(0.1, 100.0);
+            const double step = shot_rng.uniform(0.0, 1.0) < 0.5 ? 1.25 : 0.8;
+            const double fov = shot_rng.uniform(30.0, 90.0) * std::numbers::pi / 180.0;
+            LodSettings ls{.tolerance_px = shot_rng.log_uniform(0.25, 2.0), .keep_node_resolution = keep};
+            std::vector<GpuRingJob> jobs(wires.size());
+            std::vector<GpuRingResult> previous;
+            for (int frame = 0; frame < frames; ++frame, distance *= step) {
+                const glm::dvec3 eye = target + distance * dir;
+                const glm::dvec3 up = std::abs(dir.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+                const LodView view = LodView::perspective(eye, target, up, fov, 1920, 1080, 0.05, 1e4);
+                for (GpuRingJob& j : jobs) j.restart_lod = frame == 0;
+                const GpuLodFrame lod{view, ls, 0};
+                ASSERT_TRUE(rings->build(*curves, jobs, &lod).ok());
+                std::vector<GpuRingResult> gpu;
+                rings->read(gpu);
+                ASSERT_EQ(gpu.size(), wires.size());
+                for (std::size_t i = 0; i < wires.size(); ++i) {
+                    // The CPU from the GPU's previous state.
+                    const auto from_previous = [&](double tolerance) {
+                        WireLod w;
+                        if (frame > 0 && previous[i].visible) {
+                            w.counts = previous[i].counts;
+                            w.sides = previous[i].sides;
+                            w.drawn_sides = previous[i].drawn_sides;
+                            w.visible = true;
+                        }
+                        LodSettings s = ls;
+                        s.tolerance_px = tolerance;
+                        update_lod(cpu[i], view, s, w, static_cast<const BoundingSphere*>(nullptr));
+                        return w;
+                    };
+                    const WireLod ref = from_previous(ls.tolerance_px);
+                    const GpuRingResult& g = gpu[i];
+                    const std::string where = labels[i] + ", shot " + std::to_string(shot) + " frame " + std::to_string(frame);
+                    ++compared_wires;
+                    const auto fail = [&](const std::string& what) {
+                        if (failures++ == 0) first_failure = where + ": " + what;
+                    };
+                    if (ref.visible != g.visible) {
+                        ++visibility_threshold;  // a control hull on a frustum plane, within float rounding
+                        continue;
                     }
-                    LodSettings s = ls;
-                    s.tolerance_px = tolerance;
-                    update_lod(cpu[i], view, s, w, static_cast<const BoundingSphere*>(nullptr));
-                    return w;
-                };
-                const WireLod ref = from_previous(ls.tolerance_px);
-                const GpuRingResult& g = gpu[i];
-                const std::string where = labels[i] + ", shot " + std::to_string(shot) + " frame " + std::to_string(frame);
-                ++compared_wires;
-                const auto fail = [&](const std::string& what) {
-                    if (failures++ == 0) first_failure = where + ": " + what;
-                };
-                if (ref.visible != g.visible) {
-                    ++visibility_threshold;  // a control hull on a frustum plane, within float rounding
-                    continue;
-                }
-                if (!ref.visible) continue;
-                ++visible_wires;
-                if (g.overflow) fail("ring buffer overflow");
-                std::vector<RingParam> params;
-                place_rings(cpu[i], g.counts, params);
-                if (params.size() != g.rings.size()) fail("ring count " + std::to_string(g.rings.size()) + " for counts of " + std::to_string(params.size()));
-                // The LOD's promise (LodProof.ScreenErrorWithinTolerance on the CPU path): the drawn centre line
-                // within the tolerance of the curve on screen.
-                const ScreenError e = measure_screen_error(cpu[i], params, view, 32);
-                screen_ratios.push_back(e.max_px / ls.tolerance_px);
-                if (e.max_px / ls.tolerance_px > worst_screen) {
-                    worst_screen = e.max_px / ls.tolerance_px;
-                    worst_screen_where = where + ", segment " + std::to_string(e.worst_segment);
-                }
-                const WireLod up_tol = from_previous(ls.tolerance_px * (1.0 + 1e-4));
-                const WireLod down_tol = from_previous(ls.tolerance_px * (1.0 - 1e-4));
-                for (std::size_t k = 0; k < ref.counts.size(); ++k, ++compared_segments) {
-                    if (g.counts[k] == ref.counts[k]) continue;
-                    if (g.counts[k] == up_tol.counts[k] || g.counts[k] == down_tol.counts[k]) {
-                        ++count_threshold;
-                    } else {
-                        fail("segment " + std::to_string(k) + " count " + std::to_string(g.counts[k]) + ", CPU " + std::to_string(ref.counts[k]));
+                    if (!ref.visible) continue;
+                    ++visible_wires;
+                    if (g.overflow) fail("ring buffer overflow");
+                    std::vector<RingParam> params;
+                    place_rings(cpu[i], g.counts, params);
+                    if (params.size() != g.rings.size()) fail("ring count " + std::to_string(g.rings.size()) + " for counts of " + std::to_string(params.size()));
+                    {
+                        std::vector<RingParam> ref_params;
+                        place_rings(cpu[i], ref.counts, ref_params);
+                        gpu_rings_total += params.size();
+                        cpu_rings_total += ref_params.size();
+                        for (const uint32_t c : g.counts) spanned_segments += c == 0 ? 1 : 0;
                     }
-                }
-                if (g.sides != ref.sides || g.drawn_sides != ref.drawn_sides) {
-                    const bool near = (g.sides == up_tol.sides && g.drawn_sides == up_tol.drawn_sides) ||
-                                      (g.sides == down_tol.sides && g.drawn_sides == down_tol.drawn_sides);
-                    if (near) {
-                        ++side_threshold;
-                    } else {
-                        fail("sides " + std::to_string(g.sides) + "/" + std::to_string(g.drawn_sides) + ", CPU " +
-                             std::to_string(ref.sides) + "/" + std::to_string(ref.drawn_sides) + ", CPU required " +
-                             std::to_string(ref.required_sides) + ", previous " +
-                             (frame > 0 ? std::to_string(previous[i].sides) + "/" + std::to_string(previous[i].drawn_sides) : std::string("none")) + " (radius " +
-                             std::to_string(g.radius_px) + " px, CPU " + std::to_string(ref.radius_px) + ")");
+                    // The LOD's promise (LodProof.ScreenErrorWithinTolerance on the CPU path): the drawn centre line
+                    // within the tolerance of the curve on screen.
+                    const ScreenError e = measure_screen_error(cpu[i], params, view, 32);
+                    screen_ratios.push_back(e.max_px / ls.tolerance_px);
+                    if (e.max_px / ls.tolerance_px > worst_screen) {
+                        worst_screen = e.max_px / ls.tolerance_px;
+                        worst_screen_where = where + ", segment " + std::to_string(e.worst_segment);
                     }
+                    const WireLod up_tol = from_previous(ls.tolerance_px * (1.0 + 1e-4));
+                    const WireLod down_tol = from_previous(ls.tolerance_px * (1.0 - 1e-4));
+                    for (std::size_t k = 0; k < ref.counts.size(); ++k, ++compared_segments) {
+                        if (g.counts[k] == ref.counts[k]) continue;
+                        if (g.counts[k] == up_tol.counts[k] || g.counts[k] == down_tol.counts[k]) {
+                            ++count_threshold;
+                        } else {
+                            fail("segment " + std::to_string(k) + " count " + std::to_string(g.counts[k]) + ", CPU " + std::to_string(ref.counts[k]));
+                        }
+                    }
+                    if (g.sides != ref.sides || g.drawn_sides != ref.drawn_sides) {
+                        const bool near = (g.sides == up_tol.sides && g.drawn_sides == up_tol.drawn_sides) ||
+                                          (g.sides == down_tol.sides && g.drawn_sides == down_tol.drawn_sides);
+                        if (near) {
+                            ++side_threshold;
+                        } else {
+                            fail("sides " + std::to_string(g.sides) + "/" + std::to_string(g.drawn_sides) + ", CPU " +
+                                 std::to_string(ref.sides) + "/" + std::to_string(ref.drawn_sides) + ", CPU required " +
+                                 std::to_string(ref.required_sides) + ", previous " +
+                                 (frame > 0 ? std::to_string(previous[i].sides) + "/" + std::to_string(previous[i].drawn_sides) : std::string("none")) + " (radius " +
+                                 std::to_string(g.radius_px) + " px, CPU " + std::to_string(ref.radius_px) + ")");
+                        }
+                    }
+                    if (std::abs(g.radius_px - ref.radius_px) > 1e-4 * ref.radius_px) fail("radius_px " + std::to_string(g.radius_px) + ", CPU " + std::to_string(ref.radius_px));
+                    if (frame > 0 && previous[i].visible && g.counts != previous[i].counts) ++changed;
+                    strips += g.drawn_sides == 2 ? 1 : 0;
+                    lines += g.drawn_sides == 1 ? 1 : 0;
                 }
-                if (std::abs(g.radius_px - ref.radius_px) > 1e-4 * ref.radius_px) fail("radius_px " + std::to_string(g.radius_px) + ", CPU " + std::to_string(ref.radius_px));
-                if (frame > 0 && previous[i].visible && g.counts != previous[i].counts) ++changed;
-                strips += g.drawn_sides == 2 ? 1 : 0;
-                lines += g.drawn_sides == 1 ? 1 : 0;
+                previous = std::move(gpu);
             }
-            previous = std::move(gpu);
         }
+        std::printf("gpu lod: %zu wire frames (%zu visible: %zu strips, %zu lines), %zu segments compared, %zu frames where "
+                    "a wire's counts changed | at a float threshold: %zu counts, %zu side counts, %zu visibility | other "
+                    "differences: %zu%s%s\n",
+                    compared_wires, visible_wires, strips, lines, compared_segments, changed, count_threshold, side_threshold,
+                    visibility_threshold, failures, failures ? ", first: " : "", first_failure.c_str());
+        std::sort(screen_ratios.begin(), screen_ratios.end());
+        std::printf("gpu lod screen error / tolerance per visible wire frame: median %.3g, p90 %.3g, max %.3g (%s)\n",
+                    screen_ratios[screen_ratios.size() / 2], screen_ratios[screen_ratios.size() * 9 / 10], worst_screen,
+                    worst_screen_where.c_str());
+        std::printf("gpu lod rings: %zu on the GPU, %zu on the CPU (ratio %.4f); segments crossed by a span: %zu\n",
+                    gpu_rings_total, cpu_rings_total,
+                    static_cast<double>(gpu_rings_total) / static_cast<double>(cpu_rings_total), spanned_segments);
+        if (!keep) {
+            EXPECT_GT(spanned_segments, compared_segments / 20) << "the shots should exercise the spans";
+        }
+        EXPECT_LE(gpu_rings_total, cpu_rings_total * 1.01) << "the GPU's LOD should draw the CPU's rings";
+        EXPECT_LE(worst_screen, 1.0 + 1e-9) << worst_screen_where;
+        EXPECT_EQ(failures, 0u) << first_failure;
+        EXPECT_GT(changed, 0u);  // the shots exercise the hysteresis
+        EXPECT_GT(visible_wires, compared_wires / 10);
+        EXPECT_LE(count_threshold, compared_segments / 1000);
+        EXPECT_LE(side_threshold + visibility_threshold, compared_wires / 1000);
     }
-    std::printf("gpu lod: %zu wire frames (%zu visible: %zu strips, %zu lines), %zu segments compared, %zu frames where "
-                "a wire's counts changed | at a float threshold: %zu counts, %zu side counts, %zu visibility | other "
-                "differences: %zu%s%s\n",
-                compared_wires, visible_wires, strips, lines, compared_segments, changed, count_threshold, side_threshold,
-                visibility_threshold, failures, failures ? ", first: " : "", first_failure.c_str());
-    std::sort(screen_ratios.begin(), screen_ratios.end());
-    std::printf("gpu lod screen error / tolerance per visible wire frame: median %.3g, p90 %.3g, max %.3g (%s)\n",
-                screen_ratios[screen_ratios.size() / 2], screen_ratios[screen_ratios.size() * 9 / 10], worst_screen,
-                worst_screen_where.c_str());
-    EXPECT_LE(worst_screen, 1.0 + 1e-9) << worst_screen_where;
-    EXPECT_EQ(failures, 0u) << first_failure;
-    EXPECT_GT(changed, 0u);  // the shots exercise the hysteresis
-    EXPECT_GT(visible_wires, compared_wires / 10);
-    EXPECT_LE(count_threshold, compared_segments / 1000);
-    EXPECT_LE(side_threshold + visibility_threshold, compared_wires / 1000);
 }
 
 TEST_F(GpuRings, RefusesJobsThatDoNotMatchTheCurves) {
