@@ -106,7 +106,7 @@ wire::SplineSettings spline_of(const std::string& name) {
 
 wire::UploadPath path_of(const std::string& name) {
     if (const std::optional<wire::UploadPath> p = wire::parse_upload_path(name)) return *p;
-    value_error("path: expected 'cpu', 'gpu' or 'nodes', got '" + name + "'");
+    value_error("path: expected 'auto', 'nodes', 'cpu' or 'gpu', got '" + name + "'");
 }
 
 glm::dvec3 vec3_of(const std::vector<double>& v, const char* what) {
@@ -161,7 +161,7 @@ public:
         if (width < 1 || height < 1 || width > 16384 || height > 16384)
             value_error("size: expected width and height in [1, 16384], got " + std::to_string(width) + "x" +
                         std::to_string(height));
-        ctx_.path = path_of(path);
+        if (path != "auto") ctx_.path = path_of(path);
         ctx_.pop_free = pop_free;
         if (threads > 0)
             threads_.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
@@ -177,6 +177,7 @@ public:
         if (!renderer)
             throw std::runtime_error("cannot create the wire renderer: " + renderer.error().message);
         renderer_ = std::move(renderer).value();
+        if (path == "auto") ctx_.path = renderer_.preferred_path();
         const engine::platform::Extent size = gl_->framebuffer_size();
         ctx_.viewport_width_px = size.width;
         ctx_.viewport_height_px = size.height;
@@ -189,6 +190,7 @@ public:
     /// Several runtimes may live in one process, each with its own context: the renderer's GL objects are
     /// deleted with this runtime's context current.
     ~Runtime() { gl_->make_current(); }
+    [[nodiscard]] wire::UploadPath path() const { return ctx_.path; }
 
     Entity spawn(const DoubleArray& positions, const std::optional<IdArray>& ids,
                  const std::optional<FloatArray>& stretch, const std::optional<FloatArray>& radii,
@@ -491,10 +493,11 @@ PYBIND11_MODULE(wires, m) {
     py::class_<Runtime>(m, "Runtime",
                         "A scene: GL context (headless EGL or a window), wire renderer, ECS systems")
         .def(py::init<int, int, bool, const std::string&, int, bool>(), py::arg("width") = 1280,
-             py::arg("height") = 720, py::arg("headless") = true, py::arg("path") = "cpu",
+             py::arg("height") = 720, py::arg("headless") = true, py::arg("path") = "auto",
              py::arg("threads") = 0, py::arg("pop_free") = true,
-             "path: 'cpu' (meshes), 'gpu' (ring records) or 'nodes' (nodes only: curve, LOD and rings computed on "
-             "the GPU); threads: worker threads of the systems (0: all "
+             "path: 'auto' (the default: 'nodes' where the GL context has compute shaders, else 'cpu'; logged on "
+             "stderr), 'nodes' (nodes only: curve, LOD and rings computed on the GPU), 'cpu' (meshes: the portable "
+             "reference) or 'gpu' (ring records); threads: worker threads of the systems (0: all "
              "cores)")
         .def("spawn", &Runtime::spawn, py::arg("positions"), py::arg("ids") = py::none(),
              py::arg("stretch") = py::none(), py::arg("radii") = py::none(), py::arg("radius") = 0.01f,
@@ -549,6 +552,9 @@ PYBIND11_MODULE(wires, m) {
         .def_property_readonly("size", &Runtime::size)
         .def_property_readonly("headless", &Runtime::headless)
         .def_property_readonly("gl_renderer", &Runtime::gl_renderer)
+        .def_property_readonly(
+            "path", [](const Runtime& r) { return std::string(wire::upload_path_name(r.path())); },
+            "The upload path it draws with: 'nodes', 'cpu' or 'gpu' (with path='auto', what the context allows)")
         .def_property_readonly("wire_count", &Runtime::wire_count)
         .def("should_close", &Runtime::should_close, "Window: polls events; true once the user closed it");
 

@@ -27,7 +27,7 @@ struct Options {
     int width = 1280;
     int height = 720;
     double dt_s = 1.0 / 60.0;
-    std::string path = "cpu";  // wire upload path: cpu, gpu or nodes
+    std::string path = "auto";  // wire upload path: auto, nodes, cpu or gpu
 };
 
 std::string frame_name(int frame) {
@@ -66,9 +66,10 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1e-4, 0.1))
         ->capture_default_str();
     app.add_option("--path", opt.path,
-                   "Wire upload path: cpu (meshes), gpu (ring records) or nodes (the ropes' nodes only: curve, LOD "
-                   "and rings in compute shaders)")
-        ->check(CLI::IsMember({"cpu", "gpu", "nodes"}))
+                   "Wire upload path: auto (nodes where the GL context has compute shaders, else cpu; logged), "
+                   "nodes (the ropes' nodes only: curve, LOD and rings in compute shaders), cpu (meshes: the "
+                   "portable reference) or gpu (ring records)")
+        ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}))
         ->capture_default_str();
     app.footer("Window keys: F12 saves a screenshot to the --out directory, Esc quits.");
     CLI11_PARSE(app, argc, argv);
@@ -95,9 +96,6 @@ int main(int argc, char** argv) {
     wires.on_error = [](const wire::systems::ErrorReport& e) {
         std::fprintf(stderr, "bullet_ropes: %s\n", e.message.c_str());
     };
-    wires.path = opt.path == "gpu"     ? wire::UploadPath::gpu_rings
-                 : opt.path == "nodes" ? wire::UploadPath::gpu_nodes
-                                       : wire::UploadPath::cpu_mesh;
     wire::systems::install(schedule, wires);
     bullet_ropes::RopeScene scene(registry);
     auto view = bullet_ropes::RopeView::create(scene);
@@ -105,6 +103,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bullet_ropes: %s\n", view.error().message.c_str());
         return 1;
     }
+    wires.path = opt.path == "auto" ? view->preferred_path() : *wire::parse_upload_path(opt.path);
 
     const int frames = opt.frames > 0 ? opt.frames : (ctx.headless() ? 240 : 0);
     int written = 0;

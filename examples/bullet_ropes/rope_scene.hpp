@@ -88,6 +88,9 @@ public:
     void draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera,
               const wire::LodSettings& lod = {});
 
+    /// The wire renderer's preferred upload path (nodes where the context has compute; logged once).
+    [[nodiscard]] wire::UploadPath preferred_path() { return wires_->preferred_path(); }
+
     /// Background colour the frame is cleared to.
     static constexpr glm::vec3 kBackground{0.62f, 0.70f, 0.80f};
     /// Albedo of the floor and the box (neutral greys, so rope colours stand out).

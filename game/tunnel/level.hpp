@@ -61,6 +61,7 @@ enum class CameraMode { fly, free };
 struct LevelOptions {
     wire::SplineKind spline = wire::SplineKind::catmull_rom;
     double lod_tolerance_px = 0.5;
+    /// Level::create sets it to the wire renderer's preferred_path() (the nodes path where compute is there).
     wire::UploadPath upload_path = wire::UploadPath::cpu_mesh;
     bool wireframe = false;
     bool pop_free = true;

@@ -28,6 +28,7 @@ Status Level::create_wire_renderer() {
     auto renderer = wire::render::WireRenderer::create();
     if (!renderer) return renderer.error();
     s.wires = std::move(renderer).value();
+    options_.upload_path = s.wires.preferred_path();  // the nodes path where the context has compute
     s.pieces_timer = engine::gfx::GpuTimer::create();
     s.wires_timer = engine::gfx::GpuTimer::create();
     s.wires.add_material({.tint = {0.16f, 0.16f, 0.17f}});  // rubber

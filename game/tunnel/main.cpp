@@ -39,7 +39,7 @@ struct Args {
     double dt_s = 1.0 / 30.0;
     int pieces = 16;
     uint32_t seed = 1;
-    std::string path = "cpu";
+    std::string path = "auto";
     std::string spline = "automatic";
     double lod_tolerance_px = 0.5;
     bool wireframe = false;
@@ -310,9 +310,10 @@ int main(int argc, char** argv) {
     app.add_option("--pieces", args.pieces, "tunnel pieces of 4 m (default 16)")->check(CLI::Range(2, 256));
     app.add_option("--seed", args.seed, "seed of the bend animation (default 1)");
     app.add_option("--path", args.path,
-                   "wire upload path: cpu (meshes), gpu (ring records) or nodes (nodes only: curve, LOD and rings "
-                   "in compute shaders)")
-        ->check(CLI::IsMember({"cpu", "gpu", "nodes"}));
+                   "wire upload path: auto (default: nodes where the GL context has compute shaders, else cpu; "
+                   "logged at start), nodes (nodes only: curve, LOD and rings in compute shaders), cpu (meshes "
+                   "built on the CPU: the portable reference) or gpu (ring records)")
+        ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}));
     app.add_option("--spline", args.spline, "catmull-rom, c2, automatic or linear")
         ->check(CLI::IsMember({"catmull-rom", "c2", "automatic", "linear"}));
     app.add_option("--lod-tolerance", args.lod_tolerance_px, "wire LOD screen error in pixels (default 0.5)")
@@ -345,9 +346,7 @@ int main(int argc, char** argv) {
         return 1;
     }
     tunnel::LevelOptions& o = level.value()->options();
-    o.upload_path = args.path == "gpu"     ? wire::UploadPath::gpu_rings
-                    : args.path == "nodes" ? wire::UploadPath::gpu_nodes
-                                           : wire::UploadPath::cpu_mesh;
+    if (args.path != "auto") o.upload_path = *wire::parse_upload_path(args.path);
     o.spline = args.spline == "c2"          ? wire::SplineKind::c2
                : args.spline == "automatic" ? wire::SplineKind::automatic
                : args.spline == "linear"    ? wire::SplineKind::linear

@@ -56,6 +56,7 @@ def test_bad_nodes_raise_the_runtime_message_and_the_scene_goes_on():
     assert str(raised.value) == f"wire entity {bad.id} (index {bad.id}, version 0): node 3: position.y is NaN"
     assert rt.error(bad) == str(raised.value)
     assert rt.error(good) is None
+    rt.render()  # the default (nodes) path computes the rings as it draws
     assert rt.rings(good) is not None  # the rest of the frame went on
     assert rt.stats["visible_wires"] == 1
 
@@ -79,6 +80,7 @@ def test_bad_arguments_raise_value_error_and_change_nothing():
     rt = wires.Runtime(160, 90)
     w = rt.spawn(hanging(), radius=0.03)
     rt.update()
+    rt.render()
     before = rt.rings(w)
     with pytest.raises(ValueError, match=r"positions: expected an array of shape \(N, 3\)"):
         rt.set_nodes(w, hanging()[:, :2])
@@ -104,6 +106,7 @@ def test_bad_arguments_raise_value_error_and_change_nothing():
     # Still usable.
     w2 = rt.spawn(hanging(), radius=0.03)
     rt.update()
+    rt.render()
     after = rt.rings(w2)
     np.testing.assert_array_equal(before["centres"], after["centres"])
 
@@ -167,10 +170,12 @@ def test_runtime_rings_equal_wiretool_view_csv(tmp_path):
                     "--csv", str(out)], check=True)
     near, far = view_clip_planes(nodes, eye)
 
-    rt = wires.Runtime(640, 360)
+    rt = wires.Runtime(640, 360)  # both on their default path: nodes under llvmpipe
+    assert rt.path == "nodes"
     w = rt.spawn(nodes, ids=ids, stretch=stretch, radius=0.04)
     rt.set_camera(eye, target, near=near, far=far)
     rt.update()
+    rt.render()
     assert_rings_equal(rt.rings(w), read_ring_csv(out))
 
 
@@ -207,6 +212,25 @@ def test_nodes_path_rings_are_the_gpus_and_equal_wiretool_view_csv(tmp_path):
     np.testing.assert_allclose(gpu["centres"][list(g)], cpu["centres"][list(c)], rtol=0, atol=2e-6)
     with pytest.raises(ValueError, match="'nodes'"):
         wires.Runtime(64, 64, path="rings")
+
+
+def test_default_path_is_nodes_with_compute_and_cpu_without(monkeypatch, capfd):
+    """path='auto' (the default) picks the nodes path where the context has compute and logs the choice in one line;
+    with compute missing (forced: WIRE_GL_NO_COMPUTE=1) it picks cpu and still draws the wire."""
+    monkeypatch.delenv("WIRE_GL_NO_COMPUTE", raising=False)
+    assert wires.Runtime(64, 64).path == "nodes"
+    assert "wire: upload path nodes (" in capfd.readouterr().err
+    monkeypatch.setenv("WIRE_GL_NO_COMPUTE", "1")
+    rt = wires.Runtime(160, 90)
+    assert rt.path == "cpu"
+    assert "wire: upload path cpu (the nodes path cannot be used: compute shaders disabled" in capfd.readouterr().err
+    rt.spawn(hanging(), radius=0.03)
+    rt.set_camera((0.0, 0.5, 5.0), (0.0, 0.0, 0.0))
+    rt.update()
+    image = rt.render(clear=CLEAR)
+    background = np.round(np.array(CLEAR[:3]) * 255)
+    assert (np.abs(image[:, :, :3].astype(float) - background).max(axis=2) > 24).sum() > 20  # the wire's pixels
+    assert wires.Runtime(64, 64, path="nodes").path == "nodes"  # a named path is taken as named
 
 
 # ---- pixels: the wire is drawn where its nodes project ----
@@ -281,10 +305,10 @@ def test_set_positions_equals_set_nodes():
             b.set_nodes(w, p)
         a.update()
         b.update()
+    np.testing.assert_array_equal(a.render(), b.render())
     for x, y in zip(wa, wb):
         for key, value in a.rings(x).items():
             np.testing.assert_array_equal(value, b.rings(y)[key])
-    np.testing.assert_array_equal(a.render(), b.render())
 
 
 # ---- the README's and docs/python.md's examples run as written ----

@@ -54,7 +54,7 @@ struct ViewOptions {
     std::string size = "1280x720";
     std::optional<double> tolerance_px;
     std::optional<std::string> spline;
-    std::string path;  ///< cpu|gpu; empty: the runtime's default
+    std::string path;  ///< auto|cpu|gpu|nodes; empty: auto
     std::string png_out, csv_out, stats_out;
 };
 
@@ -260,8 +260,8 @@ int run_view(const ViewOptions& o) try {
     std::optional<CameraPose> cli_camera;
     if (!o.camera.empty()) cli_camera = parse_camera_option(o.camera);
     const double cli_fov = o.fov_deg.value_or(kDefaultFovDeg);
-    wire::UploadPath path = wire::systems::WireContext{}.path;
-    if (!o.path.empty()) path = wire::parse_upload_path(o.path).value_or(path);  // CLI11 checked the name
+    // Chosen once the renderer is made: the named path, or (auto) the renderer's preferred_path().
+    wire::UploadPath path = wire::UploadPath::cpu_mesh;
 
     wire::io::SceneSpec scene;
     if (engine::Status st = wire::io::load_wire_json(o.input, scene); !st.ok()) throw BadInput{st.message};
@@ -309,6 +309,8 @@ int run_view(const ViewOptions& o) try {
     auto made = wire::render::WireRenderer::create();
     if (!made) throw Failure{exit_failure, "cannot create the wire renderer: " + made.error().message};
     wire::render::WireRenderer renderer = std::move(made).value();
+    path = o.path.empty() || o.path == "auto" ? renderer.preferred_path()
+                                              : *wire::parse_upload_path(o.path);  // CLI11 checked the name
     // Material 0 is the renderer's copper weave; wires cycle through it and five more tints.
     for (const glm::vec3 tint : {glm::vec3(0.25f, 0.55f, 1.0f), glm::vec3(0.95f, 0.80f, 0.15f),
                                  glm::vec3(0.85f, 0.15f, 0.12f), glm::vec3(0.20f, 0.75f, 0.30f),
@@ -406,6 +408,10 @@ int run_view(const ViewOptions& o) try {
         }
         nlohmann::ordered_json wire_records = nlohmann::ordered_json::array();
         double frame_error = 0.0;
+        // The frame's totals: the systems' rings and draw()'s counts; on the nodes path what the GPU drew this frame
+        // (its read-back rings: draw() reports triangles 3 frames late and no vertices).
+        std::size_t frame_rings = ctx.stats.rings, frame_vertices = drawn.vertices, frame_triangles = drawn.triangles;
+        if (path == wire::UploadPath::gpu_nodes) frame_rings = frame_vertices = frame_triangles = 0;
         for (std::size_t w = 0; w < wires; ++w) {
             const wire::DrawItem* item = item_of[w];
             double error_px = 0.0;
@@ -416,6 +422,13 @@ int run_view(const ViewOptions& o) try {
                 if (const wire::render::DrawnRings* d = gpu_of[w]; d != nullptr) {
                     rings = d->rings.params.size();
                     sides = static_cast<long>(d->sides);
+                    const bool closed = d->rings.closed, caps = item == nullptr || item->caps;
+                    const std::size_t rows = rings + (closed ? 1 : 0), bands = rows - 1;
+                    const std::size_t cap_rows = !closed && caps ? 2 : 0;
+                    const std::size_t n = static_cast<std::size_t>(sides);
+                    frame_rings += rings;
+                    frame_vertices += n <= 2 ? 2 * rows : (rows + cap_rows) * (n + 1);
+                    frame_triangles += n <= 2 ? 2 * bands : (2 * bands + cap_rows) * n;
                     if (!o.csv_out.empty()) append_ring_rows(csv, f, w, d->rings, sides);
                     // The screen error of the GPU's rings (its LOD's counts) on the curve through the wire's nodes
                     // (the CPU's build of what the GPU built).
@@ -446,9 +459,9 @@ int run_view(const ViewOptions& o) try {
         for (const engine::ecs::SystemStats& s : schedule.stats()) systems_ms[s.name] = s.last_ms;
         frame_records.push_back({{"frame", f},
                                  {"visible_wires", ctx.stats.visible_wires},
-                                 {"rings", ctx.stats.rings},
-                                 {"vertices", drawn.vertices},
-                                 {"triangles", drawn.triangles},
+                                 {"rings", frame_rings},
+                                 {"vertices", frame_vertices},
+                                 {"triangles", frame_triangles},
                                  {"bytes_uploaded", drawn.bytes_uploaded},
                                  {"systems_ms", systems_ms},
                                  {"max_screen_error_px", frame_error},
@@ -473,6 +486,7 @@ int run_view(const ViewOptions& o) try {
              {{"width", width},
               {"height", height},
               {"tolerance_px", o.tolerance_px.value_or(kRuntimeDefaultTolerancePx)},
+              {"path", std::string(wire::upload_path_name(path))},
               {"gl_renderer", gl->gl_renderer()}}}};
         if (!outputs.stage_text(o.stats_out, stats.dump(1) + "\n", error)) throw Failure{exit_failure, error};
     }
@@ -510,10 +524,11 @@ Action add_view_command(CLI::App& app) {
                     "uniform|centripetal|chordal|c2|auto (also catmull-rom, linear); default: the file's, else the "
                     "runtime's")
         ->check(CLI::IsMember({"uniform", "centripetal", "chordal", "c2", "auto", "automatic", "catmull-rom", "linear"}));
-    cmd->add_option("--path", o->path, "Upload path: cpu (meshes built on the CPU), gpu (ring records, expanded in "
-                                       "the vertex shader) or nodes (nodes only: curve, LOD, frames and rings in "
-                                       "compute shaders); default: the runtime's")
-        ->check(CLI::IsMember({"cpu", "gpu", "nodes"}));
+    cmd->add_option("--path", o->path, "Upload path: auto (default: nodes where the GL context has compute "
+                                       "shaders, else cpu; logged on stderr), nodes (nodes only: curve, LOD, frames "
+                                       "and rings in compute shaders), cpu (meshes built on the CPU: the portable "
+                                       "reference) or gpu (ring records, expanded in the vertex shader)")
+        ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}));
     cmd->add_option("--png", o->png_out,
                     "Write the last frame as PNG; if OUT contains %04d, every frame (%04d = frame number)");
     cmd->add_option("--csv", o->csv_out, "Write one row per ring of every visible wire and frame (the mesh ring CSV "

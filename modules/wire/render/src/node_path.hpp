@@ -1,7 +1,7 @@
 // Internal: the renderer's nodes path (UploadPath::gpu_nodes, issue 30). Per frame the CPU sends, for the visible
 // wires whose nodes changed, their curve nodes and a 64-byte header (into the renderer's fenced stream region),
 // plus a 4-byte slot per visible wire; everything after that runs in compute dispatches: the curve (into
-// persistent per-wire segments), the LOD at node resolution (hysteresis state per wire kept on the GPU), the
+// persistent per-wire segments), the LOD (below the node resolution unless the settings keep it; hysteresis state per wire kept on the GPU), the
 // indirect commands, the rings with their frames and u, the draw and chunk records; then the gpu-rings vertex
 // shader draws them with one multi-draw per (class, material), reading commands the GPU wrote.
 #pragma once
@@ -43,7 +43,7 @@ public:
     NodePath(const NodePath&) = delete;
     NodePath& operator=(const NodePath&) = delete;
     ~NodePath();  ///< deletes its fences (context current)
-    /// The LOD of the next frames (keep_node_resolution implied, max_sides clamped to 3 .. 256).
+    /// The LOD of the next frames (max_sides clamped to 3 .. 256).
     void set_lod(const LodSettings& lod);
 
     /// Uploads and computes the frame (see the file comment) into `region` (begun by the caller with at least

@@ -22,10 +22,13 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <numbers>
 #include <string>
 #include <numeric>
+#include <optional>
+#include <string_view>
 
 namespace wire::render {
 namespace {
@@ -104,6 +107,42 @@ struct WireRenderer::State {
     std::size_t retained_ring_bytes = 0;  ///< retained path: bytes written into the ring storage this frame
     std::unique_ptr<detail::NodePath> nodes;  ///< gpu-nodes: made on its first frame
     Status nodes_failed{};                    ///< why the nodes path could not be made (not retried)
+    std::optional<UploadPath> preferred;      ///< preferred_path()'s choice, made once
+    std::string preferred_why;
+
+    /// Makes the nodes path once (a failure is kept: not retried).
+    Status ensure_nodes() {
+        if (!nodes_failed.ok()) return nodes_failed;
+        if (nodes) return Status::success();
+        if (std::string why = missing_compute(); !why.empty()) {
+            nodes_failed = Status::error("the nodes path cannot be used: " + why);
+            return nodes_failed;
+        }
+        Expected<std::unique_ptr<detail::NodePath>> made = detail::NodePath::create(desc.retain_frames);
+        if (!made) {
+            nodes_failed = Status::error("the nodes path cannot be used: " + made.error().message);
+            return nodes_failed;
+        }
+        nodes = std::move(*made);
+        return Status::success();
+    }
+    /// What the context lacks of what the nodes path needs (empty: nothing): compute shaders and multi-draw
+    /// indirect (GL 4.3 or their extensions); WIRE_GL_NO_COMPUTE=1 in the environment pretends compute is missing
+    /// (the fallback's test).
+    static std::string missing_compute() {
+        if (const char* v = std::getenv("WIRE_GL_NO_COMPUTE"); v != nullptr && std::string_view(v) == "1") {
+            return "compute shaders disabled (WIRE_GL_NO_COMPUTE=1)";
+        }
+        const int version = epoxy_gl_version();
+        if (version < 43 && !epoxy_has_gl_extension("GL_ARB_compute_shader")) {
+            return "no compute shaders (GL " + std::to_string(version / 10) + "." + std::to_string(version % 10) +
+                   " without GL_ARB_compute_shader)";
+        }
+        if (version < 43 && !epoxy_has_gl_extension("GL_ARB_multi_draw_indirect")) {
+            return "no multi-draw indirect (GL 4.3 or GL_ARB_multi_draw_indirect)";
+        }
+        return {};
+    }
     std::vector<std::string> logged;          ///< failures draw() has logged (each once)
     UploadPath last_path = UploadPath::cpu_mesh;
     bool drawn_any = false;                   ///< a draw() has run
@@ -146,15 +185,7 @@ struct WireRenderer::State {
     /// The gpu-nodes frame (node_path.hpp).
     DrawStats draw_nodes(const DrawList& list, const engine::scene::Camera& camera, const DrawSettings& settings) {
         DrawStats stats;
-        if (!nodes_failed.ok()) return failed(stats, nodes_failed);
-        if (!nodes) {
-            Expected<std::unique_ptr<detail::NodePath>> made = detail::NodePath::create(desc.retain_frames);
-            if (!made) {
-                nodes_failed = Status::error("the nodes path cannot be used: " + made.error().message);
-                return failed(stats, nodes_failed);
-            }
-            nodes = std::move(*made);
-        }
+        if (Status st = ensure_nodes(); !st) return failed(stats, st);
         nodes->set_lod(settings.node_lod);
         if (Status st = ensure_patterns(nodes->max_sides()); !st) return failed(stats, st);
         const std::size_t bytes = nodes->upload_bytes(list);
@@ -432,6 +463,30 @@ const std::vector<unsigned>& WireRenderer::allocated_ring_buffers() const {
 std::size_t WireRenderer::node_path_buffers() const { return state_->nodes ? state_->nodes->gl_buffers() : 0; }
 std::size_t WireRenderer::node_path_programs() const { return state_->nodes ? 2 : 0; }
 std::size_t WireRenderer::node_path_wires() const { return state_->nodes ? state_->nodes->resident_wires() : 0; }
+
+UploadPath WireRenderer::preferred_path() {
+    State& s = *state_;
+    if (!s.preferred) {
+        const Status st = s.ensure_nodes();
+        s.preferred = st ? UploadPath::gpu_nodes : UploadPath::cpu_mesh;
+        if (st) {
+            const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+            s.preferred_why = "GL " + std::to_string(epoxy_gl_version() / 10) + "." +
+                              std::to_string(epoxy_gl_version() % 10) + " compute on " +
+                              (renderer != nullptr ? renderer : "an unnamed renderer");
+        } else {
+            s.preferred_why = st.message + "; cpu-mesh draws the same picture";
+        }
+        std::fprintf(stderr, "wire: upload path %s (%s)\n", std::string(upload_path_name(*s.preferred)).c_str(),
+                     s.preferred_why.c_str());
+    }
+    return *s.preferred;
+}
+
+const std::string& WireRenderer::preferred_path_reason() {
+    (void)preferred_path();
+    return state_->preferred_why;
+}
 
 Status WireRenderer::read_drawn_rings(std::vector<DrawnRings>& out) const {
     out.clear();

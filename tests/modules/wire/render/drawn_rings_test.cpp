@@ -357,6 +357,43 @@ TEST_F(DrawnRingsTest, FarWiresGetFewerRingsThanNodesWithinTheTolerance) {
     EXPECT_LE(static_cast<double>(gpu_triangles), 1.1 * static_cast<double>(cpu_triangles));
 }
 
+// The default path: a fresh renderer picks the nodes path where the context has compute (llvmpipe has GL 4.5) and
+// says so in one line; with compute missing (forced by WIRE_GL_NO_COMPUTE=1) it picks cpu-mesh, names why, and a
+// frame asked of the nodes path fails with that reason instead of drawing nothing silently.
+TEST_F(DrawnRingsTest, PreferredPathIsNodesWithComputeAndCpuWithout) {
+    ASSERT_EQ(unsetenv("WIRE_GL_NO_COMPUTE"), 0);
+    ::testing::internal::CaptureStderr();
+    EXPECT_EQ(renderer_.preferred_path(), UploadPath::gpu_nodes) << renderer_.preferred_path_reason();
+    EXPECT_EQ(renderer_.preferred_path(), UploadPath::gpu_nodes);  // decided once: logged once
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(log, "wire: upload path nodes (" + renderer_.preferred_path_reason() + ")\n");
+    EXPECT_NE(renderer_.preferred_path_reason().find("compute"), std::string::npos);
+
+    ASSERT_EQ(setenv("WIRE_GL_NO_COMPUTE", "1", 1), 0);
+    auto made = WireRenderer::create();
+    ASSERT_TRUE(made.ok());
+    WireRenderer fallback = std::move(made).value();
+    ::testing::internal::CaptureStderr();
+    const UploadPath chosen = fallback.preferred_path();
+    const std::string fallback_log = ::testing::internal::GetCapturedStderr();
+    ASSERT_EQ(unsetenv("WIRE_GL_NO_COMPUTE"), 0);
+    EXPECT_EQ(chosen, UploadPath::cpu_mesh);
+    EXPECT_NE(fallback_log.find("wire: upload path cpu (the nodes path cannot be used: compute shaders disabled"),
+              std::string::npos)
+        << fallback_log;
+    const FamilyWire w = family_wire(3);
+    DrawItem item;
+    item.wire_id = 9;
+    item.nodes = &w.nodes;
+    item.spline = w.spline;
+    item.nodes_generation = 1;
+    ctx_->begin_frame();
+    const wire::render::DrawStats st = fallback.draw(DrawList{.path = UploadPath::gpu_nodes, .items = {item}}, w.camera, {});
+    ctx_->end_frame();
+    EXPECT_FALSE(st.status.ok());
+    EXPECT_NE(st.status.message.find("WIRE_GL_NO_COMPUTE"), std::string::npos) << st.status.message;
+}
+
 // The read-back names why it has nothing: nothing drawn yet, or the last draw was on a path that builds its rings on
 // the CPU.
 TEST_F(DrawnRingsTest, ReadBackRefusesOtherPathsNamingTheReason) {

@@ -21,13 +21,14 @@
 // Precision: float arithmetic on the segments' difference form (GpuCurvePass keeps b0 and the differences of the
 // control points), so derivatives, chords between rings and arc lengths keep float precision relative to a
 // segment, not to the wire's extent; centres are float offsets from the wire's origin (as the CPU's Ring).
-// The counts: the caller's (place_rings' rule), or the screen-space LOD's (wire/lod.hpp's per-segment evaluation
-// at node resolution: Wang's count at each segment's nearest hull depth and off-axis factor, coarse off-screen
-// segments, the side count, strips and lines, hysteresis on counts and sides kept on the GPU between builds of the
-// same wires). A wire's rings get a range of the ring buffer by an atomic counter (no scan).
+// The counts: the caller's (place_rings' rule), or the screen-space LOD's (wire/lod.hpp's per-segment evaluation:
+// Wang's count at each segment's nearest hull depth and off-axis factor, coarse off-screen segments, the side count,
+// strips and lines, hysteresis on counts and sides kept on the GPU between builds of the same wires; below the node
+// resolution unless LodSettings::keep_node_resolution, the span hierarchy built per wire as the segments are
+// visited and decided as update_lod decides it). A wire's rings get a range of the ring buffer by an atomic counter (no scan).
 // The renderer's nodes path (src/node_path.cpp) runs the same program in stages (LOD, the indirect commands, the
 // rings with their draw and chunk records) and draws a wire that does not fit the ring buffer with one ring a
-// segment from a reserve. Not here: LOD below node resolution (the CPU's spans).
+// segment from a reserve.
 #pragma once
 
 #include "wire/lod.hpp"
@@ -63,8 +64,8 @@ inline constexpr uint32_t kMaxSides = 256;
 /// The LOD a build evaluates on the GPU.
 struct GpuLodFrame {
     LodView view{};
-    /// keep_node_resolution must be true (spans are not on the GPU yet: build() refuses otherwise).
-    LodSettings settings{.keep_node_resolution = true};
+    /// As update_lod reads them (keep_node_resolution off: spans below the node resolution).
+    LodSettings settings{};
     /// Ring records the build may write; 0: every segment at max_rings_per_segment (always enough). A wire that
     /// does not fit is not written (GpuRingResult::overflow).
     std::size_t ring_capacity = 0;

@@ -36,6 +36,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -93,9 +94,9 @@ struct DrawSettings {
     /// predate the double camera). Offsets origin_m - eye are computed in double and sent as float, and the view
     /// is Camera::clip_from_relative(), so wires far from the world origin keep their precision.
     std::optional<glm::dvec3> eye_m{};
-    /// gpu-nodes: the LOD the GPU evaluates this frame (pass the systems' WireContext::lod); at node resolution
-    /// (keep_node_resolution is implied); max_sides above 256 is taken as 256. A wire's own most sides is
-    /// DrawItem::sides.
+    /// gpu-nodes: the LOD the GPU evaluates this frame (pass the systems' WireContext::lod), as update_lod reads it
+    /// (spans below the node resolution unless keep_node_resolution); max_sides above 256 is taken as 256. A wire's
+    /// own most sides is DrawItem::sides.
     LodSettings node_lod{};
 };
 
@@ -115,7 +116,8 @@ struct DrawStats {
     std::size_t wires_coarse = 0;
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
     std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
-    std::size_t triangles = 0;          ///< triangles drawn
+    /// Triangles drawn; gpu-nodes: as the GPU counted them, read back 3 frames late (0 until then).
+    std::size_t triangles = 0;
     /// Draw commands issued (indirect commands of the multi-draws): cpu-mesh one per (class, material) in use;
     /// gpu-rings one per (class, material, side count, chunk kind) in use (wire::render::draw_commands). Does
     /// not grow with the number of wires.
@@ -175,6 +177,16 @@ public:
     /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
     DrawStats draw(const DrawList& list, const engine::scene::Camera& camera,
                     const DrawSettings& settings = {});
+
+    /// The upload path to draw with on this context: gpu_nodes where it has what the nodes path needs (compute
+    /// shaders and multi-draw indirect: GL 4.3 or their extensions; the storage block limits its programs use;
+    /// programs that build), cpu_mesh otherwise (the portable reference: the same picture). Decided on the first
+    /// call (it makes the nodes path), logged once to stderr as one line, "wire: upload path nodes (GL 4.5 compute
+    /// on ...)" or "wire: upload path cpu (why)". Runtimes call it once at start and give it to
+    /// wire::systems::WireContext::path. WIRE_GL_NO_COMPUTE=1 in the environment forces the fallback.
+    [[nodiscard]] UploadPath preferred_path();
+    /// Why preferred_path() chose as it did (the logged line's parenthesis).
+    [[nodiscard]] const std::string& preferred_path_reason();
 
     /// gpu-nodes: the rings of every wire the last draw() drew (wires culled on the GPU are absent), in the order
     /// the GPU dispatched them; waits for the GPU. Fails, naming the reason, when the last draw() was on another
