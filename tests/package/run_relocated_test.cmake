@@ -98,7 +98,7 @@ if(PYTHON AND PYTHON_MODULE_DIR)
   run("import wires from the moved prefix" "${PYTHON}" -c
       "import numpy as np, wires\nassert wires.__file__.startswith('${prefix}/'), wires.__file__\nrt = wires.Runtime(160, 90)\nw = rt.spawn(np.array([[-1.0, 0, 0], [0, -0.3, 0], [1, 0, 0]]), radius=0.05)\nrt.set_camera((0, 0, 4), (0, 0, 0))\nrt.update()\nimg = rt.render()\nassert img.shape == (90, 160, 4) and (img[..., :3].max(axis=2) > 60).any()\nprint('wires', wires.__version__, wires.__file__)")
   message(STATUS "${last_output}")
-  if(EXPECTED_VERSION AND NOT last_output MATCHES "^wires ${EXPECTED_VERSION} ")
+  if(EXPECTED_VERSION AND NOT last_output MATCHES "(^|\n)wires ${EXPECTED_VERSION} ")
     message(FATAL_ERROR "relocated test: wires.__version__ is not ${EXPECTED_VERSION}: ${last_output}")
   endif()
 endif()
