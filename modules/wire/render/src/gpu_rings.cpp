@@ -74,7 +74,9 @@ uniform float u_focal, u_tan_x, u_tan_y, u_near, u_far, u_eps, u_band, u_strip_p
 uniform uint u_max_rings, u_max_sides;  // u_max_sides <= kMaxSides
 uniform bool u_coarse;
 uniform bool u_merge;  // spans below node resolution (LodSettings::keep_node_resolution off)
-uniform float u_sagitta[257];  // 1 - cos(pi / n), n <= 256
+// 1 - cos(pi / n) at [n >> 2][n & 3], n <= 256: vec4s, so a compiler that gives each element of a uniform array a
+// vec4 slot needs 260 components, not 1028 (of the 1024 GL_MAX_COMPUTE_UNIFORM_COMPONENTS guarantees).
+uniform vec4 u_sagitta4[65];
 
 const float kPi = 3.14159265358979;
 const float kSplitCos = 0.70710678;  // a step turning more than 45 degrees is split
@@ -325,7 +327,7 @@ uint sides_for_radius(float radius, float z, float k, uint max_sides) {
     float x = u_eps / r_px;
     if (x >= 0.5) return 3u;
     for (uint n = 4u; n < max_sides; ++n) {
-        if (x >= u_sagitta[n]) return n;
+        if (x >= u_sagitta4[n >> 2u][n & 3u]) return n;
     }
     return max_sides;
 }
@@ -835,12 +837,13 @@ void set_lod_uniforms(const engine::gfx::Program& program, const LodView& v, con
     glUniform1ui(at("u_max_sides"), std::clamp<uint32_t>(st.max_sides ? st.max_sides : 32u, 3u, kMaxSides));
     glUniform1i(at("u_coarse"), st.coarse_offscreen_segments ? 1 : 0);
     glUniform1i(at("u_merge"), st.keep_node_resolution ? 0 : 1);
-    static const std::array<float, kMaxSides + 1> sagitta = [] {
-        std::array<float, kMaxSides + 1> t{};
+    static_assert(kMaxSides + 1 <= 4 * 65, "u_sagitta4 holds n = 0 .. kMaxSides");
+    static const std::array<float, 4 * 65> sagitta = [] {
+        std::array<float, 4 * 65> t{};
         for (uint32_t n = 3; n <= kMaxSides; ++n) t[n] = static_cast<float>(1.0 - std::cos(std::numbers::pi / n));
         return t;
     }();
-    glUniform1fv(at("u_sagitta"), static_cast<GLsizei>(sagitta.size()), sagitta.data());
+    glUniform4fv(at("u_sagitta4"), 65, sagitta.data());
 }
 
 const char* ring_source() { return kRingSource; }

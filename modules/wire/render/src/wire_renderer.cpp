@@ -342,6 +342,20 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     if (!rings) return rings.error();
     s.cpu_program = std::move(cpu).value();
     s.rings_program = std::move(rings).value();
+    // Both vertex shaders read shader storage blocks (the cpu-mesh one its draw records; the rings one draws,
+    // rings, chunks and the side table), which GL 4.3 lets a driver refuse in the vertex stage (its minimum of
+    // GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS is 0): said by name at create, never a failed draw.
+    GLint vertex_blocks = 0;
+    glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &vertex_blocks);
+    for (const auto& [program, label] : {std::pair{&s.cpu_program, "wire cpu-mesh"}, std::pair{&s.rings_program, "wire gpu-rings"}}) {
+        GLint blocks = 0;
+        glGetProgramInterfaceiv(program->id(), GL_SHADER_STORAGE_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
+        if (blocks > vertex_blocks) {
+            return Error{std::string(label) + ": its vertex shader reads " + std::to_string(blocks) +
+                         " shader storage blocks, the driver allows " + std::to_string(vertex_blocks) +
+                         " (GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS)"};
+        }
+    }
 
     // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 and the vertex's draw index at binding 1
     // (both streamed, set per frame); the gpu-rings one reads the chunk index at binding 1 (instanced, from the

@@ -73,6 +73,35 @@ TEST(ShaderResources, StorageBlocksFitEveryDesktopDriver) {
     }
 }
 
+// The default uniform block of the compute programs within GL_MAX_COMPUTE_UNIFORM_COMPONENTS' minimum (1024),
+// counted as a compiler that gives every scalar, vector and array element its own vec4 slot would (a mat3 three,
+// a dvec3 two): a float[257] table came to 1028 on its own.
+TEST(ShaderResources, DefaultUniformBlocksFitTheMinimumWithVec4Slots) {
+    const std::map<std::string, int> slots = {{"float", 1}, {"int", 1}, {"uint", 1}, {"bool", 1}, {"vec2", 1},
+                                              {"vec3", 1}, {"vec4", 1}, {"uvec4", 1}, {"mat3", 3}, {"mat4", 4},
+                                              {"dvec3", 2}, {"double", 1}};
+    for (const auto& [name, source] : {std::pair{"curves", with_wire_header(curve_source())},
+                                       std::pair{"rings", with_wire_header(ring_source())}}) {
+        const std::regex uniform(R"((?:^|\n)[ \t]*uniform\s+(\w+)\s+([^;]+);)");  // declarations, not comments
+        int components = 0, declared = 0;
+        for (auto it = std::sregex_iterator(source.begin(), source.end(), uniform); it != std::sregex_iterator(); ++it) {
+            const std::string type = (*it)[1];
+            ASSERT_TRUE(slots.count(type)) << name << ": uniform type " << type << " not counted";
+            // A comma-separated list of names, each maybe an array.
+            const std::string names = (*it)[2];
+            const std::regex one(R"((\w+)\s*(\[(\d+)\])?)");
+            for (auto n = std::sregex_iterator(names.begin(), names.end(), one); n != std::sregex_iterator(); ++n) {
+                const int count = (*n)[3].matched ? std::stoi((*n)[3]) : 1;
+                components += 4 * slots.at(type) * count;
+                ++declared;
+            }
+        }
+        EXPECT_GT(declared, 0) << name;
+        EXPECT_LE(components, 1024) << name << ": default-block uniforms over the minimum with vec4 slots";
+        std::printf("%s: %d uniforms, %d components with a vec4 slot each\n", name, declared, components);
+    }
+}
+
 TEST(ShaderResources, BindingMacrosAreDistinctWithinEachProgram) {
     std::set<std::string> names;
     std::set<uint32_t> curve, ring;
