@@ -306,7 +306,6 @@ public:
         const auto t0 = std::chrono::steady_clock::now();
         wire::render::DrawSettings settings;
         settings.light = light_;
-        settings.node_lod = ctx_.lod;
         drawn_ = renderer_.draw(ctx_.draw_list, ctx_.camera, settings);
         gpu_rings_read_ = false;
         rendered_ = true;

@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
         schedule.run(registry, opt.dt_s);  // wire systems -> wires.draw_list
 
         ctx.begin_frame();
-        view->draw(scene, wires.draw_list, wires.camera, wires.lod);
+        view->draw(scene, wires.draw_list, wires.camera);
         const bool last = frames != 0 && frame + 1 == frames;
         const bool capture = (opt.capture_every > 0 && frame % opt.capture_every == 0) ||
                              (last && (ctx.headless() || opt.capture_every > 0)) ||

@@ -221,15 +221,14 @@ engine::Expected<RopeView> RopeView::create(const RopeScene& scene) {
     return view;
 }
 
-void RopeView::draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera,
-                    const wire::LodSettings& lod) {
+void RopeView::draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera) {
     (void)scene;
     engine::gfx::clear(glm::vec4(kBackground, 1.0f));
     const engine::gfx::DirectionalLight light{.to_light = {0.4f, 1.0f, 0.6f}, .ambient = 0.35f};
     lit_.begin(camera.view_projection(), light);  // floor and box sit near the origin
     lit_.draw(floor_, glm::mat4(1.0f), kFloorAlbedo);
     lit_.draw(box_, box_model_, kBoxAlbedo);
-    wires_->draw(list, camera, {.light = {.to_light = {0.4f, 1.0f, 0.6f}, .ambient = 0.35f}, .node_lod = lod});
+    wires_->draw(list, camera, {.light = {.to_light = {0.4f, 1.0f, 0.6f}, .ambient = 0.35f}});
 }
 
 engine::scene::Camera default_camera(int width_px, int height_px) {

@@ -84,9 +84,8 @@ public:
     static engine::Expected<RopeView> create(const RopeScene& scene);
 
     /// Clears, draws the floor and the box, then the wires of `list`.
-    /// `lod`: the wire systems' LOD settings (the nodes path evaluates them on the GPU).
-    void draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera,
-              const wire::LodSettings& lod = {});
+    /// The list carries the wire systems' LOD (the nodes path evaluates it on the GPU).
+    void draw(const RopeScene& scene, const wire::DrawList& list, const engine::scene::Camera& camera);
 
     /// The wire renderer's preferred upload path (nodes where the context has compute; logged once).
     [[nodiscard]] wire::UploadPath preferred_path() { return wires_->preferred_path(); }

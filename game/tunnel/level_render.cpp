@@ -85,7 +85,6 @@ void Level::draw_wires() {
             wire::render::DrawSettings settings;
             settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
             settings.wireframe = options_.wireframe;
-            settings.node_lod = s.context.lod;  // the nodes path evaluates the LOD on the GPU
             s.wire_stats = s.wires.draw(s.context.draw_list, camera_, settings);
         }
     }

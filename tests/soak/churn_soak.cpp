@@ -614,7 +614,6 @@ int Soak::run() {
         context->begin_frame();
         engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
         wire::render::DrawSettings draw_settings;
-        draw_settings.node_lod = context_.lod;
         const wire::render::DrawStats fs = renderer_->draw(context_.draw_list, context_.camera, draw_settings);
         context->end_frame();
         render_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();

@@ -331,7 +331,6 @@ int run_view(const ViewOptions& o) try {
     schedule.add("wire.render", [&](engine::ecs::Registry&, const engine::ecs::FrameContext&) {
         wire::render::DrawSettings settings;
         settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
-        settings.node_lod = ctx.lod;
         drawn = renderer.draw(ctx.draw_list, ctx.camera, settings);
         if (!drawn.status.ok()) throw Failure{exit_failure, "the wire renderer could not draw: " + drawn.status.message};
     });

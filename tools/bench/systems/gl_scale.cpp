@@ -208,7 +208,6 @@ public:
             const double t0 = wall_ms();
             row.f.timer.begin();
             wire::render::DrawSettings settings;
-            settings.node_lod = ctx.lod;
             const wire::render::DrawStats st = renderer.draw(*list, ctx.camera, settings);
             row.f.timer.end();
             const double t1 = wall_ms();

@@ -3,6 +3,7 @@
 // stay valid until the next frame's systems run.
 #pragma once
 
+#include "wire/lod.hpp"
 #include "wire/nodes.hpp"
 #include "wire/packed_nodes.hpp"
 #include "wire/packed_ring.hpp"
@@ -101,6 +102,9 @@ struct DrawItem {
 struct DrawList {
     UploadPath path = UploadPath::cpu_mesh;  ///< which of the item's arrays are filled
     std::vector<DrawItem> items;             ///< the visible wires, in entity order
+    /// The LOD the systems evaluated this frame (wire::systems::WireContext::lod, set by the draw-list stage): the
+    /// nodes path evaluates the same settings on the GPU, so no setting is copied by hand.
+    LodSettings lod{};
 };
 
 }  // namespace wire

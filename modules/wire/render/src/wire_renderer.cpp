@@ -186,7 +186,7 @@ struct WireRenderer::State {
     DrawStats draw_nodes(const DrawList& list, const engine::scene::Camera& camera, const DrawSettings& settings) {
         DrawStats stats;
         if (Status st = ensure_nodes(); !st) return failed(stats, st);
-        nodes->set_lod(settings.node_lod);
+        nodes->set_lod(list.lod);  // the systems' LOD, evaluated on the GPU
         if (Status st = ensure_patterns(nodes->max_sides()); !st) return failed(stats, st);
         const std::size_t bytes = nodes->upload_bytes(list);
         Expected<StreamRegion> begun = stream.begin(bytes);

@@ -764,6 +764,7 @@ void mesh_system(Registry& registry, WireContext& ctx) {
 void draw_list_system(Registry& registry, WireContext& ctx) {
     DrawList& list = ctx.draw_list;
     list.path = ctx.path;
+    list.lod = ctx.lod;
     list.items.clear();
 
     std::vector<Entity>& visible = reused<Entity, 1>();

@@ -184,7 +184,7 @@ protected:
 TEST_F(DrawnRingsTest, NodesPathRingsMatchTheCpuReferenceOverRandomFamilies) {
     constexpr uint32_t kWires = 96;
     DrawSettings settings;
-    settings.node_lod.keep_node_resolution = true;
+    const wire::LodSettings node_lod{.keep_node_resolution = true};
     std::vector<double> centre_err, frame_err, radius_err, u_err;
     std::size_t same_counts = 0, compared = 0, zigzag_centre_over = 0;
     double worst_centre = 0.0, worst_frame = 0.0;
@@ -197,7 +197,7 @@ TEST_F(DrawnRingsTest, NodesPathRingsMatchTheCpuReferenceOverRandomFamilies) {
                                                               w.camera.fov_y_rad, kWidth, kHeight, w.camera.near_m,
                                                               w.camera.far_m);
         wire::WireLod lod;
-        wire::update_lod(curve, view, settings.node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
+        wire::update_lod(curve, view, node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
         ASSERT_TRUE(lod.visible) << w.name;
         std::vector<wire::RingParam> params;
         wire::place_rings(curve, lod.counts, params);
@@ -210,7 +210,7 @@ TEST_F(DrawnRingsTest, NodesPathRingsMatchTheCpuReferenceOverRandomFamilies) {
         item.spline = w.spline;
         item.nodes_generation = 1;
         item.sides = 32;
-        DrawList list{.path = UploadPath::gpu_nodes, .items = {item}};
+        DrawList list{.path = UploadPath::gpu_nodes, .items = {item}, .lod = node_lod};
         const wire::render::DrawStats stats = draw(list, w.camera, settings);
         ASSERT_TRUE(stats.status.ok()) << stats.status.message;
         std::vector<DrawnRings> drawn;
@@ -305,7 +305,7 @@ TEST_F(DrawnRingsTest, TheNodesPathDrawsCpuMeshsPictureOverRandomFamilies) {
                                                                   w.camera.fov_y_rad, kWidth, kHeight,
                                                                   w.camera.near_m, w.camera.far_m);
             const auto lod_at = [&](double tolerance_px) {
-                wire::LodSettings ls = settings.node_lod;
+                wire::LodSettings ls{};  // the default LOD, as the lists below carry it
                 ls.tolerance_px = tolerance_px;
                 wire::WireLod lod;
                 wire::update_lod(curve, view, ls, lod, static_cast<const wire::BoundingSphere*>(nullptr));
@@ -420,7 +420,7 @@ TEST_F(DrawnRingsTest, TheNodesPathDrawsCpuMeshsPictureOverRandomFamilies) {
 // DrawStats::triangles, read back 3 frames late, counts what the frame drew.
 TEST_F(DrawnRingsTest, FarWiresGetFewerRingsThanNodesWithinTheTolerance) {
     constexpr uint32_t kWires = 96;
-    DrawSettings settings;  // node_lod: the defaults (0.5 px, spans below the node resolution)
+    DrawSettings settings;  // the lists carry the default LOD (0.5 px, spans below the node resolution)
     std::vector<double> screen_ratio;
     std::size_t gpu_triangles = 0, cpu_triangles = 0, rings_drawn = 0, nodes_total = 0, same = 0, counted = 0;
     double worst = 0.0;
@@ -445,7 +445,7 @@ TEST_F(DrawnRingsTest, FarWiresGetFewerRingsThanNodesWithinTheTolerance) {
                                                               w.camera.fov_y_rad, kWidth, kHeight, w.camera.near_m,
                                                               w.camera.far_m);
         wire::WireLod lod;
-        wire::update_lod(curve, view, settings.node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
+        wire::update_lod(curve, view, wire::LodSettings{}, lod, static_cast<const wire::BoundingSphere*>(nullptr));
         if (!lod.visible) continue;
         std::vector<wire::RingParam> cpu_params;
         wire::place_rings(curve, lod.counts, cpu_params);

@@ -498,8 +498,8 @@ TEST(WireRendererTest, GpuNodesRingOverflowDrawsCoarseNotMissing) {
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
     const Scene scene = test_scene();
     DrawSettings settings;
-    settings.node_lod = {.tolerance_px = 0.0002, .max_rings_per_segment = 1024, .keep_node_resolution = true};
     DrawList gpu{.path = UploadPath::gpu_nodes, .items = {}};
+    gpu.lod = {.tolerance_px = 0.0002, .max_rings_per_segment = 1024, .keep_node_resolution = true};
     for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
         DrawItem item;
         item.wire_id = 700000 + i;
@@ -540,7 +540,7 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
     ASSERT_NE(ctx, nullptr);
     WireRenderer renderer = make_renderer();
     DrawSettings node_settings;
-    node_settings.node_lod.keep_node_resolution = true;
+    const wire::LodSettings node_lod{.keep_node_resolution = true};
     const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
     const Scene scene = test_scene();
     const std::vector<NamedView> views = test_views();
@@ -552,14 +552,14 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
                                                                   kHeight, view.camera.near_m, view.camera.far_m);
         std::vector<wire::RingSet> sets(scene.nodes.size());
         DrawList cpu{.path = UploadPath::gpu_rings, .items = {}};
-        DrawList gpu{.path = UploadPath::gpu_nodes, .items = {}};
+        DrawList gpu{.path = UploadPath::gpu_nodes, .items = {}, .lod = node_lod};
         ++id;
         for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
             const wire::SplineSettings& spline = scene.settings[i].spline;
             wire::Curve curve;
             ASSERT_TRUE(wire::build_curve(scene.nodes[i], spline, curve).ok());
             wire::WireLod lod;
-            wire::update_lod(curve, lod_view, node_settings.node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
+            wire::update_lod(curve, lod_view, node_lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
             ASSERT_TRUE(lod.visible);
             std::vector<wire::RingParam> params;
             wire::place_rings(curve, lod.counts, params);

@@ -94,10 +94,6 @@ struct DrawSettings {
     /// predate the double camera). Offsets origin_m - eye are computed in double and sent as float, and the view
     /// is Camera::clip_from_relative(), so wires far from the world origin keep their precision.
     std::optional<glm::dvec3> eye_m{};
-    /// gpu-nodes: the LOD the GPU evaluates this frame (pass the systems' WireContext::lod), as update_lod reads it
-    /// (spans below the node resolution unless keep_node_resolution); max_sides above 256 is taken as 256. A wire's
-    /// own most sides is DrawItem::sides.
-    LodSettings node_lod{};
 };
 
 /// What one draw() did.
