@@ -67,14 +67,14 @@ if(PYTHON_MODULE_DIR)
 endif()
 file(GLOB_RECURSE installed "${prefix}/*")
 # Test support (modules/wire/testing: random families, exact references) is never installed: no header, and no
-# symbol of it in any installed library (wire::families, wire::testing, the Catenary reference, the remedy family,
+# symbol of it in any installed library (wire::families, wire::testing, the Catenary reference, the pop-free family,
 # the curve stage's test hooks wire::detail::spread_test and node_segment_records).
 foreach(f IN LISTS installed)
   if(f MATCHES "/include/wire/testing/")
     message(FATAL_ERROR "package test: test-support header installed: ${f}")
   endif()
   if(f MATCHES "\\.(a|so)$")
-    file(STRINGS "${f}" support REGEX "wire8families|wire7testing|8Catenary|RemedyFamily|11spread_test|20node_segment_records")
+    file(STRINGS "${f}" support REGEX "wire8families|wire7testing|8Catenary|PopFreeFamily|13PopFreeEvent|11spread_test|20node_segment_records")
     if(support)
       list(GET support 0 first)
       message(FATAL_ERROR "package test: ${f} holds test-support code: ${first}")
