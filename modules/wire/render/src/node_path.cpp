@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <optional>
 #include <cstring>
 #include <string>
 #include <tuple>
@@ -145,35 +146,19 @@ Status NodePath::grow_segments(std::size_t segments) {
 }
 
 bool NodePath::allocate_segments(uint32_t count, uint32_t& first) {
-    for (std::size_t i = 0; i < free_ranges_.size(); ++i) {
-        auto& [f, c] = free_ranges_[i];
-        if (c < count) continue;
-        first = f;
-        f += count, c -= count;
-        if (c == 0) free_ranges_.erase(free_ranges_.begin() + static_cast<std::ptrdiff_t>(i));
-        return true;
+    std::optional<std::size_t> at = segment_ranges_.allocate(count);
+    if (!at) {
+        // No free range holds it: the storage grows (at least by the count), the new space joins the free list.
+        if (!grow_segments(segment_capacity_ + std::size_t{count})) return false;
+        segment_ranges_.grow(segment_capacity_);
+        at = segment_ranges_.allocate(count);
+        if (!at) return false;
     }
-    if (segment_top_ + std::size_t{count} > segment_capacity_ && !grow_segments(segment_top_ + std::size_t{count})) {
-        return false;
-    }
-    first = segment_top_;
-    segment_top_ += count;
+    first = static_cast<uint32_t>(*at);
     return true;
 }
-
 void NodePath::free_segments(uint32_t first, uint32_t count) {
-    if (count == 0) return;
-    auto at = std::lower_bound(free_ranges_.begin(), free_ranges_.end(), std::pair<uint32_t, uint32_t>{first, 0});
-    at = free_ranges_.insert(at, {first, count});
-    // Coalesce with the neighbours.
-    if (at + 1 != free_ranges_.end() && at->first + at->second == (at + 1)->first) {
-        at->second += (at + 1)->second;
-        free_ranges_.erase(at + 1);
-    }
-    if (at != free_ranges_.begin() && (at - 1)->first + (at - 1)->second == at->first) {
-        (at - 1)->second += at->second;
-        free_ranges_.erase(at);
-    }
+    if (count != 0) segment_ranges_.free(first, count);
 }
 
 std::size_t NodePath::upload_bytes(const DrawList& list) {

@@ -10,6 +10,7 @@
 #include "wire/lod.hpp"
 #include "wire/render/wire_renderer.hpp"
 
+#include "engine/gfx/range_allocator.hpp"
 #include "engine/gfx/resources.hpp"
 #include "engine/gfx/stream_buffer.hpp"
 #include "engine/scene/camera.hpp"
@@ -87,8 +88,7 @@ private:
     uint64_t frame_ = 0;
     std::unordered_map<uint64_t, Slot> slots_;
     std::vector<uint32_t> free_slots_;
-    std::vector<std::pair<uint32_t, uint32_t>> free_ranges_;  ///< (first, count), sorted by first
-    uint32_t segment_top_ = 0;                                 ///< segments in use or freed below this
+    engine::gfx::RangeAllocator segment_ranges_{0, 1};  ///< the segment storage's ranges, in segments
     // Persistent (GPU only).
     engine::gfx::Buffer slot_headers_, slot_state_, motion_refs_, segments_, counts_;
     std::size_t slot_capacity_ = 0, segment_capacity_ = 0;
