@@ -248,7 +248,9 @@ TEST(TunnelSystem, StatsFiniteAndPlausible) {
         EXPECT_LE(s.wires_drawn, s.wires);
         if (level->options().upload_path == wire::UploadPath::gpu_nodes) {
             // The GPU counts what it drew: triangles, read back 3 frames late.
-            if (f >= 3) EXPECT_GT(s.wire_triangles, 1000u);
+            if (f >= 3) {
+                EXPECT_GT(s.wire_triangles, 1000u);
+            }
         } else {
             EXPECT_GT(s.wire_vertices, 1000u);
         }
