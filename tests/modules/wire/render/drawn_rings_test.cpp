@@ -148,6 +148,14 @@ FamilyWire family_wire(uint32_t seed) {
     return w;
 }
 
+/// The wire's camera moved `factor` times as far from its target along the line of sight, its clip planes with it.
+void pull_back(FamilyWire& w, double factor) {
+    w.camera.position = w.camera.target + factor * (w.camera.position - w.camera.target);
+    const double away = glm::length(w.camera.position - w.camera.target);
+    w.camera.near_m = static_cast<float>(0.05 * away);
+    w.camera.far_m = static_cast<float>(4.0 * away);
+}
+
 /// The angle between two unit vectors, well conditioned near 0 (acos of the dot is not: a float-rounded unit
 /// vector would read as 3e-4 rad off).
 double angle(const glm::dvec3& a, const glm::dvec3& b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); }
@@ -293,11 +301,7 @@ TEST_F(DrawnRingsTest, TheNodesPathDrawsCpuMeshsPictureOverRandomFamilies) {
             FamilyWire w = family_wire(seed);
             if (pull == 0.0) {  // pulled back to 4-12 spans
                 std::mt19937 rng(seed * 104729u);
-                const double factor = 2.0 + 4.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
-                w.camera.position = w.camera.target + factor * (w.camera.position - w.camera.target);
-                const double away = glm::length(w.camera.position - w.camera.target);
-                w.camera.near_m = static_cast<float>(0.05 * away);
-                w.camera.far_m = static_cast<float>(4.0 * away);
+                pull_back(w, 2.0 + 4.0 * std::uniform_real_distribution<double>(0.0, 1.0)(rng));
             }
             wire::Curve curve;
             ASSERT_TRUE(wire::build_curve(w.nodes, w.spline, curve).ok()) << w.name;
@@ -435,10 +439,7 @@ TEST_F(DrawnRingsTest, FarWiresGetFewerRingsThanNodesWithinTheTolerance) {
         // Pulled back along the line of sight: 4-150 spans away.
         std::mt19937 rng(seed * 7919u);
         const double factor = std::exp(std::log(2.0) + std::uniform_real_distribution<double>(0.0, 1.0)(rng) * std::log(40.0));
-        w.camera.position = w.camera.target + factor * (w.camera.position - w.camera.target);
-        const double away = glm::length(w.camera.position - w.camera.target);
-        w.camera.near_m = static_cast<float>(0.05 * away);
-        w.camera.far_m = static_cast<float>(4.0 * away);
+        pull_back(w, factor);
         wire::Curve curve;
         ASSERT_TRUE(wire::build_curve(w.nodes, w.spline, curve).ok()) << w.name;
         const wire::LodView view = wire::LodView::perspective(w.camera.position, w.camera.target, w.camera.up,
