@@ -36,7 +36,11 @@ layout(std430, binding = CURVE_SLOT_HEADERS) writeonly buffer SlotHeaders { Head
 // p[k].xyz the sample's offset from the origin, p[k].w its weight).
 struct MotionRef { vec4 origin; uvec4 counts; vec4 p[10]; };
 layout(std430, binding = CURVE_MOTION_REFS) buffer MotionRefs { MotionRef refs[]; };
+// u_list: each wire's slot goes to slot_list[u_list_first + w] (the ring pass's list of this frame's wires).
+layout(std430, binding = CURVE_SLOT_LIST) writeonly buffer SlotList { uint slot_list[]; };
 uniform uint u_wires;
+uniform bool u_list;
+uniform uint u_list_first;
 uniform bool u_persist;
 uniform bool u_motion;
 
@@ -404,6 +408,7 @@ void main() {
     uint w = gl_GlobalInvocationID.x;
     if (w >= u_wires) return;
     Header h = headers[w];
+    if (u_list) slot_list[u_list_first + w] = h.slot;
     if (u_persist && u_motion) {
         // This upload's reference (none for given segments) and, when asked, the motion fitted against the last.
         MotionRef to;
@@ -642,8 +647,11 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     // Slot w is wire w: the headers go back onto themselves (with the motion the GPU fitted), the references stay.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveSlotHeaders, headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveMotionRefs, motion_refs_.id());
+    // No slot list here (u_list off); something is bound all the same, as some drivers check every block's binding.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kCurveSlotList, scratch_.id());
     program_.use();
     glUniform1ui(program_.uniform_location("u_wires"), static_cast<GLuint>(wires.size()));
+    glUniform1i(program_.uniform_location("u_list"), 0);
     glUniform1i(program_.uniform_location("u_persist"), 1);
     glUniform1i(program_.uniform_location("u_motion"), 1);
     glDispatchCompute(static_cast<GLuint>((wires.size() + 63) / 64), 1, 1);

@@ -48,10 +48,9 @@ layout(std430, binding = RING_SLOTS) buffer Slots { SlotState slot_state[]; };
 layout(std430, binding = RING_COUNTER) buffer Counter {
     uint ring_counter; uint overflow; uint reserve_counter; uint triangles;
 };
-// The slot of each dispatched wire: the first u_changed are this frame's curve headers' (their nodes changed), the
-// others listed.
+// The slot of each dispatched wire: the first u_unchanged were listed by the CPU (their nodes did not change), the
+// others by this frame's curve passes (their nodes changed: CURVE_SLOT_LIST).
 layout(std430, binding = RING_VISIBLE) readonly buffer Visible { uint visible[]; };
-layout(std430, binding = RING_FRAME_HEADERS) readonly buffer FrameHeaders { Header frame_headers[]; };
 // u_draw: the single draw's records (wire::render's GpuDraw, the chunk records and the indirect commands).
 struct Draw { vec3 offset_m; uint ring_first; uint ring_count; uint sides; uint flags; float u_close; };
 layout(std430, binding = RING_DRAWS) writeonly buffer Draws { Draw draws[]; };
@@ -60,7 +59,7 @@ layout(std430, binding = RING_BUCKETS) buffer Buckets { uint buckets[]; };  // u
 layout(std430, binding = RING_COMMANDS) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
 layout(std430, binding = RING_TEMPLATES) readonly buffer Templates { uvec2 templates[]; };  // (count, first index) per side slot and kind
 uniform uint u_wires;
-uniform uint u_changed;
+uniform uint u_unchanged;
 uniform uint u_ring_capacity;
 uniform uint u_ring_reserve;
 uniform uint u_stage;  // 0: LOD (or the caller's counts) and rings; 1: LOD only; 2: the commands; 3: rings only
@@ -698,7 +697,7 @@ void main() {
         return;
     }
     if (w >= u_wires) return;
-    uint slot = w < u_changed ? frame_headers[w].slot : visible[w - u_changed];
+    uint slot = visible[w];
     load_wire(slot);
     uint material = H.flags >> 16u;
     bool caps = (H.flags & kCaps) != 0u;
@@ -706,7 +705,7 @@ void main() {
     uint n = CLOSED ? 0u : 1u;
     float radius_px = 0.0;
     uint drawn = 0u;
-    if (u_stage != 3u && w < u_changed) {
+    if (u_stage != 3u && w >= u_unchanged) {
         // Nodes that changed: the slot's last first normal turned by the wire's motion since (the header's
         // rotation: fitted by the curve pass, or by the CPU on id events and blends), as the CPU path's
         // carried_frames turns its own. Culled or not, so the next
@@ -954,13 +953,12 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingSlots, state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingCounter, counter_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingVisible, visible_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingFrameHeaders, curves.headers_.id());  // the "changed" wires: all (u_changed)
     program_.use();
     const auto at = [&](const char* name) { return program_.uniform_location(name); };
     glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));
     glUniform1ui(at("u_stage"), 0u);
     // Every wire is "changed" (its header's motion turns its kept first normal) when a job carries the last one.
-    glUniform1ui(at("u_changed"), carry_last ? static_cast<GLuint>(jobs.size()) : 0u);
+    glUniform1ui(at("u_unchanged"), carry_last ? 0u : static_cast<GLuint>(jobs.size()));
     glUniform1i(at("u_draw"), 0);
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1ui(at("u_ring_reserve"), 0u);  // a wire that does not fit is reported (GpuRingResult::overflow)

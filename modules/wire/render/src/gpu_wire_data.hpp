@@ -44,10 +44,10 @@ struct Header {
 /// one number.
 enum CurveBinding : uint32_t {
     kCurveHeaders, kCurveNodes, kCurveSegments, kCurveScratch, kCurveExtras, kCurveSlotHeaders, kCurveMotionRefs,
-    kCurveBindings
+    kCurveSlotList, kCurveBindings
 };
 enum RingBinding : uint32_t {
-    kRingHeaders, kRingFrameHeaders, kRingSegments, kRingJobs, kRingCounts, kRingRings, kRingSlots, kRingCounter,
+    kRingHeaders, kRingSegments, kRingJobs, kRingCounts, kRingRings, kRingSlots, kRingCounter,
     kRingVisible, kRingDraws, kRingChunks, kRingBuckets, kRingCommands, kRingTemplates, kRingBindings
 };
 /// The binding macros with_wire_header() defines: (GLSL name, binding).
@@ -58,7 +58,7 @@ struct BindingMacro {
 inline constexpr BindingMacro kBindingMacros[] = {
     {"CURVE_HEADERS", kCurveHeaders}, {"CURVE_NODES", kCurveNodes}, {"CURVE_SEGMENTS", kCurveSegments},
     {"CURVE_SCRATCH", kCurveScratch}, {"CURVE_EXTRAS", kCurveExtras}, {"CURVE_SLOT_HEADERS", kCurveSlotHeaders},
-    {"CURVE_MOTION_REFS", kCurveMotionRefs}, {"RING_HEADERS", kRingHeaders}, {"RING_FRAME_HEADERS", kRingFrameHeaders},
+    {"CURVE_MOTION_REFS", kCurveMotionRefs}, {"CURVE_SLOT_LIST", kCurveSlotList}, {"RING_HEADERS", kRingHeaders},
     {"RING_SEGMENTS", kRingSegments}, {"RING_JOBS", kRingJobs}, {"RING_COUNTS", kRingCounts},
     {"RING_RINGS", kRingRings}, {"RING_SLOTS", kRingSlots}, {"RING_COUNTER", kRingCounter},
     {"RING_VISIBLE", kRingVisible}, {"RING_DRAWS", kRingDraws}, {"RING_CHUNKS", kRingChunks},

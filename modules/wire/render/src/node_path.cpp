@@ -145,6 +145,25 @@ Status NodePath::grow_segments(std::size_t segments) {
     return Status::success();
 }
 
+std::optional<uint32_t> NodePath::acquire_slot() {
+    uint32_t index = 0;
+    if (free_slots_.empty()) {
+        if (!grow_slots(std::size_t{slot_count_} + 1)) return std::nullopt;
+        index = slot_count_++;
+    } else {
+        index = free_slots_.back();
+        free_slots_.pop_back();
+    }
+    clear_range(slot_state_, index * kSlotStateBytes, kSlotStateBytes);
+    clear_range(motion_refs_, index * kMotionRefBytes, 32);  // no reference: nothing to fit against
+    return index;
+}
+
+void NodePath::release_slot(uint32_t index, uint32_t segment_first, uint32_t segments) {
+    free_segments(segment_first, segments);
+    free_slots_.push_back(index);
+}
+
 bool NodePath::allocate_segments(uint32_t count, uint32_t& first) {
     std::optional<std::size_t> at = segment_ranges_.allocate(count);
     if (!at) {
@@ -193,6 +212,7 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
         extras += 16 * n + 16 * ((n + 3) / 4);
     }
     // prepare()'s layout: each array at least one record (a buffer range of 0 bytes cannot be bound).
+    visible += stream_ != nullptr ? stream_wires() : 0;  // the stream's unchanged wires are listed here too
     return align_up(std::max<std::size_t>(headers, 64)) + align_up(std::max<std::size_t>(nodes, 16)) +
            align_up(std::max<std::size_t>(extras, 16)) + align_up(std::max<std::size_t>(4 * visible, 4)) + kAlign;
 }
@@ -220,7 +240,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     node_pieces_.clear(), extra_pieces_.clear();
     std::size_t node_total = 0, extra_total = 0;  // vec4s in the region's node and extra arrays
     visible_slots_.clear();
-    dispatched_.clear(), listed_.clear();
+    dispatched_.clear(), listed_.clear(), changed_wires_.clear();
     material_used_.assign(ctx.materials.size(), 0);
     std::size_t segments_visible = 0;
     for (std::size_t i = 0; i < list.items.size(); ++i) {
@@ -252,19 +272,12 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             continue;
         }
         if (fresh) {
-            if (free_slots_.empty()) {
-                const auto index = static_cast<uint32_t>(slots_.size() - 1 + free_slots_.size());
-                if (!grow_slots(index + 1)) {
-                    slots_.erase(it);
-                    continue;
-                }
-                slot.index = index;
-            } else {
-                slot.index = free_slots_.back();
-                free_slots_.pop_back();
+            const std::optional<uint32_t> index = acquire_slot();
+            if (!index) {
+                slots_.erase(it);
+                continue;
             }
-            clear_range(slot_state_, slot.index * kSlotStateBytes, kSlotStateBytes);
-            clear_range(motion_refs_, slot.index * kMotionRefBytes, 32);  // no reference: nothing to fit against
+            slot.index = *index;
         }
         slot.last_frame = frame_;
         const bool changed = i < changed_item_.size() && changed_item_[i] != 0;
@@ -324,7 +337,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
             }
             slot.generation = item.nodes_generation;
             slot.built = true;
-            dispatched_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
+            changed_wires_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
         }
         if (!slot.built) continue;
         // The ring pass takes the changed wires' slots from their headers: only the others are listed.
@@ -348,16 +361,24 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         }
     }
     changed_ = up.headers.size();
-    visible_ = changed_ + visible_slots_.size();
-    stats.wires_uploaded = changed_;
-    dispatched_.insert(dispatched_.end(), listed_.begin(), listed_.end());
+    // The streamed wires (node_stream.cpp): their headers into the stream's region, the unchanged ones listed.
+    stream_changed_ = 0;
+    if (stream_ != nullptr) stream_changed_ = emit_stream(ctx.materials.size(), segments_visible, stats);
+    unchanged_ = visible_slots_.size();
+    visible_ = changed_ + stream_changed_ + unchanged_;
+    stats.wires_uploaded = changed_ + stream_changed_;
+    // The ring pass's order: the listed wires, then this frame's curve passes' (the list's, then the stream's).
+    dispatched_ = listed_;
+    dispatched_.insert(dispatched_.end(), changed_wires_.begin(), changed_wires_.end());
+    dispatched_.insert(dispatched_.end(), stream_wires_.begin(), stream_wires_.end());
     if (visible_ == 0) return false;
     // A frame that cannot be computed draws nothing and says why; the wires it would have uploaded stay unbuilt
     // (their slots hold no curve), so the next frame sends them again.
     const auto fail = [&](const Status& why) {
-        for (std::size_t k = 0; k < changed_; ++k) {
-            if (auto it = slots_.find(dispatched_[k].wire_id); it != slots_.end()) it->second.built = false;
+        for (const Dispatched& d : changed_wires_) {
+            if (auto it = slots_.find(d.wire_id); it != slots_.end()) it->second.built = false;
         }
+        if (stream_ != nullptr) unbuild_stream();
         dispatched_.clear();
         stats.wires_skipped += visible_;
         stats.status = Status::error("wire nodes: " + why.message);
@@ -371,6 +392,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     const std::size_t node_bytes = std::max<std::size_t>(real_node_bytes, sizeof(glm::vec4));
     const std::size_t extra_bytes = std::max<std::size_t>(real_extra_bytes, sizeof(glm::vec4));
     const std::size_t visible_bytes = std::max<std::size_t>(visible_slots_.size() * 4, 4);
+    const std::size_t list_bytes = std::max<std::size_t>(visible_ * 4, 4);  // unchanged, then the curve passes'
     const std::size_t node_at = align_up(header_bytes), extra_at = node_at + align_up(node_bytes);
     const std::size_t visible_at = extra_at + align_up(extra_bytes);
     if (visible_at + visible_bytes > region.size_bytes) {
@@ -400,12 +422,13 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     copy(extra_pieces_, up.extras, base + extra_at, 0, extra_pieces_.size());
     // The list of unchanged visible wires stays on the GPU while it is the same (a still scene, or still wires
     // under a camera that keeps them in view): then nothing is sent for them.
-    const bool same_list = visible_slots_ == last_visible_ && visible_kept_.id() != 0;
+    const bool same_list = visible_slots_ == last_visible_ && visible_kept_.id() != 0 && list_bytes <= visible_kept_bytes_;
+    (void)visible_bytes;
     if (!same_list && !visible_slots_.empty()) {
         std::memcpy(base + visible_at, visible_slots_.data(), visible_slots_.size() * 4);
     }
     stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + real_node_bytes : 0) +
-                           real_extra_bytes + (same_list ? 0 : visible_slots_.size() * 4);
+                           real_extra_bytes + (same_list ? 0 : visible_slots_.size() * 4) + stream_bytes_;
     const auto range = [&](GLuint binding, std::size_t offset, std::size_t bytes) {
         glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, region.buffer,
                           static_cast<GLintptr>(region.offset_bytes + offset), static_cast<GLsizeiptr>(bytes));
@@ -420,7 +443,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     // does not fit is drawn with, until the buffer has grown from the count read back).
     const std::size_t reserve = segments_visible + visible_;
     const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
-    std::size_t scratch_nodes = changed_ ? std::max<std::size_t>(node_total, 1) : 1;
+    std::size_t scratch_nodes = std::max<std::size_t>({changed_ ? node_total : 0, stream_changed_ ? stream_nodes() : 0, 1});
     const auto need = [&](gfx::Buffer& b, std::size_t& capacity, std::size_t bytes, const char* label) {
         return ensure(b, capacity, bytes, label, false);
     };
@@ -454,6 +477,17 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     }
     clear_range(counter_, 0, kCounterBytes);
     clear_range(buckets_, 0, buckets * 4);
+    if (!same_list) {
+        // The unchanged wires' slots, kept for the next frames: copied on the GPU out of the region (the curve
+        // passes write the changed wires' after them).
+        if (Status st = ensure(visible_kept_, visible_kept_bytes_, list_bytes, "wire nodes: visible slots", false); !st)
+            return fail(st);
+        if (!visible_slots_.empty()) {
+            glCopyNamedBufferSubData(region.buffer, visible_kept_.id(), static_cast<GLintptr>(region.offset_bytes + visible_at),
+                                     0, static_cast<GLsizeiptr>(visible_slots_.size() * 4));
+        }
+        last_visible_ = visible_slots_;
+    }
 
     // (1) Curves of the wires whose nodes changed, into their slots' segments and headers.
     if (changed_ != 0) {
@@ -465,12 +499,36 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         range(kCurveExtras, extra_at, extra_bytes);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotHeaders, slot_headers_.id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveMotionRefs, motion_refs_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotList, visible_kept_.id());
         glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(changed_));
         glUniform1i(curve_program_.uniform_location("u_persist"), 1);
         glUniform1i(curve_program_.uniform_location("u_motion"), 1);
+        glUniform1i(curve_program_.uniform_location("u_list"), 1);
+        glUniform1ui(curve_program_.uniform_location("u_list_first"), static_cast<GLuint>(unchanged_));
         glDispatchCompute(static_cast<GLuint>((changed_ + 63) / 64), 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
+    if (stream_changed_ != 0) {
+        // The streamed wires' curves: their headers and nodes lie in the stream's region (written by the game).
+        const StreamLayout layout = stream_layout();
+        curve_program_.use();
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveHeaders, layout.buffer, static_cast<GLintptr>(layout.header_at),
+                          static_cast<GLsizeiptr>(layout.header_bytes));
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveNodes, layout.buffer, static_cast<GLintptr>(layout.node_at),
+                          static_cast<GLsizeiptr>(layout.node_bytes));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSegments, segments_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveScratch, scratch_.id());
+        range(kCurveExtras, extra_at, extra_bytes);  // unread: the streamed wires carry no extras
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotHeaders, slot_headers_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveMotionRefs, motion_refs_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotList, visible_kept_.id());
+        glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(stream_changed_));
+        glUniform1i(curve_program_.uniform_location("u_persist"), 1);
+        glUniform1i(curve_program_.uniform_location("u_motion"), 1);
+        glUniform1i(curve_program_.uniform_location("u_list"), 1);
+        glUniform1ui(curve_program_.uniform_location("u_list_first"), static_cast<GLuint>(unchanged_ + changed_));
+        glDispatchCompute(static_cast<GLuint>((stream_changed_ + 63) / 64), 1, 1);
+    }
+    if (changed_ + stream_changed_ != 0) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     // (2) LOD, (3) commands, (4) rings and records, over the visible wires.
     ring_program_.use();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingHeaders, slot_headers_.id());
@@ -480,16 +538,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingRings, rings_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSlots, slot_state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounter, counter_.id());
-    if (!same_list) {
-        // Kept for the next frames: copied on the GPU out of the region.
-        if (Status st = ensure(visible_kept_, visible_kept_bytes_, visible_bytes, "wire nodes: visible slots", false); !st)
-            return fail(st);
-        glCopyNamedBufferSubData(region.buffer, visible_kept_.id(), static_cast<GLintptr>(region.offset_bytes + visible_at), 0,
-                                 static_cast<GLsizeiptr>(visible_bytes));
-        last_visible_ = visible_slots_;
-    }
-    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kRingVisible, visible_kept_.id(), 0, static_cast<GLsizeiptr>(visible_bytes));
-    range(kRingFrameHeaders, 0, header_bytes);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kRingVisible, visible_kept_.id(), 0, static_cast<GLsizeiptr>(list_bytes));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingDraws, draws_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingChunks, chunks_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingBuckets, buckets_.id());
@@ -505,7 +554,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glUniform1i(at("u_lod"), 1);
     glUniform1i(at("u_draw"), 1);
     glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
-    glUniform1ui(at("u_changed"), static_cast<GLuint>(changed_));
+    glUniform1ui(at("u_unchanged"), static_cast<GLuint>(unchanged_));
     glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, 0xffffffffu)));
     glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));

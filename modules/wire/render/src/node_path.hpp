@@ -8,6 +8,7 @@
 
 #include "wire/draw.hpp"
 #include "wire/lod.hpp"
+#include "wire/render/node_stream.hpp"
 #include "wire/render/wire_renderer.hpp"
 
 #include "engine/gfx/range_allocator.hpp"
@@ -21,10 +22,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
 namespace wire::render::detail {
+
+struct StreamState;
 
 /// What the nodes path borrows from the renderer to draw.
 struct NodeDrawContext {
@@ -67,6 +71,13 @@ public:
     /// Chunk records the frame may draw (the instanced chunk-index attribute must cover them).
     [[nodiscard]] std::size_t chunk_capacity() const { return chunk_bytes_ / 8; }
 
+    /// The node stream whose wires the frames draw beside the list's (node_stream.cpp); null: none.
+    void attach(StreamState* stream) { stream_ = stream; }
+    /// A slot for a new wire (its LOD and frame state and motion reference cleared); nullopt if it cannot grow.
+    std::optional<uint32_t> acquire_slot();
+    /// Gives a wire's slot and segments back.
+    void release_slot(uint32_t index, uint32_t segment_first, uint32_t segments);
+
 private:
     struct Slot {
         uint32_t index = 0;
@@ -81,6 +92,17 @@ private:
                   bool keep_contents);
     bool allocate_segments(uint32_t count, uint32_t& first);
     void free_segments(uint32_t first, uint32_t count);
+    // The stream's part of a frame (node_stream.cpp): its written wires' headers into its region (returns how
+    // many), the others listed; what to bind; the nodes written; on a failed frame, its wires marked unbuilt.
+    std::size_t emit_stream(std::size_t materials, std::size_t& segments_visible, DrawStats& stats);
+    struct StreamLayout {
+        unsigned buffer = 0;
+        std::size_t header_at = 0, header_bytes = 0, node_at = 0, node_bytes = 0;
+    };
+    [[nodiscard]] StreamLayout stream_layout() const;
+    [[nodiscard]] std::size_t stream_nodes() const;
+    [[nodiscard]] std::size_t stream_wires() const;  ///< the stream's wire records (live or not)
+    void unbuild_stream();
 
     engine::gfx::Program curve_program_, ring_program_;
     LodSettings lod_{};
@@ -88,6 +110,8 @@ private:
     uint64_t frame_ = 0;
     std::unordered_map<uint64_t, Slot> slots_;
     std::vector<uint32_t> free_slots_;
+    uint32_t slot_count_ = 0;  ///< slots made (the list's wires and the stream's)
+    StreamState* stream_ = nullptr;
     engine::gfx::RangeAllocator segment_ranges_{0, 1};  ///< the segment storage's ranges, in segments
     // Persistent (GPU only).
     engine::gfx::Buffer slot_headers_, slot_state_, motion_refs_, segments_, counts_;
@@ -127,9 +151,18 @@ private:
         uint32_t slot = 0, segment_first = 0, segments = 0;
     };
     std::vector<Dispatched> dispatched_, listed_;
+    std::vector<Dispatched> changed_wires_, stream_wires_;  ///< the frame's curve passes' wires: the list's, the stream's
+    std::size_t stream_changed_ = 0, unchanged_ = 0, stream_bytes_ = 0;
     std::vector<uint32_t> last_visible_;  ///< the list kept on the GPU (visible_kept_): unchanged, it is not sent
     engine::gfx::Buffer visible_kept_;
     std::size_t visible_kept_bytes_ = 0;
 };
+
+/// The renderer's side of a NodeStream (node_stream.cpp): attach it to the nodes path, or mark it unusable (why);
+/// whether a frame is begun and not drawn; fence the frame's region after the draws that read it.
+void attach_stream(NodePath& path, NodeStream& stream);
+void detach_stream(NodeStream& stream, const Status& why);
+bool stream_active(NodeStream& stream);
+void end_stream_frame(NodeStream& stream);
 
 }  // namespace wire::render::detail

@@ -106,6 +106,7 @@ struct WireRenderer::State {
     std::vector<uint8_t> streamed;     ///< retained path, per drawn item (order): rings streamed this frame
     std::size_t retained_ring_bytes = 0;  ///< retained path: bytes written into the ring storage this frame
     std::unique_ptr<detail::NodePath> nodes;  ///< gpu-nodes: made on its first frame
+    std::unique_ptr<NodeStream> node_stream;  ///< made on the first node_stream() call
     Status nodes_failed{};                    ///< why the nodes path could not be made (not retried)
     std::optional<UploadPath> preferred;      ///< preferred_path()'s choice, made once
     std::string preferred_why;
@@ -200,6 +201,7 @@ struct WireRenderer::State {
         at_eye.target += eye - camera.position;
         at_eye.position = eye;
         const bool drawn = nodes->prepare(list, at_eye, *begun, ctx, stats);
+        const bool streamed = node_stream && detail::stream_active(*node_stream);
         if (!stats.status.ok()) failed(stats, stats.status);
         Status index_capacity = drawn ? ensure_draw_index_capacity(nodes->chunk_capacity()) : Status::success();
         if (!index_capacity) failed(stats, index_capacity);
@@ -210,6 +212,7 @@ struct WireRenderer::State {
             if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         }
         stream.end();
+        if (streamed) detail::end_stream_frame(*node_stream);  // after the dispatches that read its region
         return stats;
     }
 
@@ -500,6 +503,19 @@ UploadPath WireRenderer::preferred_path() {
 const std::string& WireRenderer::preferred_path_reason() {
     (void)preferred_path();
     return state_->preferred_why;
+}
+
+NodeStream& WireRenderer::node_stream() {
+    State& s = *state_;
+    if (!s.node_stream) {
+        s.node_stream = std::make_unique<NodeStream>();
+        if (Status st = s.ensure_nodes(); st) {
+            detail::attach_stream(*s.nodes, *s.node_stream);
+        } else {
+            detail::detach_stream(*s.node_stream, st);
+        }
+    }
+    return *s.node_stream;
 }
 
 Status WireRenderer::read_drawn_rings(std::vector<DrawnRings>& out) const {

@@ -24,6 +24,7 @@
 
 #include "wire/draw.hpp"
 #include "wire/lod.hpp"
+#include "wire/render/node_stream.hpp"
 #include "wire/rings.hpp"
 
 #include "engine/gfx/resources.hpp"
@@ -189,6 +190,10 @@ public:
     /// path (cpu-mesh and gpu-rings build their rings on the CPU: wire::systems::wire_ring_set has them) or drew
     /// nothing because the nodes path failed.
     Status read_drawn_rings(std::vector<DrawnRings>& out) const;
+    /// The bulk node stream (node_stream.hpp): wires whose nodes a physics engine writes straight into this
+    /// renderer's mapped memory, drawn by draw() on the nodes path beside the list's wires. Made (with the nodes
+    /// path) on the first call; NodeStream::usable() says why not where the context lacks compute.
+    NodeStream& node_stream();
 
     /// True when the gpu-rings chunk index comes from gl_BaseInstanceARB + gl_InstanceID
     /// (ARB_shader_draw_parameters), false when from the instanced attribute.
