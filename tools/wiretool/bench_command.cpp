@@ -52,14 +52,15 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_option("--scenes", o->scenes, "Only these scenes, comma-separated")
         ->delimiter(',')
         ->check(CLI::IsMember({"standard", "offscreen", "swaying", "far", "catenary", "helix", "stretched_bend",
-                               "hairpin", "random_walk", "churn", "families", "remedy_families"}));
+                               "hairpin", "random_walk", "churn", "families", "remedy_families", "stream"}));
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
     cmd->add_flag(
         "--gl", o->gl,
         "Draw with the real WireRenderer (headless EGL: llvmpipe, or a GPU's EGL device): `standard`, `swaying` "
         "and `far` at --size with --wires wires on cpu-mesh, gpu-rings streamed and retained at 1, 2 and all threads, plus strips and lines off "
         "with the one-draw baseline (bench_gl.csv, bench_gl.md): systems, draw() and GPU ms, draw commands, "
-        "bytes, memory");
+        "bytes, memory; with `swaying` or `stream` selected, the node stream's rows at 1,000, 10,000 and 100,000 "
+        "moving wires (--wires: that count) beside this machine's copy floor (bench_gl_stream.csv)");
     cmd->add_option_function<std::string>(
            "--size",
            [o](const std::string& text) {

@@ -1,5 +1,6 @@
 // `wiretool bench --gl`, the scaling rows (gl_scale.hpp).
 #include "bench/systems/gl_scale.hpp"
+#include "bench/systems/gl_stream.hpp"
 
 #include "bench/scenes/field_scenes.hpp"
 #include "bench/systems/run_scene.hpp"
@@ -154,6 +155,7 @@ public:
     const std::string& error() const { return error_; }
     void set_spline(const wire::SplineSettings& spline) { spline_ = spline; }
     std::string gl_renderer() const { return context_ ? context_->gl_renderer() : std::string{}; }
+    engine::platform::Context& context() { return *context_; }
 
     // One row: the scene run on `path` (the one-draw baseline rides on a cpu-mesh run with thin wires off).
     void run_row(const Options& o, SceneKind kind, int wires, int threads, GlPathKind path, bool thin,
@@ -262,6 +264,7 @@ int run_gl_scale_bench(const Options& o) {
     std::vector<SceneKind> scenes;
     for (SceneKind k : {SceneKind::standard, SceneKind::swaying, SceneKind::far})
         if (selected(o, scene_name(k))) scenes.push_back(k);
+    const bool stream_rows = selected(o, "swaying") || selected(o, "stream");
     Table table;
     table.header = {"scene", "wires", "width", "height", "threads", "path", "thin_wires", "frames", "visible",
                     "triangles", "systems_wall_ms", "draw_ms", "gpu_ms", "draw_finish_ms", "end_to_end_ms",
@@ -269,7 +272,7 @@ int run_gl_scale_bench(const Options& o) {
                     "wire_memory_bytes", "gpu_buffer_bytes", "gpu_vs_one_draw"};
     std::string md = "# wiretool bench --gl\n\n";
     GlScale gl;
-    if (scenes.empty()) return exit_ok;
+    if (scenes.empty() && !stream_rows) return exit_ok;
     {
         // The wires' spline (--spline), resolved as `wiretool mesh` does (the systems rows do the same).
         wire::PipelineSettings resolved;
@@ -363,6 +366,10 @@ int run_gl_scale_bench(const Options& o) {
           "| gpu-nodes bytes | 16 B/node + 64 B/wire | bytes / bound (aim <= 1) |\n| --- | --- | --- | --- | --- | "
           "--- | --- | --- | --- |\n" +
           nodes_md;
+    if (stream_rows && !run_gl_stream_rows(o, gl.context(), md)) {
+        std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench_gl_stream.csv").c_str());
+        return exit_failure;
+    }
     if (!write_text(o.out_dir / "bench_gl.md", md)) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench_gl.md").c_str());
         return exit_failure;

@@ -430,6 +430,16 @@ std::size_t NodeStream::write_many(std::span<const StreamWire> wires, std::span<
     });
 }
 
+std::size_t NodeStream::state_bytes() const {
+    const StreamState& s = *state_;
+    return sizeof(StreamState) + s.wires.capacity() * sizeof(StreamState::Wire) +
+           s.styles.capacity() * sizeof(StreamStyle) + s.free.capacity() * sizeof(uint32_t);
+}
+std::size_t NodeStream::mapped_bytes() const {
+    const StreamState& s = *state_;
+    return s.buffer_made ? std::size_t{s.buffer.regions()} * s.buffer.region_bytes() : 0;
+}
+
 std::vector<StreamError> NodeStream::errors() const {
     std::lock_guard lock(state_->error_mutex);
     return state_->errors;

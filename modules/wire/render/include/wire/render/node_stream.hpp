@@ -112,6 +112,10 @@ public:
     [[nodiscard]] std::vector<StreamError> errors() const;
     /// Nodes this frame's writes used of begin()'s room; bytes they wrote into mapped memory (16 a node).
     [[nodiscard]] std::size_t nodes_written() const;
+    /// Memory the stream holds: its per-wire records on the CPU (capacity), and the mapped regions (one per frame
+    /// in flight, sized by the largest begin()).
+    [[nodiscard]] std::size_t state_bytes() const;
+    [[nodiscard]] std::size_t mapped_bytes() const;
     /// Whether the renderer could make the nodes path (begin() fails with its reason otherwise).
     [[nodiscard]] Status usable() const;
 
