@@ -19,6 +19,10 @@
 #include <cstring>
 #include <mutex>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace wire::render {
 namespace detail {
 
@@ -129,6 +133,44 @@ Measure copy_nodes(std::size_t n, Offset offset, const float* radius, std::size_
     m.ok = ok;
     return m;
 }
+
+#if defined(__SSE2__)
+/// copy_nodes for nodes without per-node radius, four lanes a node (x, y, z, radius): the offsets, their box and
+/// chords in SSE registers, the range test a mask (NaN fails it), no branch per node. `load(j, ok)` gives node j's
+/// offset with lane 3 zero and ANDs its range test into `ok`.
+template <class Load>
+Measure copy_nodes_sse(std::size_t n, Load load, float wire_radius, bool closed, glm::vec4* dst) {
+    Measure m;
+    if (n == 0) return m;
+    const __m128 radius = _mm_set_ps(wire_radius, 0.0f, 0.0f, 0.0f);
+    __m128 lo = _mm_set1_ps(FLT_MAX), hi = _mm_set1_ps(-FLT_MAX), chord = _mm_set1_ps(FLT_MAX);
+    __m128d ok = _mm_castsi128_pd(_mm_set1_epi32(-1));
+    const auto squared = [](__m128 d) {  // |d|^2 in every lane (lane 3 of d is zero)
+        const __m128 d2 = _mm_mul_ps(d, d);
+        const __m128 s = _mm_add_ps(d2, _mm_shuffle_ps(d2, d2, _MM_SHUFFLE(2, 3, 0, 1)));
+        return _mm_add_ps(s, _mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 0, 3, 2)));
+    };
+    const __m128 first = load(0, ok);
+    __m128 prev = first;
+    _mm_store_ps(&dst[0].x, _mm_or_ps(first, radius));
+    lo = _mm_min_ps(lo, first), hi = _mm_max_ps(hi, first);
+    for (std::size_t j = 1; j < n; ++j) {
+        const __m128 o = load(j, ok);
+        _mm_store_ps(&dst[j].x, _mm_or_ps(o, radius));
+        lo = _mm_min_ps(lo, o), hi = _mm_max_ps(hi, o);
+        chord = _mm_min_ps(chord, squared(_mm_sub_ps(o, prev)));
+        prev = o;
+    }
+    if (closed && n >= 2) chord = _mm_min_ps(chord, squared(_mm_sub_ps(first, prev)));
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo), _mm_store_ps(h, hi);
+    m.lo = glm::vec3(l[0], l[1], l[2]), m.hi = glm::vec3(h[0], h[1], h[2]);
+    m.min_chord2 = _mm_cvtss_f32(chord);
+    // NaN offsets leave the min/max alone: the range mask caught them (a NaN compares false).
+    m.ok = _mm_movemask_pd(ok) == 3;
+    return m;
+}
+#endif
 
 /// Whether nothing the merge rule (merge_nodes: eps = max(1e-9 diag, 64 DBL_EPSILON max |p|)) could join lies
 /// in the float offsets: the shortest chord clears eps by more than the offsets' rounding.
@@ -291,7 +333,25 @@ bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t
     if (!std::isfinite(origin.x + origin.y + origin.z) || glm::length(origin) > kMaxCoordinate_m) origin = glm::dvec3(0);
     origin = float_point(origin);
     const float wire_radius = style.radius_m > 0.0f ? style.radius_m : kDefaultWireRadius_m;
-    const detail::Measure m = detail::copy_nodes(
+    detail::Measure m;
+#if defined(__SSE2__)
+    if (radius == nullptr) {
+        const __m128d oxy = _mm_set_pd(origin.y, origin.x), oz = _mm_set_sd(origin.z);
+        const __m128d limit = _mm_set1_pd(kMaxCoordinate_m), sign = _mm_set1_pd(-0.0);
+        const auto* base = reinterpret_cast<const char*>(xyz);
+        m = detail::copy_nodes_sse(
+            n,
+            [&](std::size_t j, __m128d& ok) {
+                const auto* p = reinterpret_cast<const double*>(base + j * stride);
+                const __m128d xy = _mm_loadu_pd(p), z = _mm_load_sd(p + 2);
+                ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, xy), limit));
+                ok = _mm_and_pd(ok, _mm_unpacklo_pd(_mm_cmple_sd(_mm_andnot_pd(sign, z), limit), ok));
+                return _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(xy, oxy)), _mm_cvtpd_ps(_mm_sub_sd(z, oz)));
+            },
+            wire_radius, style.closed, dst);
+    } else
+#endif
+    m = detail::copy_nodes(
         n,
         [&](std::size_t j, bool& in_range) {
             const glm::dvec3 p = at(j);
@@ -333,7 +393,28 @@ bool write_float(StreamState& s, uint32_t index, const glm::dvec3& given_origin,
     const glm::vec3 rest(given_origin - origin);
     const auto limit = static_cast<float>(kMaxCoordinate_m);
     const float wire_radius = style.radius_m > 0.0f ? style.radius_m : kDefaultWireRadius_m;
-    detail::Measure m = detail::copy_nodes(
+    detail::Measure m;
+#if defined(__SSE2__)
+    if (radius == nullptr) {
+        const __m128 add = _mm_set_ps(0.0f, rest.z, rest.y, rest.x);
+        const __m128 lim = _mm_set1_ps(limit), sign = _mm_set1_ps(-0.0f);
+        const auto* base = reinterpret_cast<const char*>(xyz);
+        m = detail::copy_nodes_sse(
+            n,
+            [&](std::size_t j, __m128d& ok) {
+                const auto* p = reinterpret_cast<const float*>(base + j * stride);
+                // 12 bytes (a 16-byte load could read past the caller's last node).
+                const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+                const __m128 o = _mm_add_ps(_mm_movelh_ps(xy, _mm_load_ss(p + 2)), add);
+                // Each half's sign bit (what movemask_pd reads) the AND of its two lanes' tests.
+                const __m128 in = _mm_cmple_ps(_mm_andnot_ps(sign, o), lim);
+                ok = _mm_and_pd(ok, _mm_castps_pd(_mm_and_ps(in, _mm_shuffle_ps(in, in, _MM_SHUFFLE(2, 3, 0, 1)))));
+                return o;
+            },
+            wire_radius, style.closed, dst);
+    } else
+#endif
+    m = detail::copy_nodes(
         n,
         [&](std::size_t j, bool& in_range) {
             const glm::vec3 o = offset_at(j) + rest;
