@@ -9,6 +9,7 @@
 #include <engine/platform/context.hpp>
 #include <wire/io/wire_json.hpp>
 #include <wire/pipeline.hpp>
+#include <wire/render/node_stream.hpp>
 #include <wire/render/wire_renderer.hpp>
 #include <wire/systems/api.hpp>
 #include <wire/systems/systems.hpp>
@@ -262,6 +263,78 @@ public:
         registry_.destroy(w);
     }
 
+    // ---- the bulk node stream (wire/render/node_stream.hpp): the renderer's wires, nodes path only ----
+
+    wire::render::NodeStream& stream() {
+        if (ctx_.path != wire::UploadPath::gpu_nodes)
+            value_error("the node stream draws on the 'nodes' path; this runtime draws on '" +
+                        std::string(wire::upload_path_name(ctx_.path)) + "'");
+        wire::render::NodeStream& s = renderer_.node_stream();
+        if (engine::Status st = s.usable(); !st) value_error(st.message);
+        return s;
+    }
+
+    uint32_t stream_add(float radius_m, uint32_t material, const std::string& spline, bool closed, bool caps,
+                        uint32_t max_sides) {
+        if (material >= renderer_.materials().size())
+            value_error("material " + std::to_string(material) + " does not exist (the renderer has " +
+                        std::to_string(renderer_.materials().size()) + "; add_material() adds one)");
+        const wire::SplineSettings settings = spline_of(spline);
+        wire::render::StreamStyle style;
+        style.radius_m = radius_m, style.material = material, style.max_sides = max_sides;
+        style.kind = settings.kind, style.alpha = settings.alpha;
+        style.closed = closed, style.caps = caps;
+        gl_->make_current();
+        auto w = stream().add(style);
+        if (!w) value_error(w.error().message);
+        return w->index;
+    }
+
+    void stream_remove(uint32_t wire) {
+        gl_->make_current();
+        stream().remove(wire::render::StreamWire{wire});
+    }
+
+    /// One frame of many streamed wires: positions (W, N, 3), float64 world positions, or float32 offsets from
+    /// origins (W, 3) float64. Begins the stream's frame (the next render() draws it) and writes every wire in
+    /// one call; refused wires (bad nodes) keep their last curve and raise WireError after the rest is written.
+    std::size_t stream_nodes(const std::vector<uint32_t>& wires, const py::array& positions,
+                             const std::optional<DoubleArray>& origins) {
+        if (positions.ndim() != 3 || positions.shape(2) != 3 || static_cast<std::size_t>(positions.shape(0)) != wires.size())
+            value_error("positions: expected an array of shape (" + std::to_string(wires.size()) +
+                        ", N, 3), one (N, 3) block per wire");
+        const auto n = static_cast<std::size_t>(positions.shape(1));
+        std::vector<wire::render::StreamWire> handles(wires.size());
+        for (std::size_t k = 0; k < wires.size(); ++k) handles[k].index = wires[k];
+        gl_->make_current();
+        wire::render::NodeStream& s = stream();
+        if (engine::Status st = s.begin(wires.size() * n); !st) throw std::runtime_error(st.message);
+        std::size_t written = 0;
+        if (origins) {
+            if (origins->ndim() != 2 || origins->shape(1) != 3 || static_cast<std::size_t>(origins->shape(0)) != wires.size())
+                value_error("origins: expected an array of shape (" + std::to_string(wires.size()) + ", 3)");
+            const auto offsets = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(positions);
+            if (!offsets) value_error("positions: with origins, expected float32 offsets");
+            std::vector<glm::dvec3> o(wires.size());
+            for (std::size_t k = 0; k < o.size(); ++k) o[k] = {origins->at(k, 0), origins->at(k, 1), origins->at(k, 2)};
+            py::gil_scoped_release release;
+            written = s.write_many(handles, o, offsets.data(), n);
+        } else {
+            const auto xyz = DoubleArray::ensure(positions);
+            if (!xyz) value_error("positions: expected float64 world positions");
+            py::gil_scoped_release release;
+            written = s.write_many(handles, xyz.data(), n);
+        }
+        const std::vector<wire::render::StreamError> errors = s.errors();
+        if (!errors.empty()) {
+            std::string message;
+            for (const auto& e : errors) message += (message.empty() ? "" : "\n") + e.message;
+            PyErr_SetString(g_wire_error, message.c_str());
+            throw py::error_already_set();
+        }
+        return written;
+    }
+
     void set_camera(const std::vector<double>& eye, const std::vector<double>& target,
                     const std::vector<double>& up, double fov_deg, double near_m, double far_m) {
         const glm::dvec3 e = vec3_of(eye, "eye"), t = vec3_of(target, "target"), u = vec3_of(up, "up");
@@ -511,6 +584,16 @@ PYBIND11_MODULE(wires, m) {
         .def("set_positions", &Runtime::set_positions, py::arg("wires"), py::arg("positions"),
              "Positions of many wires in one call: positions has shape (len(wires), N, 3)")
         .def("destroy", &Runtime::destroy, py::arg("wire"))
+        .def("stream_add", &Runtime::stream_add, py::arg("radius") = 0.01f, py::arg("material") = 0u,
+             py::arg("spline") = "auto", py::arg("closed") = false, py::arg("caps") = true, py::arg("max_sides") = 0u,
+             "A wire of the bulk node stream (the 'nodes' path): an int handle; its nodes come from stream_nodes()")
+        .def("stream_remove", &Runtime::stream_remove, py::arg("wire"))
+        .def("stream_nodes", &Runtime::stream_nodes, py::arg("wires"), py::arg("positions"),
+             py::arg("origins") = py::none(),
+             "This frame's nodes of many streamed wires in one call, written straight into the renderer's mapped "
+             "memory: positions (len(wires), N, 3) float64 world metres, or float32 offsets from origins "
+             "(len(wires), 3). The next render() draws them beside the ECS wires. Bad nodes raise WireError naming "
+             "the wire and node after the rest is written (those wires keep their last curve).")
         .def("set_camera", &Runtime::set_camera, py::arg("eye"), py::arg("target"),
              py::arg("up") = std::vector<double>{0.0, 1.0, 0.0}, py::arg("fov_deg") = 60.0,
              py::arg("near") = 0.1, py::arg("far") = 1000.0)

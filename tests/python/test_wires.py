@@ -374,3 +374,61 @@ def test_the_module_comes_from_where_it_was_installed():
     if prefix is None:
         pytest.skip("WIRES_EXPECTED_PREFIX not set (the build tree's module, ctest python_wires)")
     assert Path(wires.__file__).resolve().is_relative_to(Path(prefix).resolve()), wires.__file__
+
+
+# ---- the bulk node stream (Runtime.stream_add / stream_nodes) ----
+
+def test_stream_draws_what_spawned_wires_draw():
+    """Wires streamed in one call per frame (double, and float32 offsets from origins) draw the picture the same
+    nodes draw as spawned ECS wires, frame after frame while they move."""
+    rows = np.array([0.0, 0.35, 0.0])[None, None, :] * (np.arange(6)[:, None, None] - 3.0)
+    frames = [np.stack([hanging(24, 0.1 + 0.04 * i, z=-0.3 * i) for i in range(6)]) + rows + 0.02 * f
+              for f in range(3)]
+    a, b, c = (wires.Runtime(320, 180, path="nodes") for _ in range(3))
+    spawned = [a.spawn(p, radius=0.05) for p in frames[0]]
+    streamed = [b.stream_add(radius=0.05) for _ in range(6)]
+    offsets = [c.stream_add(radius=0.05) for _ in range(6)]
+    for rt in (a, b, c):
+        rt.set_camera((0.0, 0.5, 5.0), (0.0, 0.0, 0.0))
+    for positions in frames:
+        for w, p in zip(spawned, positions):
+            a.set_nodes(w, p)
+        a.update()
+        b.update()
+        c.update()
+        assert b.stream_nodes(streamed, positions) == 6
+        origins = positions[:, 0, :].astype(np.float32).astype(np.float64)
+        assert c.stream_nodes(offsets, (positions - origins[:, None, :]).astype(np.float32), origins) == 6
+        want = a.render()
+        for rt in (b, c):
+            got = rt.render()
+            wire_pixels = ~background(want) | ~background(got)
+            differ = np.any(np.abs(want[..., :3].astype(int) - got[..., :3].astype(int)) > 24, axis=-1) & wire_pixels
+            assert wire_pixels.sum() > 500
+            assert differ.sum() <= 0.01 * wire_pixels.sum()
+
+
+def test_stream_refuses_bad_nodes_naming_wire_and_node_and_draws_the_rest():
+    rt = wires.Runtime(320, 180, path="nodes")
+    rt.set_camera((0.0, 0.5, 5.0), (0.0, 0.0, 0.0))
+    ws = [rt.stream_add(radius=0.03) for _ in range(3)]
+    good = np.stack([hanging(16, 0.1 * (i + 1), z=-0.3 * i) for i in range(3)])
+    rt.stream_nodes(ws, good)
+    rt.update()
+    before = rt.render()
+    bad = good.copy()
+    bad[1, 5, 1] = np.nan
+    with pytest.raises(wires.WireError, match=r"stream wire 1: node 5: position\.y is NaN"):
+        rt.stream_nodes(ws, bad)
+    rt.update()
+    after = rt.render()
+    # The bad wire keeps its last curve and the others were written (the same nodes): the same picture.
+    assert np.abs(before.astype(int) - after.astype(int)).max() <= 2
+    with pytest.raises(ValueError, match=r"positions: expected an array of shape \(3, N, 3\)"):
+        rt.stream_nodes(ws, good[:2])
+
+
+def test_stream_needs_the_nodes_path():
+    rt = wires.Runtime(64, 64, path="cpu")
+    with pytest.raises(ValueError, match="the node stream draws on the 'nodes' path"):
+        rt.stream_add()

@@ -116,8 +116,6 @@ void run_row(engine::platform::Context& context, StreamRow& row, int frames) {
         const double t0 = wall_ms();
         std::size_t written = 0;
         const bool begun = stream.begin(row.wires * kNodes).ok();
-        const double tb = wall_ms();
-        if (getenv("STREAM_DEBUG") && f > 0) fprintf(stderr, "begin %.3f ms\n", tb - t0);
         if (begun) {
             written = row.floats ? stream.write_many(wires, origins, offsets.data(), kNodes)
                                  : stream.write_many(wires, xyz.data(), kNodes);
