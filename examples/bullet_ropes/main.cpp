@@ -28,6 +28,7 @@ struct Options {
     int height = 720;
     double dt_s = 1.0 / 60.0;
     std::string path = "auto";  // wire upload path: auto, nodes, cpu or gpu
+    bool set_nodes = false;     // nodes path: wire entities (set_nodes) instead of the node stream
 };
 
 std::string frame_name(int frame) {
@@ -71,6 +72,9 @@ int main(int argc, char** argv) {
                    "portable reference) or gpu (ring records)")
         ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}))
         ->capture_default_str();
+    app.add_flag("--set-nodes", opt.set_nodes,
+                 "On the nodes path, hand the nodes to wire entities (wire::systems::set_nodes) instead of writing "
+                 "Bullet's node records straight into the renderer's node stream (the default there)");
     app.footer("Window keys: F12 saves a screenshot to the --out directory, Esc quits.");
     CLI11_PARSE(app, argc, argv);
 
@@ -104,6 +108,13 @@ int main(int argc, char** argv) {
         return 1;
     }
     wires.path = opt.path == "auto" ? view->preferred_path() : *wire::parse_upload_path(opt.path);
+    if (wires.path == wire::UploadPath::gpu_nodes && !opt.set_nodes) {
+        // The nodes path: Bullet's node records go straight into the renderer's mapped memory (the node stream).
+        if (engine::Status st = scene.stream_to(view->node_stream()); !st) {
+            std::fprintf(stderr, "bullet_ropes: the node stream: %s\n", st.message.c_str());
+            return 1;
+        }
+    }
 
     const int frames = opt.frames > 0 ? opt.frames : (ctx.headless() ? 240 : 0);
     int written = 0;

@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace bullet_ropes {
@@ -196,7 +197,48 @@ void RopeScene::step(double dt_s) {
 }
 
 void RopeScene::sync_wires() {
-    for (const Rope& rope : ropes_) wire::systems::set_nodes(registry_, rope.wire, wire_nodes(*rope.body));
+    if (stream_ == nullptr) {
+        for (const Rope& rope : ropes_) wire::systems::set_nodes(registry_, rope.wire, wire_nodes(*rope.body));
+        return;
+    }
+    std::size_t nodes = 0;
+    for (const Rope& rope : ropes_) nodes += static_cast<std::size_t>(rope.body->m_nodes.size());
+    if (engine::Status st = stream_->begin(nodes); !st) {
+        std::fprintf(stderr, "bullet_ropes: %s\n", st.message.c_str());
+        return;
+    }
+    for (const Rope& rope : ropes_) {
+        // Bullet's node records in place: each node's m_x, sizeof(Node) bytes apart; ids are the indices.
+        const btAlignedObjectArray<btSoftBody::Node>& n = rope.body->m_nodes;
+        const btScalar* first = &n[0].m_x.x();
+        const auto count = static_cast<std::size_t>(n.size());
+        bool ok = false;
+        if constexpr (sizeof(btScalar) == sizeof(float)) {
+            ok = stream_->write(rope.stream, glm::dvec3(0.0), reinterpret_cast<const float*>(first), count,
+                                sizeof(btSoftBody::Node));
+        } else {
+            ok = stream_->write(rope.stream, reinterpret_cast<const double*>(first), count, sizeof(btSoftBody::Node));
+        }
+        if (!ok) {
+            for (const wire::render::StreamError& e : stream_->errors()) {
+                if (e.wire == rope.stream) std::fprintf(stderr, "bullet_ropes: %s: %s\n", rope.name.c_str(), e.message.c_str());
+            }
+        }
+    }
+}
+
+engine::Status RopeScene::stream_to(wire::render::NodeStream& stream) {
+    if (engine::Status st = stream.usable(); !st) return st;
+    for (Rope& rope : ropes_) {
+        auto made = stream.add({.radius_m = rope.radius_m, .material = rope.material});
+        if (!made) return engine::Status::error(rope.name + ": " + made.error().message);
+        rope.stream = *made;
+        if (registry_.valid(rope.wire)) registry_.destroy(rope.wire);
+        rope.wire = engine::ecs::null_entity;
+    }
+    stream_ = &stream;
+    sync_wires();
+    return engine::Status::success();
 }
 
 engine::Expected<RopeView> RopeView::create(const RopeScene& scene) {

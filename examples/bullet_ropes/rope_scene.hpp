@@ -15,6 +15,7 @@
 #include <engine/scene/camera.hpp>
 #include <wire/draw.hpp>
 #include <wire/nodes.hpp>
+#include <wire/render/node_stream.hpp>
 #include <wire/render/wire_renderer.hpp>
 
 #include <glm/vec3.hpp>
@@ -38,7 +39,8 @@ struct Box {
 struct Rope {
     std::string name;
     btSoftBody* body = nullptr;  ///< owned by the scene's Bullet world
-    engine::ecs::Entity wire = engine::ecs::null_entity;
+    engine::ecs::Entity wire = engine::ecs::null_entity;  ///< its wire entity (null when streamed)
+    wire::render::StreamWire stream{};                    ///< its streamed wire (RopeScene::stream_to)
     float radius_m = 0.03f;
     uint32_t material = 0;   ///< renderer material (RopeView adds one per rope colour)
     glm::vec3 colour{1.0f};  ///< tint of that material (linear RGB)
@@ -61,8 +63,13 @@ public:
     /// Advances Bullet by dt_s (fixed internal steps of 1/240 s), then hands every rope's nodes to its wire
     /// (wire::systems::set_nodes).
     void step(double dt_s);
-    /// Hands every rope's current nodes to its wire entity (step() calls this).
+    /// Hands every rope's current nodes to its wire (step() calls this): to its wire entity (set_nodes), or, after
+    /// stream_to(), straight from Bullet's node records into the renderer's mapped memory (one frame of the
+    /// stream: begin() and a write per rope, reading each node's position in place).
     void sync_wires();
+    /// From now on the ropes are the stream's wires (the nodes path): their wire entities are destroyed and the
+    /// next sync_wires() writes the stream. The stream must outlive the scene's use of it.
+    engine::Status stream_to(wire::render::NodeStream& stream);
 
     [[nodiscard]] const std::vector<Rope>& ropes() const { return ropes_; }
     [[nodiscard]] const Box& box() const { return box_; }
@@ -73,6 +80,7 @@ private:
     engine::ecs::Registry& registry_;
     std::unique_ptr<World> world_;
     std::vector<Rope> ropes_;
+    wire::render::NodeStream* stream_ = nullptr;
     Box box_{};
     double time_s_ = 0.0;
 };
@@ -89,6 +97,8 @@ public:
 
     /// The wire renderer's preferred upload path (nodes where the context has compute; logged once).
     [[nodiscard]] wire::UploadPath preferred_path() { return wires_->preferred_path(); }
+    /// The renderer's node stream (draw() draws its wires beside the list's).
+    [[nodiscard]] wire::render::NodeStream& node_stream() { return wires_->node_stream(); }
 
     /// Background colour the frame is cleared to.
     static constexpr glm::vec3 kBackground{0.62f, 0.70f, 0.80f};

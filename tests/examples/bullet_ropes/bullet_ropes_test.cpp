@@ -212,3 +212,62 @@ TEST_F(BulletRopes, RopesRestOnTheFloorAndTheBox) {
 }
 
 }  // namespace
+
+namespace {
+
+// The ropes streamed (RopeScene::stream_to: Bullet's node records written straight into the renderer's mapped
+// memory) draw the picture their wire entities draw on the nodes path, frame after frame (Bullet is deterministic).
+TEST(BulletRopesStream, StreamedRopesDrawWhatTheirEntitiesDraw) {
+    auto ctx = engine::platform::create_headless_context({.width = kWidth, .height = kHeight, .quiet = true});
+    ASSERT_TRUE(ctx) << ctx.error().message;
+    struct Run {
+        engine::ecs::Registry registry;
+        engine::ecs::Schedule schedule;
+        wire::systems::WireContext wires;
+        std::unique_ptr<bullet_ropes::RopeScene> scene;
+        std::unique_ptr<bullet_ropes::RopeView> view;
+    };
+    Run runs[2];
+    for (int r = 0; r < 2; ++r) {
+        Run& run = runs[r];
+        run.wires.path = wire::UploadPath::gpu_nodes;
+        run.wires.on_error = [](const wire::systems::ErrorReport& e) { ADD_FAILURE() << e.message; };
+        wire::systems::install(run.schedule, run.wires);
+        run.scene = std::make_unique<bullet_ropes::RopeScene>(run.registry);
+        auto view = bullet_ropes::RopeView::create(*run.scene);
+        ASSERT_TRUE(view) << view.error().message;
+        run.view = std::make_unique<bullet_ropes::RopeView>(std::move(*view));
+        run.wires.camera = bullet_ropes::default_camera(kWidth, kHeight);
+        run.wires.viewport_width_px = kWidth;
+        run.wires.viewport_height_px = kHeight;
+        if (r == 1) {
+            ASSERT_TRUE(run.scene->stream_to(run.view->node_stream()).ok());
+            EXPECT_EQ(run.view->node_stream().size(), run.scene->ropes().size());
+        }
+    }
+    for (int frame = 0; frame < 90; ++frame) {
+        engine::platform::Image images[2];
+        for (int r = 0; r < 2; ++r) {
+            Run& run = runs[r];
+            run.scene->step(1.0 / 60.0);
+            run.schedule.run(run.registry, 1.0 / 60.0);
+            (*ctx)->begin_frame();
+            run.view->draw(*run.scene, run.wires.draw_list, run.wires.camera);
+            images[r] = engine::platform::read_pixels(**ctx);
+            (*ctx)->end_frame();
+        }
+        if (frame % 30 != 29) continue;
+        EXPECT_TRUE(runs[1].wires.draw_list.items.empty()) << "streamed ropes left wire entities";
+        std::size_t differ = 0, rope = 0;
+        for (std::size_t i = 0; i + 3 < images[0].rgba.size(); i += 4) {
+            int d = 0;
+            for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(images[0].rgba[i + c]) - int(images[1].rgba[i + c])));
+            differ += d > 24;
+        }
+        for (const auto& n : runs[0].wires.draw_list.items) rope += n.nodes != nullptr ? n.nodes->size() : 0;
+        EXPECT_GT(rope, 0u);
+        EXPECT_LE(differ, images[0].rgba.size() / 4 / 500) << "frame " << frame << ": " << differ << " pixels differ";
+    }
+}
+
+}  // namespace
