@@ -38,9 +38,11 @@ struct StreamState {
         uint32_t slot = UINT32_MAX, segment_first = 0, segments = 0;
         uint32_t sent_count = 0;             ///< curve nodes of the last upload the GPU got
         float origin[3] = {0, 0, 0};         ///< this write's origin (a float point)
-        double centre[3] = {0, 0, 0};        ///< the last write's box centre (the next double write's origin)
+        float centre[3] = {0, 0, 0};         ///< the last write's box centre as a float point (the next origin)
+        uint32_t material = 0;               ///< StreamStyle::material (read by every frame's pass over the wires)
         bool has_centre = false, live = false, built = false, unmerged = false, sent_unmerged = false;
     };
+    static_assert(sizeof(Wire) <= 64, "a wire's per-frame record in one cache line");
     std::vector<Wire> wires;
     std::vector<StreamStyle> styles;
     std::vector<uint32_t> free;
@@ -54,6 +56,16 @@ struct StreamState {
     std::size_t header_capacity = 0, node_capacity = 0, header_at = 0, node_at = 0;
     std::atomic<std::size_t> cursor{0};  ///< nodes used of the region's room
     std::size_t headers = 0;             ///< headers emitted this frame
+    /// Wires written this frame that need a slot or another segment count (the draw allocates them serially).
+    std::vector<uint32_t> pending;
+    std::mutex pending_mutex;
+    void accepted(Wire& w, uint32_t index) {
+        w.written = frame;
+        const uint32_t segments = styles[index].closed ? w.count : w.count - 1;
+        if (w.slot != UINT32_MAX && segments == w.segments) return;
+        std::lock_guard lock(pending_mutex);
+        pending.push_back(index);
+    }
 
     mutable std::mutex error_mutex;
     std::vector<StreamError> errors;
@@ -211,6 +223,7 @@ Expected<StreamWire> NodeStream::add(const StreamStyle& style) {
     }
     s.wires[index] = StreamState::Wire{};
     s.wires[index].live = true;
+    s.wires[index].material = style.material;
     s.styles[index] = style;
     ++s.live;
     return StreamWire{index};
@@ -220,6 +233,7 @@ Status NodeStream::set_style(StreamWire wire, const StreamStyle& style) {
     if (!live(wire)) return Status::error("stream wire " + std::to_string(wire.index) + " is not live");
     if (Status st = detail::check_style(style); !st) return st;
     state_->styles[wire.index] = style;
+    state_->wires[wire.index].material = style.material;
     return Status::success();
 }
 
@@ -263,6 +277,7 @@ Status NodeStream::begin(std::size_t nodes) {
     ++s.frame;
     s.cursor.store(0, std::memory_order_relaxed);
     s.headers = 0;
+    s.pending.clear();
     {
         std::lock_guard lock(s.error_mutex);
         s.errors.clear();
@@ -306,7 +321,7 @@ bool second_look(StreamState& s, uint32_t index, std::size_t n, Position positio
     w.count = static_cast<uint32_t>(packed.nodes.size());
     w.unmerged = packed.nodes.size() == n;
     for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(packed.origin_m[a]);
-    for (int a = 0; a < 3; ++a) w.centre[a] = packed.origin_m[a];
+    for (int a = 0; a < 3; ++a) w.centre[a] = static_cast<float>(packed.origin_m[a]);  // a float point
     w.has_centre = true;
     return true;
 }
@@ -366,12 +381,12 @@ bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t
         w.count = static_cast<uint32_t>(n);
         w.unmerged = true;
         for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(origin[a]);
-        const glm::dvec3 centre = origin + 0.5 * (glm::dvec3(m.lo) + glm::dvec3(m.hi));
-        for (int a = 0; a < 3; ++a) w.centre[a] = centre[a];
+        const glm::dvec3 centre = float_point(origin + 0.5 * (glm::dvec3(m.lo) + glm::dvec3(m.hi)));
+        for (int a = 0; a < 3; ++a) w.centre[a] = static_cast<float>(centre[a]);
         w.has_centre = true;
     }
     w.node_first = static_cast<uint32_t>(*first);
-    w.written = s.frame;
+    s.accepted(w, index);
     return true;
 }
 
@@ -433,7 +448,7 @@ bool write_float(StreamState& s, uint32_t index, const glm::dvec3& given_origin,
         for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(origin[a]);
     }
     w.node_first = static_cast<uint32_t>(*first);
-    w.written = s.frame;
+    s.accepted(w, index);
     return true;
 }
 
@@ -555,80 +570,135 @@ std::size_t NodePath::emit_stream(std::size_t materials, std::size_t& segments_v
     StreamState& s = *stream_;
     stream_wires_.clear();
     stream_bytes_ = 0;
-    std::size_t changed = 0;
-    auto* headers = s.active ? reinterpret_cast<GpuCurveHeader*>(s.region.data + s.header_at) : nullptr;
-    const auto* nodes = s.active ? reinterpret_cast<const glm::vec4*>(s.region.data + s.node_at) : nullptr;
-    (void)nodes;
-    for (uint32_t i = 0; i < s.wires.size(); ++i) {
+    const uint32_t frame = s.active ? s.frame : 0;  // 0: nothing written this frame
+    const auto wire_count = static_cast<uint32_t>(s.wires.size());
+    // What a wire does this frame: 0 nothing, 1 its written nodes go to the GPU, 2 it is listed (drawn from its
+    // state on the GPU), 3 skipped (its material is out of range).
+    const auto role = [&](const StreamState::Wire& w, uint32_t) -> int {
+        if (!w.live) return 0;
+        if (w.material >= materials) return 3;
+        if (w.written == frame && frame != 0) return 1;
+        return w.built ? 2 : 0;
+    };
+    // (1) Serially, the few written wires that need a slot or another segment count (GL calls, the allocator).
+    for (uint32_t i : s.pending) {
         StreamState::Wire& w = s.wires[i];
-        if (!w.live) continue;
-        const StreamStyle& style = s.styles[i];
-        if (style.material >= materials) {
+        if (role(w, i) != 1) continue;
+        if (w.slot == UINT32_MAX) {
+            const std::optional<uint32_t> slot = acquire_slot();
+            if (!slot) {
+                w.written = 0;
+                ++stats.wires_skipped;
+                continue;
+            }
+            w.slot = *slot;
+            w.built = false;
+        }
+        const uint32_t segments = s.styles[i].closed ? w.count : w.count - 1;
+        if (segments == w.segments) continue;
+        free_segments(w.segment_first, w.segments);
+        w.segments = 0;
+        uint32_t first = 0;
+        if (!allocate_segments(segments, first)) {
+            w.built = false, w.written = 0;
             ++stats.wires_skipped;
-            if (stats.status.ok()) {
-                stats.status = Status::error("stream wire " + std::to_string(i) + ": material " +
-                                             std::to_string(style.material) + " is out of range (" +
-                                             std::to_string(materials) + " materials): not drawn");
-            }
             continue;
         }
-        if (s.active && w.written == s.frame && changed < s.header_capacity) {
-            if (w.slot == UINT32_MAX) {
-                const std::optional<uint32_t> slot = acquire_slot();
-                if (!slot) {
-                    ++stats.wires_skipped;
-                    continue;
-                }
-                w.slot = *slot;
-                w.built = false;
-            }
-            const uint32_t segments = style.closed ? w.count : w.count - 1;
-            if (segments != w.segments) {
-                free_segments(w.segment_first, w.segments);
-                w.segments = 0;
-                uint32_t first = 0;
-                if (!allocate_segments(segments, first)) {
-                    w.built = false;
-                    ++stats.wires_skipped;
-                    continue;
-                }
-                w.segment_first = first, w.segments = segments;
-                glClearNamedBufferSubData(slot_state_.id(), GL_R32UI, static_cast<GLintptr>(w.slot) * 32, 16, GL_RED_INTEGER,
-                                          GL_UNSIGNED_INT, nullptr);  // the LOD starts afresh
-            }
-            const uint32_t kind = style.kind == SplineKind::linear      ? kKindLinear
-                                  : style.kind == SplineKind::c2        ? kKindC2
-                                  : style.kind == SplineKind::automatic ? kKindAutomatic
-                                                                        : kKindCatmullRom;
-            const uint32_t sides = style.max_sides ? std::max<uint32_t>(style.max_sides, 3) : 16u;
-            // The GPU fits the motion by index where the last upload had these nodes' count and neither merged.
-            const bool fit = w.built && w.sent_count == w.count && w.sent_unmerged && w.unmerged;
-            GpuCurveHeader h;
-            h.node_first = w.node_first;
-            h.node_count = w.count;
-            h.segment_first = w.segment_first;
-            h.flags = (style.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (style.caps ? kHeaderCaps : 0u) |
-                      (fit ? kHeaderFitMotion : 0u) | (std::min<uint32_t>(sides, 255u) << 8) |
-                      (style.material << kHeaderMaterialShift);
-            h.alpha = static_cast<float>(style.alpha), h.tension = static_cast<float>(style.tension);
-            h.bias = static_cast<float>(style.bias), h.continuity = static_cast<float>(style.continuity);
-            h.slot = w.slot;
-            std::memcpy(h.origin_m, w.origin, sizeof h.origin_m);
-            std::memcpy(headers + changed, &h, sizeof h);  // mapped memory: written once, never read
-            w.built = true;
-            w.sent_count = w.count;
-            w.sent_unmerged = w.unmerged;
-            stream_wires_.push_back({NodeStream::wire_id(StreamWire{i}), w.slot, w.segment_first, w.segments});
-            ++changed;
-            stream_bytes_ += sizeof(GpuCurveHeader) + std::size_t{w.count} * sizeof(glm::vec4);
-        } else if (w.built) {
-            visible_slots_.push_back(w.slot);
-            listed_.push_back({NodeStream::wire_id(StreamWire{i}), w.slot, w.segment_first, w.segments});
+        w.segment_first = first, w.segments = segments;
+        glClearNamedBufferSubData(slot_state_.id(), GL_R32UI, static_cast<GLintptr>(w.slot) * 32, 16, GL_RED_INTEGER,
+                                  GL_UNSIGNED_INT, nullptr);  // the LOD starts afresh (SlotState::lod)
+    }
+    s.pending.clear();
+    // (2) Per block of wires, in parallel: how many it sends and lists; then (3) each block writes its headers and
+    // list entries at its offsets (prefix sums), so the order is the wires' whatever the threads.
+    constexpr uint32_t kBlock = 4096;
+    const uint32_t blocks = (wire_count + kBlock - 1) / kBlock;
+    struct Block {
+        std::size_t changed = 0, listed = 0, segments = 0, bytes = 0;
+        uint32_t bad_material = UINT32_MAX;
+        std::vector<uint8_t> used;
+    };
+    std::vector<Block> block(blocks);
+    const auto over_blocks = [&](auto&& body) {
+        if (wire_count >= 2 * kBlock) {
+            tbb::parallel_for(uint32_t{0}, blocks, [&](uint32_t b) { body(b); });
         } else {
-            continue;
+            for (uint32_t b = 0; b < blocks; ++b) body(b);
         }
-        segments_visible += w.segments;
-        material_used_[style.material] = 1;
+    };
+    over_blocks([&](uint32_t b) {
+        Block& k = block[b];
+        for (uint32_t i = b * kBlock; i < std::min(wire_count, (b + 1) * kBlock); ++i) {
+            const int r = role(s.wires[i], i);
+            k.changed += r == 1, k.listed += r == 2;
+            if (r == 3 && k.bad_material == UINT32_MAX) k.bad_material = i;
+        }
+    });
+    std::size_t changed = 0, listed = 0;
+    std::vector<std::size_t> changed_at(blocks), listed_at(blocks);
+    for (uint32_t b = 0; b < blocks; ++b) {
+        changed_at[b] = changed, listed_at[b] = listed;
+        changed += block[b].changed, listed += block[b].listed;
+        if (block[b].bad_material != UINT32_MAX && stats.status.ok()) {
+            const uint32_t i = block[b].bad_material;
+            stats.status = Status::error("stream wire " + std::to_string(i) + ": material " +
+                                         std::to_string(s.styles[i].material) + " is out of range (" +
+                                         std::to_string(materials) + " materials): not drawn");
+        }
+    }
+    const std::size_t visible_before = visible_slots_.size(), listed_before = listed_.size();
+    visible_slots_.resize(visible_before + listed);
+    listed_.resize(listed_before + listed);
+    stream_wires_.resize(changed);
+    auto* headers = s.active ? reinterpret_cast<GpuCurveHeader*>(s.region.data + s.header_at) : nullptr;
+    over_blocks([&](uint32_t b) {
+        Block& k = block[b];
+        k.used.assign(materials, 0);
+        std::size_t c = changed_at[b], l = listed_at[b];
+        for (uint32_t i = b * kBlock; i < std::min(wire_count, (b + 1) * kBlock); ++i) {
+            StreamState::Wire& w = s.wires[i];
+            const int r = role(w, i);
+            if (r == 0 || r == 3) continue;
+            const StreamStyle& style = s.styles[i];
+            const Dispatched d{NodeStream::wire_id(StreamWire{i}), w.slot, w.segment_first, w.segments};
+            if (r == 1) {
+                const uint32_t kind = style.kind == SplineKind::linear      ? kKindLinear
+                                      : style.kind == SplineKind::c2        ? kKindC2
+                                      : style.kind == SplineKind::automatic ? kKindAutomatic
+                                                                            : kKindCatmullRom;
+                const uint32_t sides = style.max_sides ? std::max<uint32_t>(style.max_sides, 3) : 16u;
+                // The GPU fits the motion by index where the last upload had these nodes' count and neither merged.
+                const bool fit = w.built && w.sent_count == w.count && w.sent_unmerged && w.unmerged;
+                GpuCurveHeader h;
+                h.node_first = w.node_first;
+                h.node_count = w.count;
+                h.segment_first = w.segment_first;
+                h.flags = (style.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) |
+                          (style.caps ? kHeaderCaps : 0u) | (fit ? kHeaderFitMotion : 0u) |
+                          (std::min<uint32_t>(sides, 255u) << 8) | (style.material << kHeaderMaterialShift);
+                h.alpha = static_cast<float>(style.alpha), h.tension = static_cast<float>(style.tension);
+                h.bias = static_cast<float>(style.bias), h.continuity = static_cast<float>(style.continuity);
+                h.slot = w.slot;
+                std::memcpy(h.origin_m, w.origin, sizeof h.origin_m);
+                std::memcpy(headers + c, &h, sizeof h);  // mapped memory: written once, never read
+                w.built = true;
+                w.sent_count = w.count;
+                w.sent_unmerged = w.unmerged;
+                stream_wires_[c++] = d;
+                k.bytes += sizeof(GpuCurveHeader) + std::size_t{w.count} * sizeof(glm::vec4);
+            } else {
+                visible_slots_[visible_before + l] = w.slot;
+                listed_[listed_before + l] = d;
+                ++l;
+            }
+            k.segments += w.segments;
+            k.used[style.material] = 1;
+        }
+    });
+    for (const Block& k : block) {
+        segments_visible += k.segments;
+        stream_bytes_ += k.bytes;
+        for (std::size_t m = 0; m < k.used.size(); ++m) material_used_[m] |= k.used[m];
     }
     s.headers = changed;
     return changed;
