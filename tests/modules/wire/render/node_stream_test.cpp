@@ -400,3 +400,138 @@ TEST_F(NodeStreamTest, OutOfRoomAndStaleWritesAreRefusedNamingWhy) {
 }
 
 }  // namespace
+
+namespace {
+
+// A random family of inputs, good and bad (fixed seed): open and closed wires of 1-80 nodes, 1e-3-1e3 m, up to 1e9 m
+// from the origin, written in double and as float offsets; defects at random nodes: NaN, infinities, coordinates
+// past 1e12 m, runs of coincident nodes, pairs at 0.3-30x the merge tolerance, bad radii. Every write is accepted
+// exactly when check_curve_input accepts the same nodes (in double), a refusal carries its message, and an
+// accepted wire is drawn with the segments of build_curve's merge.
+TEST_F(NodeStreamTest, AcceptsExactlyWhatTheCurveStageAcceptsOverARandomFamily) {
+    camera_.target = glm::dvec3(0.0);
+    camera_.position = glm::dvec3(0.0, 0.0, 10.0);
+    camera_.near_m = 0.01f, camera_.far_m = 1e4f;
+    std::mt19937 rng(20261205);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    NodeStream& stream = streamed_.node_stream();
+    constexpr int kPerFrame = 40, kFrames = 10;
+    std::size_t accepted = 0, refused = 0, merged = 0;
+    for (int f = 0; f < kFrames; ++f) {
+        struct Case {
+            StreamWire wire;
+            wire::WireNodes nodes;
+            bool closed = false;
+            std::string want;  // empty: accepted
+            std::size_t segments = 0;
+        };
+        std::vector<Case> cases(kPerFrame);
+        std::size_t total = 0;
+        for (Case& c : cases) {
+            c.closed = unit(rng) < 0.2;
+            const auto n = static_cast<std::size_t>(1 + std::pow(unit(rng), 2.0) * 80.0);
+            const double size = std::pow(10.0, -3.0 + 6.0 * unit(rng));
+            // Always in front of the camera at the origin's scale: offset far, but wires are not looked at there.
+            const glm::dvec3 at = unit(rng) < 0.3 ? glm::dvec3(std::pow(10.0, 9.0 * unit(rng)), 0.0, 0.0) : glm::dvec3(0.0);
+            for (std::size_t j = 0; j < n; ++j) {
+                const double s = double(j) / double(std::max<std::size_t>(n - 1, 1));
+                c.nodes.positions.push_back(at + size * glm::dvec3(s - 0.5, 0.3 * std::sin(6.0 * s) + 0.1 * unit(rng), 0.2 * std::cos(5.0 * s)));
+            }
+            const int defect = static_cast<int>(unit(rng) * 8.0);
+            const std::size_t k = static_cast<std::size_t>(unit(rng) * double(n)) % n;
+            auto& p = c.nodes.positions;
+            if (defect == 1) p[k][static_cast<int>(unit(rng) * 3) % 3] = std::numeric_limits<double>::quiet_NaN();
+            if (defect == 2) p[k][static_cast<int>(unit(rng) * 3) % 3] = -std::numeric_limits<double>::infinity();
+            if (defect == 3) p[k].y = 2e12 * (unit(rng) < 0.5 ? 1 : -1);
+            if (defect == 4) {
+                for (std::size_t j = k; j < std::min(n, k + 1 + static_cast<std::size_t>(unit(rng) * 5)); ++j) p[j] = p[k];
+            }
+            if (defect == 5 && k + 1 < n) {
+                // A pair near the merge tolerance (1e-9 of the box diagonal, or 64 ulps far out).
+                glm::dvec3 lo = p[0], hi = p[0];
+                for (const auto& q : p) lo = glm::min(lo, q), hi = glm::max(hi, q);
+                const double eps = std::max(1e-9 * glm::length(hi - lo), 64.0 * 2.220446049250313e-16 * glm::length(at));
+                p[k + 1] = p[k] + glm::dvec3(eps * std::pow(10.0, -0.5 + 2.0 * unit(rng)), 0.0, 0.0);
+            }
+            if (defect == 6) c.closed = true;  // closed, possibly with too few distinct nodes
+            c.nodes.radius_m.clear();
+            if (defect == 7) {
+                c.nodes.radius_m.assign(n, 0.0f);
+                c.nodes.radius_m[k] = unit(rng) < 0.5 ? -0.1f : 1e-8f;
+            }
+            StreamStyle style;
+            style.closed = c.closed;
+            style.kind = wire::SplineKind::catmull_rom;
+            auto w = stream.add(style);
+            ASSERT_TRUE(w.ok());
+            c.wire = *w;
+            const wire::SplineSettings spline{.closed = c.closed};
+            const wire::Status st = wire::check_curve_input(c.nodes, spline);
+            if (!st.ok()) {
+                c.want = "stream wire " + std::to_string(c.wire.index) + ": " + st.message;
+            } else {
+                std::vector<glm::dvec3> curve;
+                const std::size_t m = wire::curve_nodes(c.nodes, spline, curve);
+                c.segments = c.closed ? m : m - 1;
+                merged += m != n;
+            }
+            total += n;
+        }
+        ASSERT_TRUE(stream.begin(total).ok());
+        for (std::size_t i = 0; i < cases.size(); ++i) {
+            Case& c = cases[i];
+            const auto& p = c.nodes.positions;
+            const float* r = c.nodes.radius_m.empty() ? nullptr : c.nodes.radius_m.data();
+            bool ok = false;
+            if (i % 2 == 0) {
+                ok = stream.write(c.wire, &p[0].x, p.size(), 24, r);
+            } else {
+                const glm::dvec3 origin = wire::float_point(p[0]);
+                std::vector<float> o;
+                for (const auto& q : p) o.insert(o.end(), {float(q.x - origin.x), float(q.y - origin.y), float(q.z - origin.z)});
+                // The offsets' own positions in double are what the curve stage must judge.
+                for (std::size_t j = 0; j < p.size(); ++j)
+                    c.nodes.positions[j] = origin + glm::dvec3(o[3 * j], o[3 * j + 1], o[3 * j + 2]);
+                const wire::SplineSettings spline{.closed = c.closed};
+                const wire::Status st = wire::check_curve_input(c.nodes, spline);
+                c.want = st.ok() ? "" : "stream wire " + std::to_string(c.wire.index) + ": " + st.message;
+                if (st.ok()) {
+                    std::vector<glm::dvec3> curve;
+                    const std::size_t m = wire::curve_nodes(c.nodes, spline, curve);
+                    c.segments = c.closed ? m : m - 1;
+                }
+                ok = stream.write(c.wire, origin, o.data(), p.size(), 12, r);
+            }
+            EXPECT_EQ(ok, c.want.empty()) << "case " << i << " frame " << f << ": " << c.want;
+            accepted += ok, refused += !ok;
+        }
+        const std::vector<wire::render::StreamError> errors = stream.errors();
+        for (const Case& c : cases) {
+            if (c.want.empty()) continue;
+            const auto it = std::find_if(errors.begin(), errors.end(), [&](const auto& e) { return e.wire == c.wire; });
+            ASSERT_NE(it, errors.end()) << c.want;
+            EXPECT_EQ(it->message, c.want);
+        }
+        // At node resolution every segment has a ring: the last ring's segment counts them.
+        DrawList list = nodes_list();
+        list.lod.keep_node_resolution = true;
+        ASSERT_TRUE(draw(streamed_, list).status.ok());
+        std::vector<DrawnRings> drawn;
+        ASSERT_TRUE(streamed_.read_drawn_rings(drawn).ok());
+        for (const DrawnRings& d : drawn) {
+            const auto it = std::find_if(cases.begin(), cases.end(),
+                                         [&](const Case& c) { return NodeStream::wire_id(c.wire) == d.wire_id; });
+            ASSERT_NE(it, cases.end());
+            EXPECT_TRUE(it->want.empty()) << "a refused wire was drawn";
+            EXPECT_EQ(d.rings.params.back().segment + 1, it->segments) << "merged otherwise than build_curve";
+        }
+        for (const Case& c : cases) stream.remove(c.wire);
+    }
+    std::printf("stream checks over %d random inputs: %zu accepted (%zu merged), %zu refused, each as the curve stage "
+                "decides\n", kPerFrame * kFrames, accepted, merged, refused);
+    EXPECT_GT(refused, 100u);
+    EXPECT_GT(accepted, 100u);
+    EXPECT_GT(merged, 10u);
+}
+
+}  // namespace
