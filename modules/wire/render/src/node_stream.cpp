@@ -1,204 +1,28 @@
-// The bulk node stream (node_stream.hpp) and the nodes path's part that emits its wires (node_path.hpp).
+// The bulk node stream (node_stream.hpp): its wires, frames and writes. The pass each node goes through is in
+// node_stream_pass.hpp; what draw() does with the stream's wires in node_stream_emit.cpp.
 #include "wire/render/node_stream.hpp"
 
 #include "node_path.hpp"
-#include "gpu_wire_data.hpp"
+#include "node_stream_pass.hpp"
+#include "node_stream_state.hpp"
 
 #include "wire/packed_nodes.hpp"
+#include "wire/render/gpu_curves.hpp"
 
-#include "engine/gfx/stream_buffer.hpp"
-
-#include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cfloat>
 #include <cmath>
 #include <cstring>
-#include <mutex>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include <optional>
 
 namespace wire::render {
-namespace detail {
-
-namespace gfx = engine::gfx;
-constexpr double kMaxCoordinate_m = 1e12;  // check_nodes' range (the second look applies it exactly)
-
-/// The stream's wires and this frame's region (NodeStream's state; the nodes path reads it at draw()).
-struct StreamState {
-    /// Per wire, what a frame reads and writes (dense by StreamWire::index).
-    struct Wire {
-        uint32_t node_first = 0, count = 0;  ///< this frame's write: first node in the region, curve nodes (merged)
-        uint32_t written = 0;                ///< frame of the last accepted write (0: none)
-        uint32_t slot = UINT32_MAX, segment_first = 0, segments = 0;
-        uint32_t sent_count = 0;             ///< curve nodes of the last upload the GPU got
-        float origin[3] = {0, 0, 0};         ///< this write's origin (a float point)
-        float centre[3] = {0, 0, 0};         ///< the last write's box centre as a float point (the next origin)
-        uint32_t material = 0;               ///< StreamStyle::material (read by every frame's pass over the wires)
-        bool has_centre = false, live = false, built = false, unmerged = false, sent_unmerged = false;
-    };
-    static_assert(sizeof(Wire) <= 64, "a wire's per-frame record in one cache line");
-    std::vector<Wire> wires;
-    std::vector<StreamStyle> styles;
-    std::vector<uint32_t> free;
-    std::size_t live = 0;
-
-    gfx::StreamBuffer buffer;
-    bool buffer_made = false;
-    gfx::StreamRegion region{};
-    bool active = false;      ///< begin() was called and the frame not drawn yet
-    uint32_t frame = 0;       ///< begin() count (Wire::written compares to it)
-    std::size_t header_capacity = 0, node_capacity = 0, header_at = 0, node_at = 0;
-    std::atomic<std::size_t> cursor{0};  ///< nodes used of the region's room
-    std::size_t headers = 0;             ///< headers emitted this frame
-    /// Wires written this frame that need a slot or another segment count (the draw allocates them serially).
-    std::vector<uint32_t> pending;
-    std::mutex pending_mutex;
-    void accepted(Wire& w, uint32_t index) {
-        w.written = frame;
-        const uint32_t segments = styles[index].closed ? w.count : w.count - 1;
-        if (w.slot != UINT32_MAX && segments == w.segments) return;
-        std::lock_guard lock(pending_mutex);
-        pending.push_back(index);
-    }
-
-    mutable std::mutex error_mutex;
-    std::vector<StreamError> errors;
-
-    NodePath* path = nullptr;  ///< the renderer's nodes path (null: not made)
-    Status unusable = Status::error("the node stream is not attached to a renderer (WireRenderer::node_stream())");
-
-    void refuse(uint32_t wire, int node, std::string message) {
-        std::lock_guard lock(error_mutex);
-        errors.push_back({StreamWire{wire}, node, "stream wire " + std::to_string(wire) + ": " + std::move(message)});
-    }
-};
-
 namespace {
-
 constexpr std::size_t kAlign = 256;
 std::size_t align_up(std::size_t v) { return (v + kAlign - 1) / kAlign * kAlign; }
-
-SplineSettings spline_of(const StreamStyle& s) {
-    SplineSettings spline;
-    spline.kind = s.kind;
-    spline.alpha = s.alpha;
-    spline.tension = s.tension, spline.bias = s.bias, spline.continuity = s.continuity;
-    spline.closed = s.closed;
-    spline.radius_m = s.radius_m;
-    return spline;
-}
-
-Status check_style(const StreamStyle& s) {
-    if (!gpu_builds(s.kind)) return Status::error("style: the GPU builds linear, Catmull-Rom, c2 and automatic wires");
-    WireNodes probe;
-    probe.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-    if (Status st = check_curve_input(probe, spline_of(s)); !st) {
-        return Status::error("style: " + st.message);
-    }
-    return Status::success();
-}
-
-/// What the copying pass measured: the offsets' box, the shortest chord (squared), whether every value passed.
-struct Measure {
-    glm::vec3 lo{FLT_MAX}, hi{-FLT_MAX};
-    float min_chord2 = FLT_MAX;
-    bool ok = true;
-};
-
-/// The one pass: node j's offset from `offset(j)` (its range check folded into ok), its radius, written as the
-/// curve pass reads it; the box and the shortest chord on the way.
-template <class Offset>
-Measure copy_nodes(std::size_t n, Offset offset, const float* radius, std::size_t radius_stride, float wire_radius,
-                   bool closed, glm::vec4* dst) {
-    Measure m;
-    glm::vec3 prev{};
-    bool ok = true;
-    for (std::size_t j = 0; j < n; ++j) {
-        bool in_range = true;
-        const glm::vec3 o = offset(j, in_range);
-        float r = wire_radius;
-        if (radius != nullptr) {
-            const float given = *reinterpret_cast<const float*>(reinterpret_cast<const char*>(radius) + j * radius_stride);
-            // Finite and >= 0, and 0 or at least the smallest radius (check_nodes'); NaN fails both.
-            in_range &= given >= 0.0f && given <= FLT_MAX && (given == 0.0f || given >= 1e-6f);
-            r = given > 0.0f ? given : wire_radius;
-        }
-        ok &= in_range;
-        dst[j] = glm::vec4(o, r);
-        m.lo = glm::min(m.lo, o), m.hi = glm::max(m.hi, o);
-        if (j > 0) {
-            const glm::vec3 d = o - prev;
-            m.min_chord2 = std::min(m.min_chord2, glm::dot(d, d));
-        }
-        prev = o;
-    }
-    if (closed && n >= 2) {
-        const glm::vec3 d = glm::vec3(dst[0]) - prev;
-        m.min_chord2 = std::min(m.min_chord2, glm::dot(d, d));
-    }
-    m.ok = ok;
-    return m;
-}
-
-#if defined(__SSE2__)
-/// copy_nodes for nodes without per-node radius, four lanes a node (x, y, z, radius): the offsets, their box and
-/// chords in SSE registers, the range test a mask (NaN fails it), no branch per node. `load(j, ok)` gives node j's
-/// offset with lane 3 zero and ANDs its range test into `ok`.
-template <class Load>
-Measure copy_nodes_sse(std::size_t n, Load load, float wire_radius, bool closed, glm::vec4* dst) {
-    Measure m;
-    if (n == 0) return m;
-    const __m128 radius = _mm_set_ps(wire_radius, 0.0f, 0.0f, 0.0f);
-    __m128 lo = _mm_set1_ps(FLT_MAX), hi = _mm_set1_ps(-FLT_MAX), chord = _mm_set1_ps(FLT_MAX);
-    __m128d ok = _mm_castsi128_pd(_mm_set1_epi32(-1));
-    const auto squared = [](__m128 d) {  // |d|^2 in every lane (lane 3 of d is zero)
-        const __m128 d2 = _mm_mul_ps(d, d);
-        const __m128 s = _mm_add_ps(d2, _mm_shuffle_ps(d2, d2, _MM_SHUFFLE(2, 3, 0, 1)));
-        return _mm_add_ps(s, _mm_shuffle_ps(s, s, _MM_SHUFFLE(1, 0, 3, 2)));
-    };
-    const __m128 first = load(0, ok);
-    __m128 prev = first;
-    _mm_store_ps(&dst[0].x, _mm_or_ps(first, radius));
-    lo = _mm_min_ps(lo, first), hi = _mm_max_ps(hi, first);
-    for (std::size_t j = 1; j < n; ++j) {
-        const __m128 o = load(j, ok);
-        _mm_store_ps(&dst[j].x, _mm_or_ps(o, radius));
-        lo = _mm_min_ps(lo, o), hi = _mm_max_ps(hi, o);
-        chord = _mm_min_ps(chord, squared(_mm_sub_ps(o, prev)));
-        prev = o;
-    }
-    if (closed && n >= 2) chord = _mm_min_ps(chord, squared(_mm_sub_ps(first, prev)));
-    alignas(16) float l[4], h[4];
-    _mm_store_ps(l, lo), _mm_store_ps(h, hi);
-    m.lo = glm::vec3(l[0], l[1], l[2]), m.hi = glm::vec3(h[0], h[1], h[2]);
-    m.min_chord2 = _mm_cvtss_f32(chord);
-    // NaN offsets leave the min/max alone: the range mask caught them (a NaN compares false).
-    m.ok = _mm_movemask_pd(ok) == 3;
-    return m;
-}
-#endif
-
-/// Whether nothing the merge rule (merge_nodes: eps = max(1e-9 diag, 64 DBL_EPSILON max |p|)) could join lies
-/// in the float offsets: the shortest chord clears eps by more than the offsets' rounding.
-bool clears_merge(const Measure& m, const glm::dvec3& origin, std::size_t n, bool closed) {
-    if (!m.ok || n < (closed ? 3u : 2u)) return false;
-    const glm::dvec3 lo(m.lo), hi(m.hi);
-    const double diag = glm::length(hi - lo);
-    const double max_abs = std::max(glm::length(origin + lo), glm::length(origin + hi));
-    const double eps = std::max(1e-9 * diag, 64.0 * DBL_EPSILON * max_abs);
-    const double reach = std::max(glm::length(lo), glm::length(hi));
-    const double margin = eps + 4e-7 * reach + 1e-30;  // float offsets: 2^-24 relative, a chord two of them
-    return static_cast<double>(m.min_chord2) > margin * margin;
-}
-
 }  // namespace
-}  // namespace detail
 
 using detail::StreamState;
 using detail::kMaxCoordinate_m;
@@ -267,10 +91,10 @@ Status NodeStream::begin(std::size_t nodes) {
     }
     s.header_capacity = s.wires.size();
     s.header_at = 0;
-    s.node_at = detail::align_up(std::max<std::size_t>(s.header_capacity, 1) * sizeof(GpuCurveHeader));
+    s.node_at = align_up(std::max<std::size_t>(s.header_capacity, 1) * sizeof(GpuCurveHeader));
     s.node_capacity = nodes;
     Expected<gfx::StreamRegion> region =
-        s.buffer.begin(s.node_at + detail::align_up(std::max<std::size_t>(nodes, 1) * sizeof(glm::vec4)));
+        s.buffer.begin(s.node_at + align_up(std::max<std::size_t>(nodes, 1) * sizeof(glm::vec4)));
     if (!region) return Status::error("node stream: " + region.error().message);
     s.region = *region;
     s.active = true;
@@ -545,183 +369,4 @@ std::size_t NodeStream::nodes_written() const {
     return std::min(state_->cursor.load(std::memory_order_relaxed), state_->node_capacity);
 }
 
-namespace detail {
-
-void attach_stream(NodePath& path, NodeStream& stream) {
-    StreamState& s = stream.state();
-    s.path = &path;
-    path.attach(&s);
-}
-void detach_stream(NodeStream& stream, const Status& why) {
-    StreamState& s = stream.state();
-    if (s.path != nullptr) s.path->attach(nullptr);
-    s.path = nullptr;
-    s.unusable = why;
-}
-bool stream_active(NodeStream& stream) { return stream.state().active; }
-void end_stream_frame(NodeStream& stream) {
-    StreamState& s = stream.state();
-    if (!s.active) return;
-    s.buffer.end();
-    s.active = false;
-}
-
-std::size_t NodePath::emit_stream(std::size_t materials, std::size_t& segments_visible, DrawStats& stats) {
-    StreamState& s = *stream_;
-    stream_wires_.clear();
-    stream_bytes_ = 0;
-    const uint32_t frame = s.active ? s.frame : 0;  // 0: nothing written this frame
-    const auto wire_count = static_cast<uint32_t>(s.wires.size());
-    // What a wire does this frame: 0 nothing, 1 its written nodes go to the GPU, 2 it is listed (drawn from its
-    // state on the GPU), 3 skipped (its material is out of range).
-    const auto role = [&](const StreamState::Wire& w, uint32_t) -> int {
-        if (!w.live) return 0;
-        if (w.material >= materials) return 3;
-        if (w.written == frame && frame != 0) return 1;
-        return w.built ? 2 : 0;
-    };
-    // (1) Serially, the few written wires that need a slot or another segment count (GL calls, the allocator).
-    for (uint32_t i : s.pending) {
-        StreamState::Wire& w = s.wires[i];
-        if (role(w, i) != 1) continue;
-        if (w.slot == UINT32_MAX) {
-            const std::optional<uint32_t> slot = acquire_slot();
-            if (!slot) {
-                w.written = 0;
-                ++stats.wires_skipped;
-                continue;
-            }
-            w.slot = *slot;
-            w.built = false;
-        }
-        const uint32_t segments = s.styles[i].closed ? w.count : w.count - 1;
-        if (segments == w.segments) continue;
-        free_segments(w.segment_first, w.segments);
-        w.segments = 0;
-        uint32_t first = 0;
-        if (!allocate_segments(segments, first)) {
-            w.built = false, w.written = 0;
-            ++stats.wires_skipped;
-            continue;
-        }
-        w.segment_first = first, w.segments = segments;
-        glClearNamedBufferSubData(slot_state_.id(), GL_R32UI, static_cast<GLintptr>(w.slot) * 32, 16, GL_RED_INTEGER,
-                                  GL_UNSIGNED_INT, nullptr);  // the LOD starts afresh (SlotState::lod)
-    }
-    s.pending.clear();
-    // (2) Per block of wires, in parallel: how many it sends and lists; then (3) each block writes its headers and
-    // list entries at its offsets (prefix sums), so the order is the wires' whatever the threads.
-    constexpr uint32_t kBlock = 4096;
-    const uint32_t blocks = (wire_count + kBlock - 1) / kBlock;
-    struct Block {
-        std::size_t changed = 0, listed = 0, segments = 0, bytes = 0;
-        uint32_t bad_material = UINT32_MAX;
-        std::vector<uint8_t> used;
-    };
-    std::vector<Block> block(blocks);
-    const auto over_blocks = [&](auto&& body) {
-        if (wire_count >= 2 * kBlock) {
-            tbb::parallel_for(uint32_t{0}, blocks, [&](uint32_t b) { body(b); });
-        } else {
-            for (uint32_t b = 0; b < blocks; ++b) body(b);
-        }
-    };
-    over_blocks([&](uint32_t b) {
-        Block& k = block[b];
-        for (uint32_t i = b * kBlock; i < std::min(wire_count, (b + 1) * kBlock); ++i) {
-            const int r = role(s.wires[i], i);
-            k.changed += r == 1, k.listed += r == 2;
-            if (r == 3 && k.bad_material == UINT32_MAX) k.bad_material = i;
-        }
-    });
-    std::size_t changed = 0, listed = 0;
-    std::vector<std::size_t> changed_at(blocks), listed_at(blocks);
-    for (uint32_t b = 0; b < blocks; ++b) {
-        changed_at[b] = changed, listed_at[b] = listed;
-        changed += block[b].changed, listed += block[b].listed;
-        if (block[b].bad_material != UINT32_MAX && stats.status.ok()) {
-            const uint32_t i = block[b].bad_material;
-            stats.status = Status::error("stream wire " + std::to_string(i) + ": material " +
-                                         std::to_string(s.styles[i].material) + " is out of range (" +
-                                         std::to_string(materials) + " materials): not drawn");
-        }
-    }
-    const std::size_t visible_before = visible_slots_.size(), listed_before = listed_.size();
-    visible_slots_.resize(visible_before + listed);
-    listed_.resize(listed_before + listed);
-    stream_wires_.resize(changed);
-    auto* headers = s.active ? reinterpret_cast<GpuCurveHeader*>(s.region.data + s.header_at) : nullptr;
-    over_blocks([&](uint32_t b) {
-        Block& k = block[b];
-        k.used.assign(materials, 0);
-        std::size_t c = changed_at[b], l = listed_at[b];
-        for (uint32_t i = b * kBlock; i < std::min(wire_count, (b + 1) * kBlock); ++i) {
-            StreamState::Wire& w = s.wires[i];
-            const int r = role(w, i);
-            if (r == 0 || r == 3) continue;
-            const StreamStyle& style = s.styles[i];
-            const Dispatched d{NodeStream::wire_id(StreamWire{i}), w.slot, w.segment_first, w.segments};
-            if (r == 1) {
-                const uint32_t kind = style.kind == SplineKind::linear      ? kKindLinear
-                                      : style.kind == SplineKind::c2        ? kKindC2
-                                      : style.kind == SplineKind::automatic ? kKindAutomatic
-                                                                            : kKindCatmullRom;
-                const uint32_t sides = style.max_sides ? std::max<uint32_t>(style.max_sides, 3) : 16u;
-                // The GPU fits the motion by index where the last upload had these nodes' count and neither merged.
-                const bool fit = w.built && w.sent_count == w.count && w.sent_unmerged && w.unmerged;
-                GpuCurveHeader h;
-                h.node_first = w.node_first;
-                h.node_count = w.count;
-                h.segment_first = w.segment_first;
-                h.flags = (style.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) |
-                          (style.caps ? kHeaderCaps : 0u) | (fit ? kHeaderFitMotion : 0u) |
-                          (std::min<uint32_t>(sides, 255u) << 8) | (style.material << kHeaderMaterialShift);
-                h.alpha = static_cast<float>(style.alpha), h.tension = static_cast<float>(style.tension);
-                h.bias = static_cast<float>(style.bias), h.continuity = static_cast<float>(style.continuity);
-                h.slot = w.slot;
-                std::memcpy(h.origin_m, w.origin, sizeof h.origin_m);
-                std::memcpy(headers + c, &h, sizeof h);  // mapped memory: written once, never read
-                w.built = true;
-                w.sent_count = w.count;
-                w.sent_unmerged = w.unmerged;
-                stream_wires_[c++] = d;
-                k.bytes += sizeof(GpuCurveHeader) + std::size_t{w.count} * sizeof(glm::vec4);
-            } else {
-                visible_slots_[visible_before + l] = w.slot;
-                listed_[listed_before + l] = d;
-                ++l;
-            }
-            k.segments += w.segments;
-            k.used[style.material] = 1;
-        }
-    });
-    for (const Block& k : block) {
-        segments_visible += k.segments;
-        stream_bytes_ += k.bytes;
-        for (std::size_t m = 0; m < k.used.size(); ++m) material_used_[m] |= k.used[m];
-    }
-    s.headers = changed;
-    return changed;
-}
-
-NodePath::StreamLayout NodePath::stream_layout() const {
-    const StreamState& s = *stream_;
-    StreamLayout l;
-    l.buffer = s.region.buffer;
-    l.header_at = s.region.offset_bytes + s.header_at;
-    l.header_bytes = std::max<std::size_t>(s.headers, 1) * sizeof(GpuCurveHeader);
-    l.node_at = s.region.offset_bytes + s.node_at;
-    l.node_bytes = std::max<std::size_t>(std::min(s.cursor.load(), s.node_capacity), 1) * sizeof(glm::vec4);
-    return l;
-}
-
-std::size_t NodePath::stream_nodes() const { return std::min(stream_->cursor.load(), stream_->node_capacity); }
-std::size_t NodePath::stream_wires() const { return stream_->wires.size(); }
-
-void NodePath::unbuild_stream() {
-    StreamState& s = *stream_;
-    for (const Dispatched& d : stream_wires_) s.wires[static_cast<uint32_t>(d.wire_id)].built = false;
-}
-
-}  // namespace detail
 }  // namespace wire::render
