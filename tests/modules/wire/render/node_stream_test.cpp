@@ -535,3 +535,80 @@ TEST_F(NodeStreamTest, AcceptsExactlyWhatTheCurveStageAcceptsOverARandomFamily) 
 }
 
 }  // namespace
+
+namespace {
+
+// One renderer drawing entities' items and streamed wires in the same frame (the curve passes of both, and wires
+// of both that did not change, listed) draws each wire as the renderer that draws only that kind draws it: over 6
+// frames where some wires of each kind move, some stay and some are not written.
+TEST_F(NodeStreamTest, ListAndStreamInOneDrawAsEachAlone) {
+    const glm::dvec3 centre(-3.0e4, 1.0e3, 2.0e4);
+    const std::vector<StreamCase> cases = stream_family(centre);
+    camera_.target = centre + glm::dvec3(200.0, 120.0, 0.0);
+    camera_.position = camera_.target + glm::dvec3(40.0, -90.0, 520.0);
+    camera_.near_m = 20.0f, camera_.far_m = 2000.0f;
+    auto made = WireRenderer::create();
+    ASSERT_TRUE(made.ok());
+    WireRenderer both = std::move(made).value();
+    NodeStream& mixed = both.node_stream();
+    NodeStream& alone = streamed_.node_stream();
+    // Even cases: list items (in `both` and `list_`); odd: streamed (in `both` and `streamed_`).
+    std::vector<StreamWire> in_mixed(cases.size()), in_alone(cases.size());
+    for (std::size_t k = 1; k < cases.size(); k += 2) {
+        in_mixed[k] = mixed.add(cases[k].style).value();
+        in_alone[k] = alone.add(cases[k].style).value();
+    }
+    std::size_t compared = 0;
+    double worst = 0.0;
+    for (int f = 0; f < 6; ++f) {
+        std::vector<wire::WireNodes> nodes;
+        for (const StreamCase& c : cases) nodes.push_back(at_frame(c, f < 2 ? f : (f % 3 == 0 ? f : f - 1)));
+        DrawList list = nodes_list();
+        std::size_t stream_nodes = 0;
+        for (std::size_t k = 0; k < cases.size(); k += 2) {
+            DrawItem item;
+            item.wire_id = 1000 + k;
+            item.nodes = &nodes[k];
+            item.spline = wire::SplineSettings{.kind = cases[k].style.kind, .radius_m = cases[k].style.radius_m};
+            // Every third wire keeps its generation from frame 1 on: unchanged, listed.
+            item.nodes_generation = (k / 2) % 3 == 0 ? static_cast<uint64_t>(std::min(f, 1) + 1) : static_cast<uint64_t>(f + 1);
+            if ((k / 2) % 3 == 0) nodes[k] = at_frame(cases[k], std::min(f, 1));
+            item.fit_motion = f > 0;
+            item.sides = cases[k].style.max_sides;
+            list.items.push_back(item);
+        }
+        for (std::size_t k = 1; k < cases.size(); k += 2) stream_nodes += nodes[k].size();
+        ASSERT_TRUE(mixed.begin(stream_nodes).ok());
+        ASSERT_TRUE(alone.begin(stream_nodes).ok());
+        for (std::size_t k = 1; k < cases.size(); k += 2) {
+            if (f > 1 && (k / 2) % 3 == 0) continue;  // not written: drawn from its state on the GPU
+            ASSERT_TRUE(mixed.write(in_mixed[k], &nodes[k].positions[0].x, nodes[k].size()));
+            ASSERT_TRUE(alone.write(in_alone[k], &nodes[k].positions[0].x, nodes[k].size()));
+        }
+        ASSERT_TRUE(draw(both, list).status.ok());
+        std::vector<DrawnRings> got;
+        ASSERT_TRUE(both.read_drawn_rings(got).ok());
+        ASSERT_TRUE(draw(list_, list).status.ok());
+        ASSERT_TRUE(draw(streamed_, nodes_list()).status.ok());
+        std::vector<DrawnRings> want, want_stream;
+        ASSERT_TRUE(list_.read_drawn_rings(want).ok());
+        ASSERT_TRUE(streamed_.read_drawn_rings(want_stream).ok());
+        want.insert(want.end(), want_stream.begin(), want_stream.end());
+        ASSERT_EQ(got.size(), want.size()) << "frame " << f;
+        for (const DrawnRings& g : got) {
+            const auto it = std::find_if(want.begin(), want.end(), [&](const DrawnRings& d) { return d.wire_id == g.wire_id; });
+            ASSERT_NE(it, want.end()) << g.wire_id;
+            ASSERT_EQ(it->rings.params.size(), g.rings.params.size()) << g.wire_id << " frame " << f;
+            ++compared;
+            for (std::size_t i = 0; i < g.rings.params.size(); ++i) {
+                worst = std::max(worst, glm::length((g.rings.origin_m + g.rings.centre_m[i]) -
+                                                    (it->rings.origin_m + it->rings.centre_m[i])));
+                worst = std::max(worst, angle(g.rings.frames[i].r, it->rings.frames[i].r));
+            }
+        }
+    }
+    EXPECT_EQ(compared, 6 * cases.size());
+    EXPECT_EQ(worst, 0.0) << "the same inputs through the same programs";
+}
+
+}  // namespace
