@@ -182,7 +182,9 @@ bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t
             n,
             [&](std::size_t j, __m128d& ok) {
                 const auto* p = reinterpret_cast<const double*>(base + j * stride);
-                const __m128d xy = _mm_loadu_pd(p), z = _mm_load_sd(p + 2);
+                double pz;  // a caller's doubles need not be 8-byte aligned (any stride): loaded unaligned
+                std::memcpy(&pz, p + 2, sizeof pz);
+                const __m128d xy = _mm_loadu_pd(p), z = _mm_set_sd(pz);
                 ok = _mm_and_pd(ok, _mm_cmple_pd(_mm_andnot_pd(sign, xy), limit));
                 ok = _mm_and_pd(ok, _mm_unpacklo_pd(_mm_cmple_sd(_mm_andnot_pd(sign, z), limit), ok));
                 return _mm_movelh_ps(_mm_cvtpd_ps(_mm_sub_pd(xy, oxy)), _mm_cvtpd_ps(_mm_sub_sd(z, oz)));
@@ -243,7 +245,7 @@ bool write_float(StreamState& s, uint32_t index, const glm::dvec3& given_origin,
             [&](std::size_t j, __m128d& ok) {
                 const auto* p = reinterpret_cast<const float*>(base + j * stride);
                 // 12 bytes (a 16-byte load could read past the caller's last node).
-                const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+                const __m128 xy = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));  // unaligned
                 const __m128 o = _mm_add_ps(_mm_movelh_ps(xy, _mm_load_ss(p + 2)), add);
                 // Each half's sign bit (what movemask_pd reads) the AND of its two lanes' tests.
                 const __m128 in = _mm_cmple_ps(_mm_andnot_ps(sign, o), lim);
