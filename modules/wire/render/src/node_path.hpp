@@ -1,6 +1,8 @@
 // Internal: the renderer's nodes path (UploadPath::gpu_nodes, issue 30). Per frame the CPU sends, for the visible
 // wires whose nodes changed, their curve nodes and a 64-byte header (into the renderer's fenced stream region),
-// plus a 4-byte slot per visible wire; everything after that runs in compute dispatches: the curve (into
+// plus a 4-byte slot per other visible wire (the curve passes list the changed ones); the node stream's wires
+// (node_stream.hpp) arrive with their headers and nodes in the stream's own region, and get a curve pass of their
+// own. Everything after that runs in compute dispatches: the curve (into
 // persistent per-wire segments), the LOD (below the node resolution unless the settings keep it; hysteresis state per wire kept on the GPU), the
 // indirect commands, the rings with their frames and u, the draw and chunk records; then the gpu-rings vertex
 // shader draws them with one multi-draw per (class, material), reading commands the GPU wrote.
@@ -144,8 +146,8 @@ private:
     };
     std::vector<Piece> node_pieces_, extra_pieces_;
     std::vector<uint32_t> visible_slots_;
-    /// Per wire the last prepare() dispatched, in dispatch order (the changed wires' headers, then the listed):
-    /// what read_rings() needs to find its records.
+    /// Per wire the last prepare() dispatched, in the ring pass's order (the listed, then the list's changed wires,
+    /// then the stream's): what read_rings() needs to find its records.
     struct Dispatched {
         uint64_t wire_id = 0;
         uint32_t slot = 0, segment_first = 0, segments = 0;
