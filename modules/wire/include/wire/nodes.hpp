@@ -46,6 +46,10 @@ enum class SplineKind : uint8_t {
 /// The radius of a wire whose settings and nodes give none (0): 1 cm. Metres.
 inline constexpr float kDefaultWireRadius_m = 0.01f;
 
+/// Largest accepted |coordinate| of a node, metres (the curve stage refuses a node beyond it): the tube's float
+/// vertices (relative to ring 0) and squared chord lengths must stay finite; 1e12 m is far beyond any scene.
+inline constexpr double kMaxCoordinate_m = 1e12;
+
 /// Settings of the curve stage. Default-initialized (`SplineSettings{}` or `{.closed = true}`) is sensible:
 /// centripetal Catmull-Rom, no tension, open wire, radius 1 cm, merge epsilon 1e-9 of the scene scale.
 struct SplineSettings {

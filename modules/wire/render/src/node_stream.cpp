@@ -25,7 +25,6 @@ std::size_t align_up(std::size_t v) { return (v + kAlign - 1) / kAlign * kAlign;
 }  // namespace
 
 using detail::StreamState;
-using detail::kMaxCoordinate_m;
 namespace gfx = engine::gfx;
 
 NodeStream::NodeStream() : state_(std::make_unique<StreamState>()) {}
@@ -157,15 +156,38 @@ bool refuse_room(StreamState& s, uint32_t index, std::size_t count) {
     return false;
 }
 
+/// After the pass: the wire as measured (origin, count, the next double write's origin), or, where the pass could
+/// not clear it, as the second look finds it (refused, or merged).
+template <class Position>
+bool finish_write(StreamState& s, uint32_t index, std::size_t first, std::size_t n, const detail::Measure& m,
+                  const glm::dvec3& origin, Position at, const float* radius, std::size_t radius_stride,
+                  glm::vec4* dst) {
+    StreamState::Wire& w = s.wires[index];
+    if (!detail::clears_merge(m, origin, n, s.styles[index].closed)) {
+        if (!second_look(s, index, n, at, radius, radius_stride, dst)) return false;
+    } else {
+        w.count = static_cast<uint32_t>(n);
+        w.unmerged = true;
+        for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(origin[a]);
+        const glm::dvec3 centre = float_point(origin + 0.5 * (glm::dvec3(m.lo) + glm::dvec3(m.hi)));
+        for (int a = 0; a < 3; ++a) w.centre[a] = static_cast<float>(centre[a]);
+        w.has_centre = true;
+    }
+    w.node_first = static_cast<uint32_t>(first);
+    s.accepted(w, index);
+    return true;
+}
+
 bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t n, std::size_t stride,
                   const float* radius, std::size_t radius_stride, std::optional<std::size_t> first) {
     StreamState::Wire& w = s.wires[index];
     const StreamStyle& style = s.styles[index];
     if (!first) return refuse_room(s, index, n);
     auto* dst = reinterpret_cast<glm::vec4*>(s.region.data + s.node_at) + *first;
-    const auto at = [&](std::size_t j) {
-        const auto* p = reinterpret_cast<const double*>(reinterpret_cast<const char*>(xyz) + j * stride);
-        return glm::dvec3(p[0], p[1], p[2]);
+    const auto at = [&](std::size_t j) {  // the caller's doubles need not be 8-byte aligned (any stride)
+        glm::dvec3 p;
+        std::memcpy(&p.x, reinterpret_cast<const char*>(xyz) + j * stride, sizeof p);
+        return p;
     };
     // The origin: last frame's box centre (a moving wire moves little in a frame), else the first node.
     glm::dvec3 origin = w.has_centre ? glm::dvec3(w.centre[0], w.centre[1], w.centre[2]) : (n ? at(0) : glm::dvec3(0));
@@ -201,24 +223,11 @@ bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t
             return glm::vec3(p - origin);
         },
         radius, radius_stride, wire_radius, style.closed, dst);
-    if (!detail::clears_merge(m, origin, n, style.closed)) {
-        if (!second_look(s, index, n, at, radius, radius_stride, dst)) return false;
-    } else {
-        w.count = static_cast<uint32_t>(n);
-        w.unmerged = true;
-        for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(origin[a]);
-        const glm::dvec3 centre = float_point(origin + 0.5 * (glm::dvec3(m.lo) + glm::dvec3(m.hi)));
-        for (int a = 0; a < 3; ++a) w.centre[a] = static_cast<float>(centre[a]);
-        w.has_centre = true;
-    }
-    w.node_first = static_cast<uint32_t>(*first);
-    s.accepted(w, index);
-    return true;
+    return finish_write(s, index, *first, n, m, origin, at, radius, radius_stride, dst);
 }
 
 bool write_float(StreamState& s, uint32_t index, const glm::dvec3& given_origin, const float* xyz, std::size_t n,
                  std::size_t stride, const float* radius, std::size_t radius_stride, std::optional<std::size_t> first) {
-    StreamState::Wire& w = s.wires[index];
     const StreamStyle& style = s.styles[index];
     if (!first) return refuse_room(s, index, n);
     auto* dst = reinterpret_cast<glm::vec4*>(s.region.data + s.node_at) + *first;
@@ -266,16 +275,7 @@ bool write_float(StreamState& s, uint32_t index, const glm::dvec3& given_origin,
     // Near the +-1e12 m edge the float test is not the double one: the second look decides there.
     m.ok &= origin_ok && glm::length(origin) + glm::length(glm::max(glm::abs(glm::dvec3(m.lo)), glm::abs(glm::dvec3(m.hi)))) <
                              0.5 * kMaxCoordinate_m;
-    if (!detail::clears_merge(m, origin, n, style.closed)) {
-        if (!second_look(s, index, n, at, radius, radius_stride, dst)) return false;
-    } else {
-        w.count = static_cast<uint32_t>(n);
-        w.unmerged = true;
-        for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(origin[a]);
-    }
-    w.node_first = static_cast<uint32_t>(*first);
-    s.accepted(w, index);
-    return true;
+    return finish_write(s, index, *first, n, m, origin, at, radius, radius_stride, dst);
 }
 
 bool check_wire(StreamState& s, StreamWire wire) {

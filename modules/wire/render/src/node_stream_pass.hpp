@@ -20,7 +20,6 @@
 
 namespace wire::render::detail {
 
-constexpr double kMaxCoordinate_m = 1e12;  // check_nodes' range (the second look applies it exactly)
 
 
 

@@ -8,9 +8,7 @@
 
 namespace wire::curve_stage {
 
-// Largest accepted |coordinate| (metres): the tube's float vertices (relative to ring 0) and squared chord
-// lengths must stay finite; 1e12 m is far beyond any scene (DESIGN §5 asks for 1e6 m from the origin).
-constexpr double kMaxCoordinate_m = 1e12;
+// Largest accepted |coordinate|: wire::kMaxCoordinate_m (nodes.hpp; DESIGN §5 asks for 1e6 m from the origin).
 
 // A value as the messages write it: %.9g, NaN, +Inf, -Inf.
 std::string describe(double v);
