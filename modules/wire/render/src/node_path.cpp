@@ -443,11 +443,13 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     // does not fit is drawn with, until the buffer has grown from the count read back).
     const std::size_t reserve = segments_visible + visible_;
     const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
-    std::size_t scratch_nodes = std::max<std::size_t>({changed_ ? node_total : 0, stream_changed_ ? stream_nodes() : 0, 1});
+    // c2 scratch, 2 dvec4 a node: the list's wires', then the stream's (at an aligned offset).
+    const std::size_t stream_scratch_at = changed_ ? align_up(node_total * 2 * 32) : 0;
+    const std::size_t scratch_need = stream_scratch_at + (stream_changed_ ? stream_nodes() * 2 * 32 : 0);
     const auto need = [&](gfx::Buffer& b, std::size_t& capacity, std::size_t bytes, const char* label) {
         return ensure(b, capacity, bytes, label, false);
     };
-    Status made = need(scratch_, scratch_bytes_, scratch_nodes * 2 * 32, "wire nodes: c2 scratch");
+    Status made = need(scratch_, scratch_bytes_, std::max<std::size_t>(scratch_need, 64), "wire nodes: c2 scratch");
     if (made) made = need(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs");
     if (made) made = need(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws");
     if (made) made = need(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings");
@@ -489,44 +491,38 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
         last_visible_ = visible_slots_;
     }
 
-    // (1) Curves of the wires whose nodes changed, into their slots' segments and headers.
-    if (changed_ != 0) {
+    // (1) Curves of the wires whose nodes changed, into their slots' segments and headers: the list's (headers and
+    // nodes in this frame's region), then the stream's (in the stream's region). Both write disjoint slots, list
+    // entries and c2 scratch (the stream's after the list's), so they need no barrier between them.
+    const auto curve_pass = [&](unsigned buffer, std::size_t header_at, std::size_t header_size, std::size_t nodes_at,
+                                std::size_t nodes_size, std::size_t scratch_at, std::size_t wires, std::size_t list_first) {
         curve_program_.use();
-        range(kCurveHeaders, 0, header_bytes);
-        range(kCurveNodes, node_at, node_bytes);
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveHeaders, buffer, static_cast<GLintptr>(header_at),
+                          static_cast<GLsizeiptr>(header_size));
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveNodes, buffer, static_cast<GLintptr>(nodes_at),
+                          static_cast<GLsizeiptr>(nodes_size));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSegments, segments_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveScratch, scratch_.id());
-        range(kCurveExtras, extra_at, extra_bytes);
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveScratch, scratch_.id(), static_cast<GLintptr>(scratch_at),
+                          static_cast<GLsizeiptr>(scratch_bytes_ - scratch_at));
+        range(kCurveExtras, extra_at, extra_bytes);  // the streamed wires carry none (the list's range, unread)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotHeaders, slot_headers_.id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveMotionRefs, motion_refs_.id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotList, visible_kept_.id());
-        glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(changed_));
+        glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(wires));
         glUniform1i(curve_program_.uniform_location("u_persist"), 1);
         glUniform1i(curve_program_.uniform_location("u_motion"), 1);
         glUniform1i(curve_program_.uniform_location("u_list"), 1);
-        glUniform1ui(curve_program_.uniform_location("u_list_first"), static_cast<GLuint>(unchanged_));
-        glDispatchCompute(static_cast<GLuint>((changed_ + 63) / 64), 1, 1);
+        glUniform1ui(curve_program_.uniform_location("u_list_first"), static_cast<GLuint>(list_first));
+        glDispatchCompute(static_cast<GLuint>((wires + 63) / 64), 1, 1);
+    };
+    if (changed_ != 0) {
+        curve_pass(region.buffer, region.offset_bytes, header_bytes, region.offset_bytes + node_at, node_bytes, 0, changed_,
+                   unchanged_);
     }
     if (stream_changed_ != 0) {
-        // The streamed wires' curves: their headers and nodes lie in the stream's region (written by the game).
         const StreamLayout layout = stream_layout();
-        curve_program_.use();
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveHeaders, layout.buffer, static_cast<GLintptr>(layout.header_at),
-                          static_cast<GLsizeiptr>(layout.header_bytes));
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveNodes, layout.buffer, static_cast<GLintptr>(layout.node_at),
-                          static_cast<GLsizeiptr>(layout.node_bytes));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSegments, segments_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveScratch, scratch_.id());
-        range(kCurveExtras, extra_at, extra_bytes);  // unread: the streamed wires carry no extras
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotHeaders, slot_headers_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveMotionRefs, motion_refs_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotList, visible_kept_.id());
-        glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(stream_changed_));
-        glUniform1i(curve_program_.uniform_location("u_persist"), 1);
-        glUniform1i(curve_program_.uniform_location("u_motion"), 1);
-        glUniform1i(curve_program_.uniform_location("u_list"), 1);
-        glUniform1ui(curve_program_.uniform_location("u_list_first"), static_cast<GLuint>(unchanged_ + changed_));
-        glDispatchCompute(static_cast<GLuint>((stream_changed_ + 63) / 64), 1, 1);
+        curve_pass(layout.buffer, layout.header_at, layout.header_bytes, layout.node_at, layout.node_bytes,
+                   stream_scratch_at, stream_changed_, unchanged_ + changed_);
     }
     if (changed_ + stream_changed_ != 0) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     // (2) LOD, (3) commands, (4) rings and records, over the visible wires.
