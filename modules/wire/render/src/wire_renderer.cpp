@@ -537,6 +537,12 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     s.drawn_any = true;
     if (list.path == UploadPath::gpu_nodes) return s.draw_nodes(list, camera, settings);
     DrawStats stats;
+    if (s.node_stream && detail::stream_active(*s.node_stream)) {
+        // The stream's wires are computed by the nodes path only: said, not dropped in silence; the list draws.
+        detail::end_stream_frame(*s.node_stream);
+        s.failed(stats, Status::error("the node stream's wires draw on the nodes path; this draw list is on '" +
+                                      std::string(upload_path_name(list.path)) + "': they were not drawn"));
+    }
     const bool cpu = list.path == UploadPath::cpu_mesh;
     const bool retained = !cpu && s.desc.retain_rings;
 

@@ -394,6 +394,15 @@ TEST_F(NodeStreamTest, OutOfRoomAndStaleWritesAreRefusedNamingWhy) {
     ASSERT_EQ(errors.size(), 1u);
     EXPECT_NE(errors[0].message.find("no room for its 4 nodes (begin() reserved 6"), std::string::npos) << errors[0].message;
     EXPECT_FALSE(stream.write(StreamWire{99}, xyz, 4));
+    // A frame drawn with a list on another path: the stream's wires are not drawn, and draw() says why.
+    ASSERT_TRUE(stream.begin(4).ok());
+    ASSERT_TRUE(stream.write(a, xyz, 4));
+    DrawList cpu;
+    cpu.path = UploadPath::cpu_mesh;
+    const auto stats = draw(streamed_, cpu);
+    EXPECT_NE(stats.status.message.find("the node stream's wires draw on the nodes path; this draw list is on 'cpu'"),
+              std::string::npos)
+        << stats.status.message;
     const auto bad_style = stream.add({.alpha = std::numeric_limits<double>::quiet_NaN()});
     ASSERT_FALSE(bad_style.ok());
     EXPECT_EQ(bad_style.error().message, "style: settings.alpha is NaN");
