@@ -7,6 +7,9 @@
 #include <engine/ecs/registry.hpp>
 #include <engine/ecs/schedule.hpp>
 #include <engine/gfx/lit_renderer.hpp>
+#include <engine/gfx/mesh.hpp>
+#include <engine/gfx/shadow.hpp>
+#include <engine/scene/light_view.hpp>
 #include <engine/platform/capture.hpp>
 #include <engine/platform/context.hpp>
 #include <wire/io/wire_json.hpp>
@@ -17,6 +20,7 @@
 #include <wire/systems/systems.hpp>
 
 #include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -56,7 +60,14 @@ struct ViewOptions {
     std::optional<std::string> spline;
     std::string path;  ///< auto|cpu|gpu|nodes; empty: auto
     std::string png_out, csv_out, stats_out;
+    std::optional<double> ground_y;  ///< --ground: a horizontal plane at this height
+    std::string light;               ///< --light DX,DY,DZ: toward the shadow-casting directional light
 };
+
+/// The light the view draws with: toward (0.3, 1, 0.4) unless --light says otherwise.
+constexpr glm::dvec3 kDefaultToLight{0.3, 1.0, 0.4};
+constexpr int kShadowMapPx = 2048;
+
 
 /// A bad input or command line: exit 2, nothing written.
 struct BadInput {
@@ -105,6 +116,21 @@ CameraPose parse_camera_option(const std::string& text) {
     c.target = {v[3], v[4], v[5]};
     if (!(glm::length(c.target - c.eye) > 0.0)) throw BadInput{"--camera: eye and target must differ"};
     return c;
+}
+
+glm::dvec3 parse_light_option(const std::string& text) {
+    std::vector<double> v;
+    bool numbers = !text.empty() && text.back() != ',';
+    std::stringstream ss(text);
+    for (std::string cell; numbers && std::getline(ss, cell, ',');) {
+        double d = 0;
+        numbers = parse_number(cell, d);
+        v.push_back(d);
+    }
+    if (!numbers || v.size() != 3) throw BadInput{"--light: expected DX,DY,DZ (3 finite numbers), got '" + text + "'"};
+    const glm::dvec3 d{v[0], v[1], v[2]};
+    if (!(glm::length(d) > 0.0)) throw BadInput{"--light: the direction must not be zero"};
+    return glm::normalize(d);
 }
 
 /// An up vector for lookAt: the given one, or +y, or (if +y is parallel to the view direction) -z / +z.
@@ -259,6 +285,7 @@ int run_view(const ViewOptions& o) try {
     const double aspect = static_cast<double>(width) / height;
     std::optional<CameraPose> cli_camera;
     if (!o.camera.empty()) cli_camera = parse_camera_option(o.camera);
+    if (!o.light.empty()) (void)parse_light_option(o.light);  // a bad value is said before anything runs
     const double cli_fov = o.fov_deg.value_or(kDefaultFovDeg);
     // Chosen once the renderer is made: the named path, or (auto) the renderer's preferred_path().
     wire::UploadPath path = wire::UploadPath::cpu_mesh;
@@ -327,10 +354,56 @@ int run_view(const ViewOptions& o) try {
     std::vector<wire::systems::ErrorReport> runtime_errors;
     ctx.on_error = [&](const wire::systems::ErrorReport& e) { runtime_errors.push_back(e); };
     wire::systems::install(schedule, ctx);
+    // Shadows (--ground, --light): a map from the directional light fitted to the frame's wires (an orthographic
+    // view along the light maps a caster and its shadow to the same texel, so the wires' sphere is enough), drawn
+    // each frame from the same list with its own view (view 1: its own LOD on the nodes path).
+    const bool shadows = o.ground_y.has_value() || !o.light.empty();
+    const glm::dvec3 to_light = o.light.empty() ? glm::normalize(kDefaultToLight) : parse_light_option(o.light);
+    std::optional<engine::gfx::ShadowMap> shadow_map;
+    std::optional<engine::gfx::LitRenderer> ground_renderer;
+    std::optional<engine::gfx::GpuMesh> ground_mesh;
+    if (shadows) {
+        auto map = engine::gfx::ShadowMap::create(kShadowMapPx);
+        if (!map) throw Failure{exit_failure, "cannot create the shadow map: " + map.error().message};
+        shadow_map = std::move(*map);
+    }
+    if (o.ground_y) {
+        auto lit = engine::gfx::LitRenderer::create();
+        if (!lit) throw Failure{exit_failure, "cannot create the ground renderer: " + lit.error().message};
+        ground_renderer = std::move(*lit);
+        auto mesh = engine::gfx::upload_mesh(engine::gfx::make_plane_mesh(1.0f), "ground");
+        if (!mesh) throw Failure{exit_failure, "cannot upload the ground: " + mesh.error().message};
+        ground_mesh = std::move(*mesh);
+    }
+    Bounds frame_bounds;  // this frame's wires (set before each run)
     wire::render::DrawStats drawn;
     schedule.add("wire.render", [&](engine::ecs::Registry&, const engine::ecs::FrameContext&) {
         wire::render::DrawSettings settings;
-        settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
+        settings.light = {.to_light = glm::vec3(to_light), .ambient = 0.35f, .specular = 0.25f};
+        if (shadow_map) {
+            shadow_map->light = engine::scene::directional_light_view(to_light, frame_bounds.centre,
+                                                                       1.25 * std::max(frame_bounds.radius_m, 1e-6));
+            shadow_map->begin();
+            const wire::render::DrawStats cast = renderer.draw(
+                ctx.draw_list, shadow_map->light, {.output = wire::render::Output::depth, .view = 1});
+            shadow_map->end();
+            if (!cast.status.ok()) throw Failure{exit_failure, "the wire renderer could not draw the shadow map: " + cast.status.message};
+            settings.shadow = &*shadow_map;
+        }
+        if (ground_renderer) {
+            // A square under the wires reaching past their shadows, drawn eye-relative (exact far from the origin).
+            const engine::scene::Camera& cam = ctx.camera;
+            const double drop = std::abs(frame_bounds.centre.y - *o.ground_y);
+            const double slant = glm::length(glm::dvec2(to_light.x, to_light.z)) / std::max(std::abs(to_light.y), 0.05);
+            const double half = 3.0 * frame_bounds.radius_m + drop * std::min(slant, 20.0);
+            const glm::dvec3 centre{frame_bounds.centre.x, *o.ground_y, frame_bounds.centre.z};
+            const glm::mat4 model = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(centre - cam.position)),
+                                               glm::vec3(static_cast<float>(half)));
+            ground_renderer->begin(cam.clip_from_relative(),
+                                   {.to_light = glm::vec3(to_light), .color = glm::vec3(1.0f), .ambient = 0.35f},
+                                   shadow_map ? &*shadow_map : nullptr, cam.position);
+            ground_renderer->draw(*ground_mesh, model, glm::vec3(0.55f, 0.55f, 0.52f));
+        }
         drawn = renderer.draw(ctx.draw_list, ctx.camera, settings);
         if (!drawn.status.ok()) throw Failure{exit_failure, "the wire renderer could not draw: " + drawn.status.message};
     });
@@ -367,7 +440,12 @@ int run_view(const ViewOptions& o) try {
         // tiny near plane would make the LOD refine every segment that crosses it to its maximum count).
         const double reach = 1.25 * b.radius_m;
         const double distance = glm::length(pose.eye - b.centre);
-        const double far_m = 1.01 * (distance + reach);
+        double far_m = 1.01 * (distance + reach);
+        frame_bounds = b;
+        if (o.ground_y) {  // the ground reaches past the wires: so does the far plane
+            const double drop = std::abs(b.centre.y - *o.ground_y);
+            far_m = std::max(far_m, 1.01 * (distance + drop + 4.0 * reach + 20.0 * drop));
+        }
         const double close_near_m = std::max(1e-5 * far_m, std::min(0.05, 0.01 * reach));
         const double near_m = std::max(0.5 * (distance - reach), close_near_m);
         engine::scene::Camera& cam = ctx.camera;
@@ -533,6 +611,12 @@ Action add_view_command(CLI::App& app) {
     cmd->add_option("--csv", o->csv_out, "Write one row per ring of every visible wire and frame (the mesh ring CSV "
                                          "plus the sides the LOD chose)");
     cmd->add_option("--stats", o->stats_out, "Write per-frame statistics (JSON) with the measured screen error");
+    cmd->add_option("--ground", o->ground_y,
+                    "Y: draw a horizontal ground plane at height Y metres (the environment's shading) that receives "
+                    "the wires' shadows; turns shadows on");
+    cmd->add_option("--light", o->light,
+                    "DX,DY,DZ: direction toward the directional light (default 0.3,1,0.4); it casts shadows (2048 px "
+                    "map fitted to the wires) onto the ground and the wires; turns shadows on");
     return [o] { return run_view(*o); };
 }
 

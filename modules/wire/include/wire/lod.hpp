@@ -65,7 +65,8 @@
 namespace wire {
 
 /// A perspective camera as the LOD sees it, in double: GL conventions (right-handed view space looking down -z).
-/// Build it with LodView::perspective(); the fields are derived and compared as a whole to detect camera motion.
+/// Build it with LodView::perspective() (or orthographic()); the fields are derived and compared as a whole to
+/// detect camera motion.
 struct LodView {
     glm::dvec3 eye_m{};                  ///< camera position, world metres
     glm::dmat4 view_from_world{1.0};     ///< view matrix (glm::lookAt)
@@ -83,6 +84,19 @@ struct LodView {
     [[nodiscard]] static LodView perspective(const glm::dvec3& eye_m, const glm::dvec3& target_m, const glm::dvec3& up,
                                              double fov_y_rad, double width_px, double height_px, double near_m,
                                              double far_m);
+
+    /// An orthographic view (glm::ortho(-h aspect, h aspect, -h, h, near, far) looking from eye_m at target_m, h =
+    /// half_height_m) as the LOD sees it: the perspective view from a point far behind eye_m whose frustum holds the
+    /// orthographic box and whose pixels per metre inside it are within 1% of the box's (the tangent is chosen so
+    /// the near face is exactly the box's; the eye is 100 box depths back). The LOD's perspective bounds therefore
+    /// hold within that 1%. Its eye_m is the far eye: the renderer places positions relative to it and draws them
+    /// with the orthographic projection moved back by the same distance (orthographic_back_m()).
+    [[nodiscard]] static LodView orthographic(const glm::dvec3& eye_m, const glm::dvec3& target_m, const glm::dvec3& up,
+                                              double half_height_m, double width_px, double height_px, double near_m,
+                                              double far_m);
+    /// How far behind an orthographic view's eye orthographic() puts the LOD's eye: 100 box depths (far - near),
+    /// at least 100 half heights.
+    [[nodiscard]] static double orthographic_back_m(double half_height_m, double near_m, double far_m);
 
     /// View-space position (x right, y up, z = depth in front of the camera, positive).
     [[nodiscard]] glm::dvec3 to_view(const glm::dvec3& world_m) const;

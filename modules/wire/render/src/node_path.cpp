@@ -101,6 +101,7 @@ std::size_t NodePath::gl_buffers() const {
                                  &rings_, &buckets_, &commands_, &counter_, &templates_, &readback_, &visible_kept_}) {
         n += b->id() != 0 ? 1 : 0;
     }
+    for (const gfx::Buffer& b : view_states_) n += b.id() != 0 ? 1 : 0;
     return n;
 }
 
@@ -126,6 +127,14 @@ Status NodePath::grow_slots(std::size_t slots) {
     const std::size_t old = slot_state_bytes_;
     if (Status st = ensure(slot_state_, slot_state_bytes_, want * kSlotStateBytes, "wire nodes: slot state", true); !st) return st;
     if (slot_state_bytes_ > old) clear_range(slot_state_, old, slot_state_bytes_ - old);
+    for (gfx::Buffer& state : view_states_) {
+        if (state.id() == 0 || state.size_bytes() >= slot_state_bytes_) continue;
+        auto made = gfx::make_buffer({.size_bytes = slot_state_bytes_, .label = "wire nodes: view slot state"});
+        if (!made) return made.error();
+        glCopyNamedBufferSubData(state.id(), made->id(), 0, 0, static_cast<GLsizeiptr>(state.size_bytes()));
+        clear_range(*made, state.size_bytes(), slot_state_bytes_ - state.size_bytes());
+        state = std::move(*made);
+    }
     const std::size_t old_refs = motion_ref_bytes_;
     if (Status st = ensure(motion_refs_, motion_ref_bytes_, want * kMotionRefBytes, "wire nodes: motion references", true);
         !st) {
@@ -145,6 +154,26 @@ Status NodePath::grow_segments(std::size_t segments) {
     return Status::success();
 }
 
+const gfx::Buffer* NodePath::view_state(uint32_t view) {
+    if (view == 0) return &slot_state_;
+    if (view_states_.size() < view) view_states_.resize(view);
+    gfx::Buffer& state = view_states_[view - 1];
+    if (state.id() == 0 && slot_state_bytes_ != 0) {
+        auto made = gfx::make_buffer({.size_bytes = slot_state_bytes_, .label = "wire nodes: view slot state"});
+        if (!made) return nullptr;
+        clear_range(*made, 0, slot_state_bytes_);  // every wire's LOD starts afresh in a new view
+        state = std::move(*made);
+    }
+    return &state;
+}
+
+void NodePath::clear_slot_state(uint32_t index, std::size_t bytes) {
+    clear_range(slot_state_, index * kSlotStateBytes, bytes);
+    for (const gfx::Buffer& state : view_states_) {
+        if (state.id() != 0) clear_range(state, index * kSlotStateBytes, bytes);
+    }
+}
+
 std::optional<uint32_t> NodePath::acquire_slot() {
     uint32_t index = 0;
     if (free_slots_.empty()) {
@@ -154,7 +183,7 @@ std::optional<uint32_t> NodePath::acquire_slot() {
         index = free_slots_.back();
         free_slots_.pop_back();
     }
-    clear_range(slot_state_, index * kSlotStateBytes, kSlotStateBytes);
+    clear_slot_state(index, kSlotStateBytes);
     clear_range(motion_refs_, index * kMotionRefBytes, 32);  // no reference: nothing to fit against
     return index;
 }
@@ -217,7 +246,7 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
            align_up(std::max<std::size_t>(extras, 16)) + align_up(std::max<std::size_t>(4 * visible, 4)) + kAlign;
 }
 
-bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera, const gfx::StreamRegion& region,
+bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_index, const gfx::StreamRegion& region,
                        const NodeDrawContext& ctx, DrawStats& stats) {
     ++frame_;
     // The ring buffer's size: the counts the GPU reported kReadbackSlots frames ago, read only once the fence
@@ -333,7 +362,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
                 }
                 slot.segment_first = first, slot.segments = segments;
                 up.headers.back().segment_first = first;
-                clear_range(slot_state_, slot.index * kSlotStateBytes, 16);  // the LOD starts afresh
+                clear_slot_state(slot.index, 16);  // the LOD starts afresh
             }
             slot.generation = item.nodes_generation;
             slot.built = true;
@@ -532,7 +561,8 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingJobs, jobs_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounts, counts_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingRings, rings_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSlots, slot_state_.id());
+    const gfx::Buffer* state = view_state(view_index);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSlots, state != nullptr ? state->id() : slot_state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounter, counter_.id());
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kRingVisible, visible_kept_.id(), 0, static_cast<GLsizeiptr>(list_bytes));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingDraws, draws_.id());
@@ -541,11 +571,6 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCommands, commands_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingTemplates, templates_.id());
     const auto at = [&](const char* name) { return ring_program_.uniform_location(name); };
-    GLint viewport[4] = {0, 0, 1, 1};
-    glGetIntegerv(GL_VIEWPORT, viewport);
-    const LodView view = LodView::perspective(camera.position, camera.target, camera.up, camera.fov_y_rad,
-                                              std::max(viewport[2], 1), std::max(viewport[3], 1), camera.near_m,
-                                              camera.far_m);
     set_lod_uniforms(ring_program_, view, lod_);
     glUniform1i(at("u_lod"), 1);
     glUniform1i(at("u_draw"), 1);
@@ -578,7 +603,7 @@ bool NodePath::prepare(const DrawList& list, const engine::scene::Camera& camera
     return true;
 }
 
-void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats) {
+void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, bool depth_only) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, draws_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, rings_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.circle);
@@ -590,6 +615,7 @@ void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats) {
     const auto draw = [&](std::size_t m, uint32_t first_slot, uint32_t slots) {
         const Material& material = ctx.materials[m];
         ctx.program.set("u_tint", material.tint);
+        ctx.program.set("u_roughness", material.roughness);
         ctx.textures[material.texture].bind(0);
         const auto* indirect =
             reinterpret_cast<const void*>((m * per_material + std::size_t{first_slot} * 6) * 20);
@@ -600,9 +626,11 @@ void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats) {
     for (std::size_t m = 0; m < materials_; ++m) {
         if (m < material_used_.size() && material_used_[m]) draw(m, 2, side_slots_ - 2);
     }
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-    glDepthMask(GL_FALSE);
+    if (!depth_only) {
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+        glDepthMask(GL_FALSE);
+    }
     for (std::size_t m = 0; m < materials_; ++m) {
         if (m < material_used_.size() && material_used_[m]) draw(m, 1, 1);
     }

@@ -54,12 +54,13 @@ public:
     void set_lod(const LodSettings& lod);
 
     /// Uploads and computes the frame (see the file comment) into `region` (begun by the caller with at least
-    /// upload_bytes(list) bytes); returns false (nothing to draw) when no item draws. The patterns in `ctx` must
-    /// cover max_sides().
-    bool prepare(const DrawList& list, const engine::scene::Camera& camera, const engine::gfx::StreamRegion& region,
+    /// upload_bytes(list) bytes) as seen by `lod_view` (positions relative to its eye), with view `view`'s LOD and
+    /// frame state (< kMaxViews; each view keeps its own hysteresis); returns false (nothing to draw) when no item
+    /// draws. The patterns in `ctx` must cover max_sides().
+    bool prepare(const DrawList& list, const LodView& lod_view, uint32_t view, const engine::gfx::StreamRegion& region,
                  const NodeDrawContext& ctx, DrawStats& stats);
-    /// Issues the draws prepare() set up.
-    void submit(const NodeDrawContext& ctx, DrawStats& stats);
+    /// Issues the draws prepare() set up; depth_only: the phone-wire lines write depth too and are not blended.
+    void submit(const NodeDrawContext& ctx, DrawStats& stats, bool depth_only = false);
     /// Bytes prepare() writes into the region for `list` (an upper bound; computed per frame).
     std::size_t upload_bytes(const DrawList& list);
     /// The rings the last prepare() computed and submit() drew (WireRenderer::read_drawn_rings); waits for the GPU.
@@ -89,6 +90,10 @@ private:
         bool built = false;  ///< its curve is on the GPU
     };
     Status grow_slots(std::size_t slots);
+    /// View `view`'s LOD and frame state (view 0: slot_state_), made (cleared) on first use; null if it cannot be.
+    const engine::gfx::Buffer* view_state(uint32_t view);
+    /// Clears `bytes` of slot `index`'s state in every view's buffer (16: the LOD only, kSlotStateBytes: all).
+    void clear_slot_state(uint32_t index, std::size_t bytes);
     Status grow_segments(std::size_t segments);
     Status ensure(engine::gfx::Buffer& buffer, std::size_t& capacity, std::size_t bytes, const char* label,
                   bool keep_contents);
@@ -117,6 +122,7 @@ private:
     engine::gfx::RangeAllocator segment_ranges_{0, 1};  ///< the segment storage's ranges, in segments
     // Persistent (GPU only).
     engine::gfx::Buffer slot_headers_, slot_state_, motion_refs_, segments_, counts_;
+    std::vector<engine::gfx::Buffer> view_states_;  ///< views 1 ..: their slot state (same size as slot_state_)
     std::size_t slot_capacity_ = 0, segment_capacity_ = 0;
     std::size_t slot_header_bytes_ = 0, slot_state_bytes_ = 0, motion_ref_bytes_ = 0, segment_bytes_ = 0,
                 count_bytes_ = 0;

@@ -73,8 +73,7 @@ std::size_t NodePath::emit_stream(std::size_t materials, std::size_t& segments_v
             continue;
         }
         w.segment_first = first, w.segments = segments;
-        glClearNamedBufferSubData(slot_state_.id(), GL_R32UI, static_cast<GLintptr>(w.slot) * 32, 16, GL_RED_INTEGER,
-                                  GL_UNSIGNED_INT, nullptr);  // the LOD starts afresh (SlotState::lod)
+        clear_slot_state(w.slot, 16);  // the LOD starts afresh (SlotState::lod)
     }
     s.pending.clear();
     // (2) Per block of wires, in parallel: how many it sends and lists; then (3) each block writes its headers and

@@ -4,6 +4,8 @@
 // pattern.
 #include "shaders.hpp"
 
+#include "engine/gfx/shadow.hpp"
+
 namespace wire::render::detail {
 namespace {
 
@@ -257,20 +259,42 @@ uniform vec3 u_light_color;
 uniform float u_ambient;     // fraction of albedo on the unlit side
 uniform float u_specular;    // Blinn-Phong specular strength
 uniform float u_shininess;
+uniform float u_roughness;   // the material's (G-buffer output)
+// The shadow map's visibility at this fragment (1 lit, 0 in shadow; 1 without a map): the default shading scales
+// the light's diffuse and specular by it; a shading hook may read it.
+float wire_shadow = 1.0;
+)";
+
+constexpr std::string_view kColorOutput = R"(
 out vec4 o_color;
+)";
+
+// The default G-buffer layout: 0 normal (world, * 0.5 + 0.5), 1 albedo, 2 (roughness, 0, 0, 1).
+constexpr std::string_view kDefaultGbuffer = R"(
+layout(location = 0) out vec4 o_normal;
+layout(location = 1) out vec4 o_albedo;
+layout(location = 2) out vec4 o_material;
+void write_gbuffer(vec3 albedo, vec3 n, vec3 rel_m, float roughness) {
+  o_normal = vec4(n * 0.5 + 0.5, 1.0);
+  o_albedo = vec4(albedo, 1.0);
+  o_material = vec4(roughness, 0.0, 0.0, 1.0);
+}
 )";
 
 constexpr std::string_view kDefaultShading = R"(
 vec3 shade(vec3 albedo, vec3 n, vec3 to_eye) {
-  float diffuse = max(dot(n, u_to_light), 0.0);
+  float diffuse = max(dot(n, u_to_light), 0.0) * wire_shadow;
   vec3 h = normalize(u_to_light + to_eye);
-  float spec = diffuse > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
+  float spec = diffuse > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) * wire_shadow : 0.0;
   return (albedo * (u_ambient + (1.0 - u_ambient) * diffuse) + u_specular * spec) * u_light_color;
 }
 )";
 
-constexpr std::string_view kFragmentMain = R"(
-void main() {
+// The surface at this fragment: albedo, unit normal (facing the eye), unit direction to the eye, opacity.
+constexpr std::string_view kSurface = R"(
+struct Surface { vec3 albedo; vec3 n; vec3 to_eye; float alpha; };
+Surface surface() {
+  Surface o;
   if (v_mode != 0u) {
     // The tube a strip stands for: across = t x (to eye), facing = the to-eye direction without its t part;
     // the tube point seen at strip coordinate s has normal s across + sqrt(1 - s^2) facing (a phone-wire line
@@ -286,15 +310,36 @@ void main() {
     float v = fract(atan(dot(n, v_frame_s), dot(n, v_frame_r)) * 0.15915494);
     // Gradients of the continuous (u, s / 4) instead of v: no mip seam where v wraps.
     vec2 g = vec2(v_uv.x, 0.25 * v_strip);
-    vec3 albedo = textureGrad(u_texture, vec2(v_uv.x, v), dFdx(g), dFdy(g)).rgb * u_tint;
-    o_color = vec4(shade(albedo, n, to_eye), v_alpha);
-    return;
+    o.albedo = textureGrad(u_texture, vec2(v_uv.x, v), dFdx(g), dFdy(g)).rgb * u_tint;
+    o.n = n, o.to_eye = to_eye, o.alpha = v_alpha;
+    return o;
   }
-  vec3 n = normalize(v_normal);
-  if (!gl_FrontFacing) n = -n;  // wireframe and cut-away views see back faces
-  vec3 albedo = texture(u_texture, v_uv).rgb * u_tint;
-  o_color = vec4(shade(albedo, n, normalize(-v_rel_m)), 1.0);
+  o.n = normalize(v_normal);
+  if (!gl_FrontFacing) o.n = -o.n;  // wireframe and cut-away views see back faces
+  o.albedo = texture(u_texture, v_uv).rgb * u_tint;
+  o.to_eye = normalize(-v_rel_m), o.alpha = 1.0;
+  return o;
 }
+)";
+
+constexpr std::string_view kColorMain = R"(
+void main() {
+  Surface o = surface();
+  wire_shadow = shadow_visibility(v_rel_m, o.n);
+  o_color = vec4(shade(o.albedo, o.n, o.to_eye), o.alpha);
+}
+)";
+
+constexpr std::string_view kGbufferMain = R"(
+void main() {
+  Surface o = surface();
+  write_gbuffer(o.albedo, o.n, v_rel_m, u_roughness);
+}
+)";
+
+// Depth only: no outputs, nothing read.
+constexpr std::string_view kDepthFragment = R"(#version 450 core
+void main() {}
 )";
 
 }  // namespace
@@ -307,14 +352,19 @@ std::string vertex_source(bool cpu_mesh, bool draw_parameters) {
     return s;
 }
 
-std::string fragment_source(std::string_view shading) {
+std::string fragment_source(FragmentOutput output, std::string_view shading, std::string_view gbuffer) {
+    if (output == FragmentOutput::depth) return std::string(kDepthFragment);
     std::string s(kFragmentHead);
-    if (shading.empty()) {
-        s += kDefaultShading;
-    } else {
-        s += shading;
+    s += kSurface;
+    if (output == FragmentOutput::gbuffer) {
+        s += gbuffer.empty() ? kDefaultGbuffer : gbuffer;
+        s += kGbufferMain;
+        return s;
     }
-    s += kFragmentMain;
+    s += kColorOutput;
+    s += engine::gfx::shadow_glsl();
+    s += shading.empty() ? kDefaultShading : shading;
+    s += kColorMain;
     return s;
 }
 

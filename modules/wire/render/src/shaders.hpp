@@ -28,8 +28,11 @@ inline constexpr uint32_t kStreamedRings = 32u;
 /// (ARB_shader_draw_parameters), else the instanced attribute at location 3 (divisor 1; its buffer holds 0, 1,
 /// 2, ... so it reads baseInstance + instance).
 std::string vertex_source(bool cpu_mesh, bool draw_parameters);
-/// `shading`: optional GLSL defining vec3 shade(vec3 albedo, vec3 n, vec3 to_eye); empty: the default
-/// lighting.
-std::string fragment_source(std::string_view shading);
+/// What a fragment shader writes (WireRenderer's Output).
+enum class FragmentOutput { color, depth, gbuffer };
+/// `shading` (color): optional GLSL defining vec3 shade(vec3 albedo, vec3 n, vec3 to_eye); empty: the default
+/// lighting. `gbuffer` (gbuffer): optional GLSL declaring its outputs and defining void write_gbuffer(vec3 albedo,
+/// vec3 n, vec3 rel_m, float roughness); empty: the default layout. depth: a shader that writes nothing.
+std::string fragment_source(FragmentOutput output, std::string_view shading, std::string_view gbuffer);
 
 }  // namespace wire::render::detail

@@ -79,8 +79,11 @@ void append_pattern(uint32_t n, std::vector<uint32_t>& out) {
 
 struct WireRenderer::State {
     RendererDesc desc;
-    gfx::Program cpu_program;
-    gfx::Program rings_program;
+    gfx::Program cpu_program;    ///< colour output
+    gfx::Program rings_program;  ///< colour output (the nodes path draws with it too)
+    /// Depth and G-buffer outputs, [0] cpu-mesh, [1] rings: compiled with their first draw.
+    std::array<gfx::Program, 2> depth_programs, gbuffer_programs;
+    std::string cpu_vertex, rings_vertex, gbuffer_glsl;  ///< kept for those compiles
     gfx::VertexArray cpu_vao;
     gfx::VertexArray rings_vao;
     gfx::Buffer draw_index_buffer;  ///< 0, 1, 2, ... for the instanced chunk-index attribute (fallback only)
@@ -158,6 +161,54 @@ struct WireRenderer::State {
         return stats;
     }
 
+    /// The program of `output` for cpu-mesh or the rings (compiled on first use); null: it did not build (why).
+    const gfx::Program* program_for(bool cpu, Output output, Status& why) {
+        if (output == Output::color) return cpu ? &cpu_program : &rings_program;
+        const bool depth = output == Output::depth;
+        gfx::Program& program = (depth ? depth_programs : gbuffer_programs)[cpu ? 0 : 1];
+        if (program.id() != 0) return &program;
+        const std::string fragment = detail::fragment_source(
+            depth ? detail::FragmentOutput::depth : detail::FragmentOutput::gbuffer, {}, gbuffer_glsl);
+        const std::string label = std::string(cpu ? "wire cpu-mesh" : "wire gpu-rings") + (depth ? " depth" : " gbuffer");
+        Expected<gfx::Program> made =
+            gfx::make_program({.vertex = cpu ? cpu_vertex : rings_vertex, .fragment = fragment, .label = label});
+        if (!made) {
+            why = Status::error(label + ": " + made.error().message);
+            return nullptr;
+        }
+        program = std::move(made).value();
+        return &program;
+    }
+
+    /// The camera a draw places positions and projects with, and the LOD's view of it.
+    struct View {
+        engine::scene::Camera camera;  ///< at the eye positions are relative to
+        LodView lod;
+    };
+    /// `camera` at settings.eye_m (if set) over the bound viewport; an orthographic camera is moved back to the
+    /// eye of LodView::orthographic() with its clip box unchanged (positions relative to that eye).
+    static View view_of(const engine::scene::Camera& camera, const DrawSettings& settings) {
+        GLint viewport[4] = {0, 0, 1, 1};
+        glGetIntegerv(GL_VIEWPORT, viewport);
+        const double w = std::max(viewport[2], 1), h = std::max(viewport[3], 1);
+        View v{camera, {}};
+        const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
+        v.camera.target += eye - camera.position;
+        v.camera.position = eye;
+        const engine::scene::Camera& c = v.camera;
+        if (!c.orthographic()) {
+            v.lod = LodView::perspective(c.position, c.target, c.up, c.fov_y_rad, w, h, c.near_m, c.far_m);
+            return v;
+        }
+        v.lod = LodView::orthographic(c.position, c.target, c.up, c.ortho_half_height_m, w, h, c.near_m, c.far_m);
+        const double back = LodView::orthographic_back_m(c.ortho_half_height_m, c.near_m, c.far_m);
+        v.camera.target += v.lod.eye_m - v.camera.position;
+        v.camera.position = v.lod.eye_m;
+        v.camera.near_m = static_cast<float>(back + c.near_m);
+        v.camera.far_m = static_cast<float>(back + c.far_m);
+        return v;
+    }
+
     /// The frame's GL state and the wire program's per-frame uniforms (both paths that draw rings, and cpu-mesh).
     void begin_wires(const gfx::Program& program, const engine::scene::Camera& camera, const DrawSettings& settings) {
         glEnable(GL_DEPTH_TEST);
@@ -179,8 +230,8 @@ struct WireRenderer::State {
         glGetIntegerv(GL_VIEWPORT, viewport);
         program.set("u_viewport_px", glm::vec2(static_cast<float>(std::max(viewport[2], 1)),
                                                static_cast<float>(std::max(viewport[3], 1))));
-        program.set("u_focal_px",
-                    0.5f * static_cast<float>(std::max(viewport[3], 1)) / std::tan(0.5f * camera.fov_y_rad));
+        program.set("u_focal_px", camera.focal_px(static_cast<float>(std::max(viewport[3], 1))));
+        if (settings.output == Output::color) gfx::set_shadow_uniforms(program, settings.shadow, camera.position);
     }
 
     /// The gpu-nodes frame (node_path.hpp).
@@ -194,20 +245,23 @@ struct WireRenderer::State {
         if (!begun) return failed(stats, begun.error());
         stats.buffer_grew = begun->grew;
         stats.waited_for_gpu = begun->waited;
-        const detail::NodeDrawContext ctx{rings_program, rings_vao, circle.id(), pattern_first, materials, textures,
+        Status no_program;
+        const gfx::Program* program = program_for(false, settings.output, no_program);
+        if (program == nullptr) {
+            stream.end();
+            return failed(stats, no_program);
+        }
+        const detail::NodeDrawContext ctx{*program, rings_vao, circle.id(), pattern_first, materials, textures,
                                           draw_parameters};
-        glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
-        engine::scene::Camera at_eye = camera;
-        at_eye.target += eye - camera.position;
-        at_eye.position = eye;
-        const bool drawn = nodes->prepare(list, at_eye, *begun, ctx, stats);
+        const View view = view_of(camera, settings);
+        const bool drawn = nodes->prepare(list, view.lod, std::min(settings.view, kMaxViews - 1), *begun, ctx, stats);
         const bool streamed = node_stream && detail::stream_active(*node_stream);
         if (!stats.status.ok()) failed(stats, stats.status);
         Status index_capacity = drawn ? ensure_draw_index_capacity(nodes->chunk_capacity()) : Status::success();
         if (!index_capacity) failed(stats, index_capacity);
         if (drawn && index_capacity) {
-            begin_wires(rings_program, camera, settings);
-            nodes->submit(ctx, stats);
+            begin_wires(*program, view.camera, settings);
+            nodes->submit(ctx, stats, settings.output != Output::color);
             glBindVertexArray(0);
             if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         }
@@ -334,9 +388,13 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     s.draw_parameters = !desc.force_draw_index_attribute &&
                         epoxy_has_gl_extension("GL_ARB_shader_draw_parameters");  // the 450 source's `require`
 
-    const std::string fragment = detail::fragment_source(desc.shading_glsl);
-    const std::string cpu_vertex = detail::vertex_source(true, s.draw_parameters);
-    const std::string rings_vertex = detail::vertex_source(false, s.draw_parameters);
+    const std::string fragment = detail::fragment_source(detail::FragmentOutput::color, desc.shading_glsl, {});
+    s.cpu_vertex = detail::vertex_source(true, s.draw_parameters);
+    s.rings_vertex = detail::vertex_source(false, s.draw_parameters);
+    s.gbuffer_glsl = std::string(desc.gbuffer_glsl);
+    s.desc.shading_glsl = {}, s.desc.gbuffer_glsl = {};  // views of the caller's strings: not kept
+    const std::string& cpu_vertex = s.cpu_vertex;
+    const std::string& rings_vertex = s.rings_vertex;
     Expected<gfx::Program> cpu =
         gfx::make_program({.vertex = cpu_vertex, .fragment = fragment, .label = "wire cpu-mesh"});
     if (!cpu) return cpu.error();
@@ -680,7 +738,8 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     stats.waited_for_gpu = region.waited;
 
     // Fill the region with sequential writes only (write-combined memory: never read it back).
-    const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
+    const State::View view = State::view_of(camera, settings);
+    const glm::dvec3 eye = view.camera.position;
     std::byte* base = region.data;
     const auto first_index_base = static_cast<uint32_t>((region.offset_bytes + index_offset) / sizeof(uint32_t));
     if (cpu) {
@@ -751,8 +810,15 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     stats.indirect_commands = s.commands.size();
 
     // (3) Submit: GL state for the wires, the mode's program and vertex array, one multi-draw per run.
-    const gfx::Program& program = cpu ? s.cpu_program : s.rings_program;
-    s.begin_wires(program, camera, settings);
+    Status no_program;
+    const gfx::Program* chosen = s.program_for(cpu, settings.output, no_program);
+    if (chosen == nullptr) {
+        s.stream.end();
+        if (retained) s.ring_storage.end_frame();
+        return s.failed(stats, no_program);
+    }
+    const gfx::Program& program = *chosen;
+    s.begin_wires(program, view.camera, settings);
 
     const GLuint buffer = region.buffer;
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, buffer, static_cast<GLintptr>(region.offset_bytes),
@@ -789,7 +855,8 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     for (std::size_t run = 0; run + 1 < s.run_first.size(); ++run) {
         const DrawItem& head = list.items[s.order[s.run_first[run]]];
         const bool line = head.sides == 1;
-        if (line && !blending) {  // phone-wire lines: opacity = true width / drawn width, over the opaque wires
+        // Phone-wire lines: opacity = true width / drawn width, over the opaque wires (colour output only).
+        if (line && !blending && settings.output == Output::color) {
             glEnable(GL_BLEND);
             glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
             glDepthMask(GL_FALSE);
@@ -797,6 +864,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         }
         const Material& material = s.materials[head.material];
         program.set("u_tint", material.tint);
+        program.set("u_roughness", material.roughness);
         s.textures[material.texture].bind(0);
         const auto* indirect = reinterpret_cast<const void*>(
             region.offset_bytes + command_offset + s.run_command[run] * sizeof(DrawElementsIndirectCommand));

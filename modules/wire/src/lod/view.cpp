@@ -38,6 +38,22 @@ LodView LodView::perspective(const glm::dvec3& eye_m, const glm::dvec3& target_m
     return v;
 }
 
+double LodView::orthographic_back_m(double half_height_m, double near_m, double far_m) {
+    return 100.0 * std::max(far_m - near_m, half_height_m);
+}
+
+LodView LodView::orthographic(const glm::dvec3& eye_m, const glm::dvec3& target_m, const glm::dvec3& up,
+                              double half_height_m, double width_px, double height_px, double near_m, double far_m) {
+    // Perspective from `back` behind the eye, its near plane on the box's near face with the box's half height
+    // there: the frustum widens with depth, so it holds the box, and pixels per metre fall from the box's value
+    // at its near face by (back + near) / (back + far) >= 1 - (far - near) / back = 0.99 at its far face.
+    const double back = orthographic_back_m(half_height_m, near_m, far_m);
+    const glm::dvec3 forward = glm::normalize(target_m - eye_m);
+    const glm::dvec3 far_eye = eye_m - forward * back;
+    const double fov_y = 2.0 * std::atan(half_height_m / (back + near_m));
+    return perspective(far_eye, target_m, up, fov_y, width_px, height_px, back + near_m, back + far_m);
+}
+
 glm::dvec3 LodView::to_view(const glm::dvec3& world_m) const {
     const glm::dvec4 q = view_from_world * glm::dvec4(world_m, 1.0);
     return {q.x, q.y, -q.z};

@@ -100,7 +100,7 @@ TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
     EXPECT_EQ(stride(*curves, "refs[0].origin"), static_cast<GLint>(kMotionRefBytes));
     for (const bool draw_parameters : {true, false}) {
         const std::string vertex = vertex_source(false, draw_parameters);
-        const std::string fragment = fragment_source("");
+        const std::string fragment = fragment_source(FragmentOutput::color, "", "");
         auto rings = gfx::make_program({.vertex = vertex, .fragment = fragment, .label = "layout: ring vertex"});
         ASSERT_TRUE(rings.ok()) << rings.error().message;
         EXPECT_EQ(stride(*rings, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));

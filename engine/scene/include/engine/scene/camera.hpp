@@ -1,5 +1,6 @@
-// Perspective camera: position, look-at target, vertical field of view; GL clip conventions (z in [-1, 1],
-// right-handed view space looking down -z), as glm::perspective and glm::lookAt produce them.
+// Camera: position, look-at target, and a vertical field of view (perspective) or a half height (orthographic:
+// a directional light's shadow map, a top-down map); GL clip conventions (z in [-1, 1], right-handed view space
+// looking down -z), as glm::perspective, glm::ortho and glm::lookAt produce them.
 //
 // Open-world coordinates: the eye and the target are double, so a camera 1e6 m from the origin still moves in
 // 1 mm steps (a float there steps by 6 cm). Draw camera-relative: positions as offsets from the eye (computed
@@ -19,7 +20,7 @@
 /// Camera and frustum.
 namespace engine::scene {
 
-/// A perspective camera looking from `position` at `target` (see the file comment for the conventions).
+/// A camera looking from `position` at `target` (see the file comment for the conventions).
 struct Camera {
     glm::dvec3 position{0.0, 0.0, 5.0};     ///< eye, world metres (double: see the file comment)
     glm::dvec3 target{0.0};                 ///< the point looked at, world metres
@@ -28,6 +29,9 @@ struct Camera {
     float aspect = 16.0f / 9.0f;            ///< width / height
     float near_m = 0.1f;                    ///< near clip distance, metres
     float far_m = 1000.0f;                  ///< far clip distance, metres
+    /// > 0: orthographic, the view box +-ortho_half_height_m tall and +-aspect times that wide (fov_y_rad unused);
+    /// 0: perspective.
+    float ortho_half_height_m = 0.0f;
 
     /// View matrix (world -> view space), glm::lookAt computed in double and rounded to float: its
     /// translation is the eye in float, so prefer view_relative() away from the origin.
@@ -35,8 +39,16 @@ struct Camera {
     /// The view's rotation only (the eye at the origin): maps offsets from the eye (world metres) to view
     /// space.
     glm::mat4 view_relative() const { return glm::mat4(glm::lookAt(glm::dvec3(0.0), target - position, up)); }
-    /// Projection matrix (view -> clip space), glm::perspective.
-    glm::mat4 projection() const { return glm::perspective(fov_y_rad, aspect, near_m, far_m); }
+    /// Projection matrix (view -> clip space), glm::perspective (glm::ortho when orthographic).
+    glm::mat4 projection() const {
+        if (orthographic()) {
+            const float h = ortho_half_height_m;
+            return glm::ortho(-h * aspect, h * aspect, -h, h, near_m, far_m);
+        }
+        return glm::perspective(fov_y_rad, aspect, near_m, far_m);
+    }
+    /// ortho_half_height_m > 0.
+    [[nodiscard]] bool orthographic() const { return ortho_half_height_m > 0.0f; }
     /// projection() * view(): world -> clip space (exact near the origin only; see view()).
     glm::mat4 view_projection() const { return projection() * view(); }
     /// projection() * view_relative(): offsets from the eye -> clip space, exact at any distance from the
@@ -46,8 +58,10 @@ struct Camera {
     glm::dvec3 forward() const { return glm::normalize(target - position); }
 
     /// Focal length in pixels for a viewport `height_px` tall: (H/2) / tan(fovY/2). A length L at view depth
-    /// z covers L * focal_px / z pixels.
-    float focal_px(float height_px) const { return 0.5f * height_px / std::tan(0.5f * fov_y_rad); }
+    /// z covers L * focal_px / z pixels. Orthographic: pixels per metre, (H/2) / ortho_half_height_m (clip w is 1).
+    float focal_px(float height_px) const {
+        return orthographic() ? 0.5f * height_px / ortho_half_height_m : 0.5f * height_px / std::tan(0.5f * fov_y_rad);
+    }
 };
 
 }  // namespace engine::scene

@@ -28,6 +28,7 @@
 #include "wire/rings.hpp"
 
 #include "engine/gfx/resources.hpp"
+#include "engine/gfx/shadow.hpp"
 #include "engine/core/expected.hpp"
 #include "engine/scene/camera.hpp"
 
@@ -52,7 +53,25 @@ using engine::Expected;
 struct Material {
     glm::vec3 tint{1.0f};  ///< multiplies the texture (linear RGB)
     uint32_t texture = 0;  ///< index into the renderer's textures; 0 is the built-in weave
+    float roughness = 0.5f;  ///< written by the G-buffer output (Output::gbuffer)
 };
+
+/// What a draw() writes into the bound framebuffer (always with depth test and depth writes).
+enum class Output : uint8_t {
+    /// Lit colour: the default shading or RendererDesc::shading_glsl, receiving DrawSettings::shadow.
+    color,
+    /// Depth only: a shadow map (draw from the light's view: engine::scene::directional_light_view,
+    /// spot_light_view) or a depth pre-pass. Phone-wire lines write depth too, at their drawn width (at least
+    /// one pixel of this view across: a wire thinner than a shadow-map texel casts a one-texel shadow).
+    depth,
+    /// The surface into a G-buffer, for an engine's deferred lights: RendererDesc::gbuffer_glsl, or the default
+    /// layout (colour attachment 0: world normal * 0.5 + 0.5, 1: albedo, 2: (roughness, 0, 0, 1)). The normal
+    /// and albedo are those the colour output shades.
+    gbuffer,
+};
+
+/// Views a renderer keeps LOD state for (DrawSettings::view is below it).
+inline constexpr uint32_t kMaxViews = 8;
 
 /// Directional light: colour = (albedo * (ambient + (1 - ambient) * max(0, n.l)) + specular *
 /// blinn^shininess) * light colour, albedo = texture(u, v) * tint. Both upload paths shade identically.
@@ -75,6 +94,11 @@ struct RendererDesc {
     /// u_to_light, u_light_color, u_ambient, u_specular, u_shininess are declared). A shader that fails to
     /// compile makes create() return the driver's log.
     std::string_view shading_glsl{};
+    /// Optional GLSL declaring the G-buffer's outputs and defining `void write_gbuffer(vec3 albedo, vec3 n, vec3
+    /// rel_m, float roughness)` (n: unit world normal facing the eye; rel_m: the fragment minus the eye, metres),
+    /// used by Output::gbuffer; empty: the default layout (Output::gbuffer). Compiled with the first G-buffer draw;
+    /// a failure is that draw's status, with the driver's log.
+    std::string_view gbuffer_glsl{};
     /// gpu-rings: use the instanced chunk-index attribute even when ARB_shader_draw_parameters is available
     /// (tests). cpu-mesh always reads the draw index from its per-vertex attribute.
     bool force_draw_index_attribute = false;
@@ -95,6 +119,17 @@ struct DrawSettings {
     /// predate the double camera). Offsets origin_m - eye are computed in double and sent as float, and the view
     /// is Camera::clip_from_relative(), so wires far from the world origin keep their precision.
     std::optional<glm::dvec3> eye_m{};
+    /// What the draw writes (colour, depth only, G-buffer).
+    Output output = Output::color;
+    /// Which view this draw is, 0 .. kMaxViews - 1: a frame may draw the same list from several views (a camera,
+    /// a light's shadow map, a second camera), each with its own culling and LOD. The nodes path keeps each
+    /// view's LOD hysteresis and frame state apart and sends nodes once (a later view's draw of an unchanged list
+    /// sends a 4-byte slot per wire); give each view of a frame its own number, the same every frame. The CPU
+    /// paths draw the rings their list holds (the systems' LOD for their camera); their strips face and their
+    /// lines are sized for the view drawn.
+    uint32_t view = 0;
+    /// Output::color: the shadow map the wires receive (its `light` the view it was drawn from); null: none.
+    const engine::gfx::ShadowMap* shadow = nullptr;
 };
 
 /// What one draw() did.
