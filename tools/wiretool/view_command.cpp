@@ -385,7 +385,7 @@ int run_view(const ViewOptions& o) try {
                                                                        1.25 * std::max(frame_bounds.radius_m, 1e-6));
             shadow_map->begin();
             const wire::render::DrawStats cast = renderer.draw(
-                ctx.draw_list, shadow_map->light, {.output = wire::render::Output::depth, .view = 1});
+                ctx.draw_list, shadow_map->light, {.output = wire::render::Output::shadow, .view = 1});
             shadow_map->end();
             if (!cast.status.ok()) throw Failure{exit_failure, "the wire renderer could not draw the shadow map: " + cast.status.message};
             settings.shadow = &*shadow_map;

@@ -49,6 +49,7 @@ ShadowMap::ShadowMap(ShadowMap&& o) noexcept
     : light(o.light),
       normal_offset_texels(o.normal_offset_texels),
       depth_bias_texels(o.depth_bias_texels),
+      slope_bias_texels(o.slope_bias_texels),
       texture_(std::exchange(o.texture_, 0u)),
       framebuffer_(std::exchange(o.framebuffer_, 0u)),
       size_px_(std::exchange(o.size_px_, 0)) {}
@@ -58,6 +59,7 @@ ShadowMap& ShadowMap::operator=(ShadowMap&& o) noexcept {
         light = o.light;
         normal_offset_texels = o.normal_offset_texels;
         depth_bias_texels = o.depth_bias_texels;
+        slope_bias_texels = o.slope_bias_texels;
         texture_ = std::exchange(o.texture_, 0u);
         framebuffer_ = std::exchange(o.framebuffer_, 0u);
         size_px_ = std::exchange(o.size_px_, 0);
@@ -97,19 +99,29 @@ uniform bool u_shadow_ortho;
 uniform float u_shadow_near, u_shadow_far;
 uniform float u_shadow_size;     // texels across
 uniform float u_shadow_offset;   // normal offset, texels
-uniform float u_shadow_bias;     // depth bias, texels
+uniform float u_shadow_bias;     // constant depth bias, texels
+uniform float u_shadow_slope;    // depth bias per unit tangent of the angle to the light, texels
+uniform vec3 u_shadow_dir;       // orthographic: unit direction toward the light
+uniform vec3 u_shadow_light_rel; // perspective: the light's position relative to the frame's origin
 float shadow_visibility(vec3 rel_m, vec3 n) {
   if (!u_shadow_on) return 1.0;
+  vec3 l = u_shadow_ortho ? u_shadow_dir : normalize(u_shadow_light_rel - rel_m);
+  float cos_t = dot(n, l);
+  if (cos_t <= 0.0) return 0.0;  // facing away from the light: its own body shadows it
   float w = max((u_shadow_from_rel * vec4(rel_m, 1.0)).w, 1e-6);
   float texel_m = u_shadow_texel * w;
   vec4 c = u_shadow_from_rel * vec4(rel_m + n * (u_shadow_offset * texel_m), 1.0);
   vec3 q = c.xyz / c.w * 0.5 + 0.5;
   if (q.x < 0.0 || q.y < 0.0 || q.x > 1.0 || q.y > 1.0) return 1.0;  // outside the map: lit
   q.z = min(q.z, 1.0);  // beyond the far plane: behind every caster the map holds
+  // The receiver's depth varies by tan(angle) per texel across the filter's footprint: biased by that (clamped at
+  // grazing angles, where the light's diffuse term is near 0 anyway) plus a constant.
+  float tan_t = min(sqrt(max(1.0 - cos_t * cos_t, 0.0)) / cos_t, 8.0);
+  float bias_m = (u_shadow_bias + u_shadow_slope * tan_t) * texel_m;
   // d(depth in [0, 1]) / d(distance from the light): orthographic 1 / (f - n); perspective f n / ((f - n) w^2).
   float f = u_shadow_far, nr = u_shadow_near;
   float per_m = u_shadow_ortho ? 1.0 / (f - nr) : f * nr / ((f - nr) * c.w * c.w);
-  float ref = q.z - u_shadow_bias * texel_m * per_m;
+  float ref = q.z - bias_m * per_m;
   float sum = 0.0;
   for (int y = -1; y <= 1; ++y)
     for (int x = -1; x <= 1; ++x) sum += texture(u_shadow_map, vec3(q.xy + vec2(x, y) / u_shadow_size, ref));
@@ -138,6 +150,9 @@ void set_shadow_uniforms(const Program& program, const ShadowMap* map, const glm
     program.set("u_shadow_size", size);
     program.set("u_shadow_offset", map->normal_offset_texels);
     program.set("u_shadow_bias", map->depth_bias_texels);
+    program.set("u_shadow_slope", map->slope_bias_texels);
+    program.set("u_shadow_dir", glm::vec3(glm::normalize(l.position - l.target)));
+    program.set("u_shadow_light_rel", glm::vec3(l.position - eye_m));
     glBindTextureUnit(kShadowTextureUnit, map->texture());
 }
 

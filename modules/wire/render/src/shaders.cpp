@@ -37,6 +37,7 @@ const uint kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;
 uint strip_mode(DrawData d) { return (d.flags & kStrip) != 0u ? 2u : (d.flags & kLine) != 0u ? 1u : 0u; }
 uniform mat4 u_clip_from_rel;   // projection * camera rotation: positions are camera-relative
 uniform vec2 u_viewport_px;     // viewport size (phone-wire lines are sized in pixels)
+uniform bool u_push_back;       // shadow casters: strips and lines at the tube's far side from the eye (the light)
 uniform float u_focal_px;       // (viewport height / 2) * projection[1][1]: pixels per metre at depth 1
 out vec3 v_normal;
 out vec2 v_uv;
@@ -68,6 +69,10 @@ void strip_vertex(DrawData d, uint mode, vec3 centre, vec3 r, vec3 s, vec3 t, fl
   v_mode = mode; v_tangent = t; v_frame_r = r; v_frame_s = s; v_strip = side;
   v_normal = normalize(-rel);
   v_uv = vec2(u, 0.0);
+  if (u_push_back) {  // the tube's far side, as its back faces are for a tube; wound back-facing (front faces culled)
+    rel += radius * normalize(rel);
+    side = -side;
+  }
   if (mode == 2u) {
     rel += (side * radius) * across;
     v_alpha = 1.0;
@@ -337,9 +342,17 @@ void main() {
 }
 )";
 
-// Depth only: no outputs, nothing read.
+// Depth only. A phone-wire line (drawn at least one pixel of this view across, opacity = true width / drawn width)
+// keeps that share of its fragments (interleaved gradient noise against the opacity): a depth map cannot hold a
+// partial cover, but a filtered lookup over the dithered texels darkens by the line's true width on average.
 constexpr std::string_view kDepthFragment = R"(#version 450 core
-void main() {}
+in float v_alpha;
+void main() {
+  if (v_alpha < 1.0) {
+    float noise = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+    if (noise >= v_alpha) discard;
+  }
+}
 )";
 
 }  // namespace

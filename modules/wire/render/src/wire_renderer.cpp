@@ -164,7 +164,7 @@ struct WireRenderer::State {
     /// The program of `output` for cpu-mesh or the rings (compiled on first use); null: it did not build (why).
     const gfx::Program* program_for(bool cpu, Output output, Status& why) {
         if (output == Output::color) return cpu ? &cpu_program : &rings_program;
-        const bool depth = output == Output::depth;
+        const bool depth = output == Output::depth || output == Output::shadow;
         gfx::Program& program = (depth ? depth_programs : gbuffer_programs)[cpu ? 0 : 1];
         if (program.id() != 0) return &program;
         const std::string fragment = detail::fragment_source(
@@ -231,6 +231,8 @@ struct WireRenderer::State {
         program.set("u_viewport_px", glm::vec2(static_cast<float>(std::max(viewport[2], 1)),
                                                static_cast<float>(std::max(viewport[3], 1))));
         program.set("u_focal_px", camera.focal_px(static_cast<float>(std::max(viewport[3], 1))));
+        program.set("u_push_back", settings.output == Output::shadow ? 1 : 0);
+        if (settings.output == Output::shadow) glCullFace(GL_FRONT);  // the far side (end_wires() restores)
         if (settings.output == Output::color) gfx::set_shadow_uniforms(program, settings.shadow, camera.position);
     }
 
@@ -263,6 +265,7 @@ struct WireRenderer::State {
             begin_wires(*program, view.camera, settings);
             nodes->submit(ctx, stats, settings.output != Output::color);
             glBindVertexArray(0);
+            glCullFace(GL_BACK);
             if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
         }
         stream.end();
@@ -881,6 +884,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
 
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);
+    glCullFace(GL_BACK);
     if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     return stats;
 }

@@ -3,12 +3,16 @@
 // cable's shadow falls the same way on a wire and on a wall.
 //
 // Receiving: shadow_glsl() declares `float shadow_visibility(vec3 rel_m, vec3 n)` (1 lit, 0 in shadow) for a point
-// given relative to the draw's eye and its unit normal; set_shadow_uniforms() feeds it. The lookup moves the point
-// along its normal by normal_offset_texels texels of the map (no acne: a lit surface does not shadow itself, at any
-// angle to the light) and compares 3 x 3 bilinear taps (hardware comparison: a smooth edge about 3 texels wide,
-// symmetric, so the 50% line and the darkening's integral stay where the hard edge is). Points outside the map are
-// lit. What it cannot do: a caster thinner than a texel is drawn one texel wide (the wire renderer's lines keep at
-// least one pixel in every view), so its shadow is up to one texel wider than the caster's.
+// given relative to the draw's eye and its unit normal; set_shadow_uniforms() feeds it. It compares 3 x 3 bilinear
+// taps (hardware comparison: an edge about 3 texels wide, symmetric, so the darkening's centroid and integral stay
+// where the hard edge is) against the receiver's depth less a bias: a constant plus the depth the receiver's plane
+// gains across the filter's footprint (slope_bias_texels times the tangent of its angle to the light). That bias is
+// along the light, never sideways: a shadow does not move (a normal offset, off by default, would shift it by up to
+// its size). Why no acne: a lit surface's own depth stays within the bias over the footprint. Where the bias costs:
+// a caster closer to its receiver than the bias (along the light) leaves no shadow there: a cable lying on a wall
+// loses the sliver of shadow under its own body (about bias / tan of the light's angle across), which the cable hides
+// from most views. Points outside the map are lit; points beyond its far plane are behind every caster; surfaces
+// facing away from the light are in shadow (0).
 #pragma once
 
 #include "engine/core/expected.hpp"
@@ -46,8 +50,9 @@ public:
     [[nodiscard]] int size_px() const { return size_px_; }
 
     scene::Camera light{};              ///< the light's view (directional_light_view, spot_light_view)
-    float normal_offset_texels = 1.5f;  ///< how far along its normal a receiver looks the map up, in texels
-    float depth_bias_texels = 0.5f;     ///< depth bias, in texels of depth at the receiver
+    float normal_offset_texels = 0.0f;  ///< how far along its normal a receiver looks the map up, in texels
+    float depth_bias_texels = 0.5f;     ///< constant depth bias, in texels (world size at the receiver)
+    float slope_bias_texels = 1.5f;     ///< depth bias per unit tangent of the angle to the light, in texels
 
 private:
     void release();

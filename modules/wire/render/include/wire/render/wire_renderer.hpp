@@ -60,10 +60,16 @@ struct Material {
 enum class Output : uint8_t {
     /// Lit colour: the default shading or RendererDesc::shading_glsl, receiving DrawSettings::shadow.
     color,
-    /// Depth only: a shadow map (draw from the light's view: engine::scene::directional_light_view,
-    /// spot_light_view) or a depth pre-pass. Phone-wire lines write depth too, at their drawn width (at least
-    /// one pixel of this view across: a wire thinner than a shadow-map texel casts a one-texel shadow).
+    /// Depth only, of the surfaces facing the view: a depth pre-pass. Phone-wire lines (wires under a pixel of this
+    /// view across) write depth over one pixel, dithered to their opacity (true width / one pixel).
     depth,
+    /// Depth only, as a shadow caster: draw from the light's view (engine::scene::directional_light_view,
+    /// spot_light_view) into an engine::gfx::ShadowMap. The tube's far side from the light is written (back faces;
+    /// strips and lines moved back by the radius): the side a wire shows the light is in front of its own map by
+    /// about a diameter, so it never shadows itself (in stripes where the light's LOD or sides differ from the
+    /// camera's), and its silhouette, hence its shadow on anything else, is unchanged. Lines dither as in `depth`: a
+    /// filtered lookup darkens by the wire's true width on average, never by a whole texel.
+    shadow,
     /// The surface into a G-buffer, for an engine's deferred lights: RendererDesc::gbuffer_glsl, or the default
     /// layout (colour attachment 0: world normal * 0.5 + 0.5, 1: albedo, 2: (roughness, 0, 0, 1)). The normal
     /// and albedo are those the colour output shades.
