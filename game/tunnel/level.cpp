@@ -132,6 +132,8 @@ void Level::install_systems() {
     schedule.add("tunnel.cables",
                  [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->update_cables(); });
     wire::systems::install(schedule, s.context);
+    schedule.add("tunnel.shadows",
+                 [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->draw_shadow_map(); });
     schedule.add("tunnel.pieces",
                  [self](engine::ecs::Registry&, const engine::ecs::FrameContext&) { self->draw_pieces(); });
     schedule.add("wire.render",

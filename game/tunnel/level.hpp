@@ -10,6 +10,7 @@
 //                   node insertion/removal
 //   tunnel.cables   wall cables and rope nodes bent by the CPU transform -> wire entities; rope metrics
 //   wire.curve .. wire.draw_list   (wire::systems::install)
+//   tunnel.shadows  the head lamp's shadow map: the pieces' coarsest level and the wires (Output::shadow)
 //   tunnel.pieces   clear, per-piece subdivision level, bent instanced pieces (GL)
 //   wire.render     WireRenderer draws the frame's DrawList (GL)
 // Needs a current GL 4.5 context (engine::platform::Context) for create() and frame(). level.cpp lists the
@@ -71,6 +72,9 @@ struct LevelOptions {
     bool gusts = true;        ///< gusts of wind travel down the tunnel and swing the hanging cables
     bool draw_pieces = true;
     bool draw_wires = true;
+    /// The head lamp (on the camera rig, 0.9 m up and 0.6 m right of the eye) casts shadows: the wires, ropes and the
+    /// pieces (their coarsest level) are drawn into its map; the pieces and wires receive them.
+    bool shadows = true;
     double subdivision_tolerance_px = 0.5;  ///< predicted geometric error of a piece on screen
     int max_subdivision_level =
         4;                 ///< clamp of the per-piece level (<= LevelSettings::max_subdivision_level)
@@ -186,6 +190,7 @@ private:
     void draw_pieces();
     void measure_ropes();
     void draw_wires();
+    void draw_shadow_map();
     void apply_options();
     glm::dvec3 rope_end(int piece, std::size_t anchor, double inset_m, double lift_m) const;
 

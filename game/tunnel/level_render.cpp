@@ -4,11 +4,15 @@
 
 #include <curved_space/gpu.hpp>
 #include <engine/gfx/lit_renderer.hpp>
+#include <engine/gfx/shadow.hpp>
+#include <engine/scene/light_view.hpp>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 namespace tunnel {
 
@@ -39,6 +43,53 @@ Status Level::create_wire_renderer() {
     return {};
 }
 
+namespace {
+constexpr int kHeadLampMapPx = 2048;
+constexpr float kHeadLampHalfAngle = 0.8f;  // radians
+constexpr float kHeadLampRange_m = 40.0f;
+
+/// The head lamp's view: 0.9 m above and 0.6 m right of the eye, looking where the camera looks.
+engine::scene::Camera head_lamp_view(const engine::scene::Camera& camera) {
+    const glm::dvec3 forward = camera.forward();
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+    const glm::dvec3 up = glm::cross(right, forward);
+    return engine::scene::spot_light_view(camera.position + 0.9 * up + 0.6 * right, forward, kHeadLampHalfAngle,
+                                          kHeadLampRange_m, 0.1f);
+}
+}  // namespace
+
+void Level::draw_shadow_map() {
+    State& s = *state_;
+    if (!options_.shadows) return;
+    if (!s.head_lamp) {
+        auto map = engine::gfx::ShadowMap::create(kHeadLampMapPx);
+        if (!map) {
+            options_.shadows = false;  // said once, the level draws on unshadowed
+            std::fprintf(stderr, "tunnel: no head lamp shadows: %s\n", map.error().message.c_str());
+            return;
+        }
+        s.head_lamp = std::move(*map);
+    }
+    engine::gfx::ShadowMap& map = *s.head_lamp;
+    map.light = head_lamp_view(camera_);
+    map.begin();
+    if (options_.draw_pieces) {  // the pieces' coarsest level: the lamp sees their shapes, not their detail
+        const glm::dvec3 eye = camera_.position;
+        const std::vector<curved_space::GpuSegment> records = curved_space::gpu_segments(chain_, eye);
+        s.pieces.begin({.clip_from_rel = engine::gfx::shadow_from_relative(map.light, eye), .segments = records});
+        s.bucket.clear();
+        for (int k = 0; k < piece_count(); ++k) s.bucket.push_back(static_cast<float>(kPieceLength * k));
+        for (const Group& group : s.groups) s.pieces.draw(group.meshes[0], group.surface, group.albedo, s.bucket);
+        s.pieces.end();
+    }
+    if (options_.draw_wires) {
+        const wire::render::DrawStats cast = s.wires.draw(
+            s.context.draw_list, map.light, {.output = wire::render::Output::shadow, .view = 1});
+        (void)cast;  // a failure is logged by the renderer; the camera's draw says it again in the stats
+    }
+    map.end();
+}
+
 void Level::draw_pieces() {
     State& s = *state_;
     const GpuPass gpu_pass(s.pieces_timer);
@@ -54,6 +105,12 @@ void Level::draw_pieces() {
                      .segments = records,
                      .to_light = glm::normalize(glm::vec3(0.3f, 1.0f, 0.4f)),
                      .wireframe = options_.wireframe};
+    const engine::scene::Camera lamp = head_lamp_view(camera_);
+    frame.head_rel_m = glm::vec3(lamp.position - eye);
+    frame.head_dir = glm::vec3(lamp.forward());
+    frame.head_cos_cone = std::cos(kHeadLampHalfAngle);
+    frame.head_shadow = options_.shadows && s.head_lamp ? &*s.head_lamp : nullptr;
+    frame.eye_m = eye;
     stats_.segment_bytes_uploaded = s.pieces.begin(frame);
     const int max_level = std::clamp(options_.max_subdivision_level, 0, s.settings.max_subdivision_level);
     const int n = piece_count();
@@ -85,6 +142,12 @@ void Level::draw_wires() {
             wire::render::DrawSettings settings;
             settings.light = {.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
             settings.wireframe = options_.wireframe;
+            if (options_.shadows && s.head_lamp) {
+                // Lit by the head lamp (from where it shines on the view's middle distance), in its shadows.
+                const engine::scene::Camera& lamp = s.head_lamp->light;
+                settings.light.to_light = glm::vec3(glm::normalize(lamp.position - (camera_.position + 3.0 * camera_.forward())));
+                settings.shadow = &*s.head_lamp;
+            }
             s.wire_stats = s.wires.draw(s.context.draw_list, camera_, settings);
         }
     }
@@ -114,6 +177,7 @@ void Level::draw_wires() {
 }
 
 void Level::render() {
+    draw_shadow_map();
     draw_pieces();
     draw_wires();
 }

@@ -10,6 +10,8 @@
 #include <curved_space/chain.hpp>
 #include <engine/ecs/registry.hpp>
 #include <engine/gfx/gpu_timer.hpp>
+#include <engine/gfx/shadow.hpp>
+#include <optional>
 #include <wire/nodes.hpp>
 #include <wire/render/wire_renderer.hpp>
 #include <wire/systems/api.hpp>
@@ -84,6 +86,7 @@ struct Level::State {
     wire::systems::WireContext context;
     wire::render::WireRenderer wires;
     PieceRenderer pieces;
+    std::optional<engine::gfx::ShadowMap> head_lamp;  ///< the head lamp's shadow map (options.shadows)
     std::vector<Group> groups;
     std::vector<glm::dvec3> anchors;  // unbent, in piece space
     std::vector<SegmentAnimation> animation;

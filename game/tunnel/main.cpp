@@ -43,6 +43,7 @@ struct Args {
     std::string spline = "automatic";
     double lod_tolerance_px = 0.5;
     bool wireframe = false;
+    bool no_shadows = false;
     bool frames_given = false;  // window: close after `frames` frames
     int screenshot_frame = -1;  // window: screenshot (with the panel) at this frame
     std::string assets;         // level assets; empty: found relative to the executable
@@ -319,6 +320,8 @@ int main(int argc, char** argv) {
     app.add_option("--lod-tolerance", args.lod_tolerance_px, "wire LOD screen error in pixels (default 0.5)")
         ->check(CLI::PositiveNumber);
     app.add_flag("--wireframe", args.wireframe, "draw wireframe");
+    app.add_flag("--no-shadows", args.no_shadows, "the head lamp casts no shadows (default: it does: cables, ropes and "
+                                                   "pieces into its map; pieces and wires receive)");
     app.add_option("--assets", args.assets,
                    "folder of the level's assets (default: " TUNNEL_ASSETS_FROM_EXE " relative to the executable)");
     CLI11_PARSE(app, argc, argv);
@@ -353,6 +356,7 @@ int main(int argc, char** argv) {
                                             : wire::SplineKind::catmull_rom;
     o.lod_tolerance_px = args.lod_tolerance_px;
     o.wireframe = args.wireframe;
+    o.shadows = !args.no_shadows;
     const platform::Extent size = ctx.value()->framebuffer_size();
     level.value()->set_viewport(size.width, size.height);
     if (ctx.value()->headless()) return run_headless(*ctx.value(), *level.value(), args);

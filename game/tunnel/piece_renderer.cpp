@@ -47,7 +47,7 @@ void main() {
 }
 )";
 
-constexpr const char* kFragment = R"(#version 450 core
+constexpr const char* kFragmentHead = R"(#version 450 core
 in vec3 v_rel;
 in vec3 v_normal;
 in vec3 v_unbent;
@@ -59,7 +59,13 @@ uniform vec3 u_fog_color;
 uniform float u_fog_m;
 uniform float u_lamp_spacing_m;
 uniform float u_lamp_y_m;
+uniform vec3 u_head_rel;
+uniform vec3 u_head_dir;
+uniform float u_head_cos;
 out vec4 o_color;
+)";
+
+constexpr const char* kFragment = R"(
 
 float hash12(vec2 p) {
     vec3 p3 = fract(vec3(p.xyx) * 0.1031);
@@ -110,7 +116,13 @@ void main() {
     float ambient = 0.16;
     float sun = 0.25 * max(dot(n, normalize(u_to_light)), 0.0);
     float d = length(v_rel);
-    float head = 0.75 * max(dot(n, to_eye), 0.0) / (1.0 + d * d / 90.0);
+    // The head lamp, beside the eye, in its cone, shadowed by its map.
+    vec3 to_head = u_head_rel - v_rel;
+    float dh = length(to_head);
+    to_head /= max(dh, 1e-6);
+    float cone = smoothstep(u_head_cos, mix(u_head_cos, 1.0, 0.2), dot(-to_head, u_head_dir));
+    float head = 0.9 * max(dot(n, to_head), 0.0) * cone / (1.0 + dh * dh / 90.0);
+    if (head > 0.0) head *= shadow_visibility(v_rel, n);
     vec3 lamp_light = vec3(0.0);
     float k0 = floor(v_unbent.z / u_lamp_spacing_m);
     for (int k = 0; k < 2; ++k) {
@@ -154,7 +166,9 @@ Expected<PieceRenderer> PieceRenderer::create() {
     const std::string vertex =
         std::string(kVertexHead) + std::string(curved_space::glsl_bend_source()) + kVertexBody;
     Expected<gfx::Program> program =
-        gfx::make_program({.vertex = vertex, .fragment = kFragment, .label = "tunnel pieces"});
+        gfx::make_program({.vertex = vertex,
+                           .fragment = std::string(kFragmentHead) + std::string(gfx::shadow_glsl()) + kFragment,
+                           .label = "tunnel pieces"});
     if (!program) return program.error();
     PieceRenderer r;
     r.state_ = std::make_unique<State>();
@@ -225,6 +239,10 @@ std::size_t PieceRenderer::begin(const PieceFrame& frame) {
     s.program.set("u_fog_m", frame.fog_distance_m);
     s.program.set("u_lamp_spacing_m", frame.lamp_spacing_m);
     s.program.set("u_lamp_y_m", frame.lamp_y_m);
+    s.program.set("u_head_rel", frame.head_rel_m);
+    s.program.set("u_head_dir", frame.head_dir);
+    s.program.set("u_head_cos", frame.head_cos_cone);
+    gfx::set_shadow_uniforms(s.program, frame.head_shadow, frame.eye_m);
     return bytes;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <curved_space/gpu.hpp>
+#include <engine/gfx/shadow.hpp>
 #include <engine/assets/mesh_data.hpp>
 #include <engine/core/expected.hpp>
 
@@ -40,6 +41,13 @@ struct PieceFrame {
     float lamp_spacing_m = 4.0f;
     float lamp_y_m = 2.1f;
     bool wireframe = false;
+    /// The head lamp: its position relative to the eye and unit direction; `head_shadow` its shadow map (its
+    /// light the lamp's view; null: unshadowed), looked up eye-relative (eye_m: the camera position).
+    glm::vec3 head_rel_m{0.0f};
+    glm::vec3 head_dir{0.0f, 0.0f, -1.0f};
+    float head_cos_cone = 0.0f;  ///< cosine of the lamp's cone half angle (the beam fades over its outer fifth)
+    const engine::gfx::ShadowMap* head_shadow = nullptr;
+    glm::dvec3 eye_m{0.0};
 };
 
 class PieceRenderer {

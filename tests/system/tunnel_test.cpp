@@ -276,7 +276,7 @@ TEST(TunnelSystem, StatsFiniteAndPlausible) {
             EXPECT_GE(st.last_ms, 0.0) << st.name;
         }
     }
-    EXPECT_EQ(level->system_stats().size(), 10u);
+    EXPECT_EQ(level->system_stats().size(), 11u);
 }
 
 TEST(TunnelSystem, RopesInsertAndRemoveNodesWithNewIds) {

@@ -52,7 +52,7 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_option("--scenes", o->scenes, "Only these scenes, comma-separated")
         ->delimiter(',')
         ->check(CLI::IsMember({"standard", "offscreen", "swaying", "far", "catenary", "helix", "stretched_bend",
-                               "hairpin", "random_walk", "churn", "families", "remedy_families", "stream"}));
+                               "hairpin", "random_walk", "churn", "families", "remedy_families", "stream", "views"}));
     cmd->add_flag("--no-accuracy", o->skip_accuracy, "Skip accuracy.csv/md, stability.md and the plot");
     cmd->add_flag(
         "--gl", o->gl,

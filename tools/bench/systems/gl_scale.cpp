@@ -1,6 +1,7 @@
 // `wiretool bench --gl`, the scaling rows (gl_scale.hpp).
 #include "bench/systems/gl_scale.hpp"
 #include "bench/systems/gl_stream.hpp"
+#include "bench/systems/gl_views.hpp"
 
 #include "bench/scenes/field_scenes.hpp"
 #include "bench/systems/run_scene.hpp"
@@ -265,6 +266,7 @@ int run_gl_scale_bench(const Options& o) {
     for (SceneKind k : {SceneKind::standard, SceneKind::swaying, SceneKind::far})
         if (selected(o, scene_name(k))) scenes.push_back(k);
     const bool stream_rows = selected(o, "swaying") || selected(o, "stream");
+    const bool views_rows = std::find(o.scenes.begin(), o.scenes.end(), "views") != o.scenes.end();
     Table table;
     table.header = {"scene", "wires", "width", "height", "threads", "path", "thin_wires", "frames", "visible",
                     "triangles", "systems_wall_ms", "draw_ms", "gpu_ms", "draw_finish_ms", "end_to_end_ms",
@@ -272,7 +274,7 @@ int run_gl_scale_bench(const Options& o) {
                     "wire_memory_bytes", "gpu_buffer_bytes", "gpu_vs_one_draw"};
     std::string md = "# wiretool bench --gl\n\n";
     GlScale gl;
-    if (scenes.empty() && !stream_rows) return exit_ok;
+    if (scenes.empty() && !stream_rows && !views_rows) return exit_ok;
     {
         // The wires' spline (--spline), resolved as `wiretool mesh` does (the systems rows do the same).
         wire::PipelineSettings resolved;
@@ -368,6 +370,10 @@ int run_gl_scale_bench(const Options& o) {
           nodes_md;
     if (stream_rows && !run_gl_stream_rows(o, gl.context(), md)) {
         std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench_gl_stream.csv").c_str());
+        return exit_failure;
+    }
+    if (views_rows && !run_gl_views_rows(o, gl.context(), md)) {
+        std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "bench_gl_views.csv").c_str());
         return exit_failure;
     }
     if (!write_text(o.out_dir / "bench_gl.md", md)) {
