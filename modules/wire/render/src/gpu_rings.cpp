@@ -772,9 +772,14 @@ void main() {
                     : (job.flags & 1u) != 0u ? vec4(job.previous_normal.xyz, 1.0)
                                              : vec4(0.0);
     if (previous.w != 0.0) {
-        vec3 p = previous.xyz - dot(previous.xyz, t0) * t0;
-        float len = length(p);
-        if (len > 1e-6) r0 = p / len;
+        float along = dot(previous.xyz, t0);
+        if (abs(along) <= 1e-6 && abs(dot(previous.xyz, previous.xyz) - 1.0) <= 4e-7) {
+            r0 = previous.xyz;  // already a unit normal of t0: kept bit for bit (a still wire's frames do not drift)
+        } else {
+            vec3 p = previous.xyz - along * t0;
+            float len = length(p);
+            if (len > 1e-6) r0 = p / len;
+        }
     }
     vec4 totals = vec4(0.0);
     if (CLOSED) {

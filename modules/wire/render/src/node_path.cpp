@@ -554,7 +554,9 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
                    stream_scratch_at, stream_changed_, unchanged_ + changed_);
     }
     if (changed_ + stream_changed_ != 0) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    // (2) LOD, (3) commands, (4) rings and records, over the visible wires.
+    // (2) LOD, (3) commands, (4) rings and records, over the visible wires. They overwrite the per-frame buffers the
+    // last draw read (the previous view of this frame, or the last frame): the barrier orders those reads first.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     ring_program_.use();
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingHeaders, slot_headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSegments, segments_.id());
@@ -603,7 +605,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     return true;
 }
 
-void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, bool depth_only) {
+void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, Lines lines) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, draws_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, rings_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.circle);
@@ -626,12 +628,12 @@ void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, bool depth_o
     for (std::size_t m = 0; m < materials_; ++m) {
         if (m < material_used_.size() && material_used_[m]) draw(m, 2, side_slots_ - 2);
     }
-    if (!depth_only) {
+    if (lines == Lines::blended) {
         glEnable(GL_BLEND);
         glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
         glDepthMask(GL_FALSE);
     }
-    for (std::size_t m = 0; m < materials_; ++m) {
+    for (std::size_t m = 0; lines != Lines::skipped && m < materials_; ++m) {
         if (m < material_used_.size() && material_used_[m]) draw(m, 1, 1);
     }
     glDisable(GL_BLEND);

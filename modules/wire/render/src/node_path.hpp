@@ -59,8 +59,11 @@ public:
     /// draws. The patterns in `ctx` must cover max_sides().
     bool prepare(const DrawList& list, const LodView& lod_view, uint32_t view, const engine::gfx::StreamRegion& region,
                  const NodeDrawContext& ctx, DrawStats& stats);
-    /// Issues the draws prepare() set up; depth_only: the phone-wire lines write depth too and are not blended.
-    void submit(const NodeDrawContext& ctx, DrawStats& stats, bool depth_only = false);
+    /// How submit() draws the phone-wire lines: blended over the rest without depth writes (colour), not at all
+    /// (a depth pre-pass: they are translucent), or opaque with depth (a shadow caster; the shader dithers them).
+    enum class Lines { blended, skipped, opaque };
+    /// Issues the draws prepare() set up.
+    void submit(const NodeDrawContext& ctx, DrawStats& stats, Lines lines = Lines::blended);
     /// Bytes prepare() writes into the region for `list` (an upper bound; computed per frame).
     std::size_t upload_bytes(const DrawList& list);
     /// The rings the last prepare() computed and submit() drew (WireRenderer::read_drawn_rings); waits for the GPU.

@@ -263,7 +263,11 @@ struct WireRenderer::State {
         if (!index_capacity) failed(stats, index_capacity);
         if (drawn && index_capacity) {
             begin_wires(*program, view.camera, settings);
-            nodes->submit(ctx, stats, settings.output != Output::color);
+            using Lines = detail::NodePath::Lines;
+            nodes->submit(ctx, stats,
+                          settings.output == Output::color   ? Lines::blended
+                          : settings.output == Output::depth ? Lines::skipped
+                                                             : Lines::opaque);
             glBindVertexArray(0);
             glCullFace(GL_BACK);
             if (settings.wireframe) glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
@@ -858,6 +862,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     for (std::size_t run = 0; run + 1 < s.run_first.size(); ++run) {
         const DrawItem& head = list.items[s.order[s.run_first[run]]];
         const bool line = head.sides == 1;
+        if (line && settings.output == Output::depth) break;  // translucent: no depth in a pre-pass (lines run last)
         // Phone-wire lines: opacity = true width / drawn width, over the opaque wires (colour output only).
         if (line && !blending && settings.output == Output::color) {
             glEnable(GL_BLEND);

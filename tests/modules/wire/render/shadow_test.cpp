@@ -20,7 +20,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -93,7 +92,6 @@ ShadowCase shadow_case(uint32_t seed) {
     c.to_light = {std::cos(elevation) * std::cos(azimuth), std::sin(elevation), std::cos(elevation) * std::sin(azimuth)};
     c.texel_px = 0.3 * std::pow(2.5 / 0.3, unit(rng));
     c.spot = seed % 3 == 0;
-    if (const char* t = std::getenv("SHADOW_TEXEL")) c.texel_px = std::atof(t);
     c.spot_m = {2.0 * (unit(rng) - 0.5), c.height_m + 1.0 + 2.0 * unit(rng)};
     char name[200];
     std::snprintf(name, sizeof name, "seed %u: width %.2f px, height %.3f m, %s %.2f, texel %.2f px", seed, width_px,
@@ -205,7 +203,6 @@ TEST_F(ShadowTest, WireShadowOnTheGroundIsTheAnalyticProjectionOverRandomPlaceme
             const auto meet = [&](double a) { return c.spot_m.x - c.spot_m.y * std::cos(a) / std::sin(a); };
             const double x1 = meet(phi - alpha), x2 = meet(phi + alpha);
             centre_x = 0.5 * (x1 + x2);
-            if (std::getenv("SHADOW_DEBUG")) std::printf("seed %u spot (%g, %g) h %g r %g x1 %g x2 %g\n", seed, c.spot_m.x, c.spot_m.y, c.height_m, c.radius_m, x1, x2);
             width = std::abs(x2 - x1);
             lit_dir = glm::normalize(c.spot_m.x * e + glm::dvec3(0.0, c.spot_m.y, 0.0) - centre_x * e);  // from the shadow
         }
@@ -284,41 +281,44 @@ TEST_F(ShadowTest, WireShadowOnTheGroundIsTheAnalyticProjectionOverRandomPlaceme
             const double dark_value = 255.0 * kAlbedo * kAmbient;
             // Four windows 40 px long along the shadow; in each, the darkening's integral and centroid across it.
             double sum_centre = 0.0, sum_width = 0.0, worst_here = 0.0, acne_here = 0.0;
-            for (int win = 0; win < 4; ++win) {
-                const double v0 = (-0.7 + 0.35 * win) * kHalfView_m, v1 = v0 + 40 * kPixel_m;
-                double mass = 0.0, moment = 0.0;
-                for (int y = 0; y < kSize; ++y) {
-                    for (int x = 0; x < kSize; ++x) {
-                        // Pixel centre in world x, z (top-down, up = -z: image up is -z, image right is +x).
-                        const double wx = shadow_mid.x + ((x + 0.5) * kPixel_m - kHalfView_m);
-                        const double wz = shadow_mid.z + ((y + 0.5) * kPixel_m - kHalfView_m);  // read_pixels: row 0 at the top
-                        const glm::dvec3 q{wx, 0.0, wz};
-                        const double u = glm::dot(q, e), v = glm::dot(q - shadow_mid, c.along);
-                        if (v < v0 || v >= v1) continue;
-                        const double value = image.pixel(x, y)[0];
-                        const double d = std::clamp((lit_value - value) / (lit_value - dark_value), -1.0, 2.0);
-                        if (std::abs(u - centre_x) > 0.5 * width + (4.0 * texel_px + 3.0) * kPixel_m) {
-                            acne_here = std::max(acne_here, d);
-                            continue;
-                        }
-                        if (std::abs(u) < c.radius_m) continue;  // under the wire: hidden from the camera by it
-                        mass += d;
-                        moment += d * u;
+            std::array<double, 4> mass{}, moment{}, v0{};
+            for (int win = 0; win < 4; ++win) v0[static_cast<std::size_t>(win)] = (-0.7 + 0.35 * win) * kHalfView_m;
+            const double window_m = 40 * kPixel_m;
+            for (int y = 0; y < kSize; ++y) {
+                for (int x = 0; x < kSize; ++x) {
+                    // Pixel centre in world x, z (top-down, up = -z: image right is +x, row 0 the top, at -z).
+                    const double wx = shadow_mid.x + ((x + 0.5) * kPixel_m - kHalfView_m);
+                    const double wz = shadow_mid.z + ((y + 0.5) * kPixel_m - kHalfView_m);
+                    const glm::dvec3 q{wx, 0.0, wz};
+                    const double u = glm::dot(q, e), v = glm::dot(q - shadow_mid, c.along);
+                    std::size_t win = 4;
+                    for (std::size_t w = 0; w < 4; ++w) win = v >= v0[w] && v < v0[w] + window_m ? w : win;
+                    if (win == 4) continue;
+                    const double value = image.pixel(x, y)[0];
+                    const double d = std::clamp((lit_value - value) / (lit_value - dark_value), -1.0, 2.0);
+                    if (std::abs(u - centre_x) > 0.5 * width + (4.0 * texel_px + 3.0) * kPixel_m) {
+                        acne_here = std::max(acne_here, d);
+                        continue;
                     }
+                    if (std::abs(u) < c.radius_m) continue;  // under the wire: hidden from the camera by it
+                    mass[win] += d;
+                    moment[win] += d * u;
                 }
-                const double measured_width = mass * kPixel_m * kPixel_m / (v1 - v0);
-                const double measured_centre = mass > 0.0 ? moment / mass : 0.0;
-                const double ce = mass > 0.0 ? std::abs(measured_centre - seen_centre) / kPixel_m : 0.0;
+            }
+            for (std::size_t win = 0; win < 4; ++win) {
+                const double measured_width = mass[win] * kPixel_m * kPixel_m / window_m;
+                const double measured_centre = mass[win] > 0.0 ? moment[win] / mass[win] : 0.0;
+                const double ce = mass[win] > 0.0 ? std::abs(measured_centre - seen_centre) / kPixel_m : 0.0;
                 const double we = std::abs(measured_width - seen_width) / kPixel_m;
                 // A shadow under a pixel wide has a centroid known only as well as its mass: compared when > 0.5 px.
                 if (seen_width > 0.5 * kPixel_m) sum_centre = std::max(sum_centre, ce);
                 sum_width = std::max(sum_width, we);
                 worst_here = std::max({worst_here, we, seen_width > 0.5 * kPixel_m ? ce : 0.0});
                 EXPECT_LE(we, bound_px) << (p == 0 ? "nodes" : "cpu") << " " << c.name << ", window " << win << ": width "
-                                   << measured_width / kPixel_m << " px, analytic " << seen_width / kPixel_m << " px";
+                                        << measured_width / kPixel_m << " px, analytic " << seen_width / kPixel_m << " px";
                 if (seen_width > 0.5 * kPixel_m) {
                     EXPECT_LE(ce, bound_px) << (p == 0 ? "nodes" : "cpu") << " " << c.name << ", window " << win
-                                       << ": centre off by " << ce << " px";
+                                            << ": centre off by " << ce << " px";
                 }
             }
             EXPECT_LE(acne_here, 0.06) << (p == 0 ? "nodes" : "cpu") << " " << c.name << ": the lit ground darkens";
@@ -512,6 +512,44 @@ TEST_F(ShadowTest, GbufferNormalsAndAlbedoAreTheLitOutputs) {
     EXPECT_GT(compared, 10000u);
     EXPECT_LE(worst[0], 1);
     EXPECT_LE(worst[1], 1);
+}
+
+// A depth pre-pass (Output::depth) writes the depth the colour output writes, value for value, on both paths: an
+// engine's later passes (an equal-depth test, occlusion of its own geometry) see the wires where the lit pass puts
+// them. Phone-wire lines write no depth in either.
+TEST_F(ShadowTest, ADepthPrePassWritesTheColourOutputsDepth) {
+    std::size_t compared = 0, covered = 0, lines = 0;
+    for (uint32_t seed = 1; seed <= 16; ++seed) {
+        Hanging h = hanging(seed + 200);
+        if (seed % 2 == 0) h.w.spline.radius_m *= 0.05f;  // 0.15 - 1.6 px: strips and phone-wire lines
+        for (const UploadPath path : {UploadPath::gpu_nodes, UploadPath::cpu_mesh}) {
+            make_list(h.w, path, lod_view_of(h.camera), 1300 + seed);
+            const DrawList list{.path = path, .items = {h.w.item}};
+            lines += path == UploadPath::cpu_mesh && h.w.item.sides == 1 ? 1 : 0;
+            const auto depth_of = [&](Output output) {
+                ctx_->begin_frame();
+                gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
+                EXPECT_TRUE(renderer_.draw(list, h.camera, {.output = output}).status.ok());
+                std::vector<float> depth(std::size_t{kSize} * kSize);
+                glReadPixels(0, 0, kSize, kSize, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+                ctx_->end_frame();
+                return depth;
+            };
+            (void)depth_of(Output::color);  // the nodes path's LOD state settles on this view first
+            const std::vector<float> lit = depth_of(Output::color), pre = depth_of(Output::depth);
+            std::size_t differ = 0;
+            for (std::size_t i = 0; i < lit.size(); ++i) {
+                differ += lit[i] != pre[i] ? 1 : 0;
+                covered += lit[i] < 1.0f ? 1 : 0;
+            }
+            compared += lit.size();
+            EXPECT_EQ(differ, 0u) << (path == UploadPath::cpu_mesh ? "cpu" : "nodes") << " seed " << seed << ": "
+                                  << differ << " depth values differ";
+        }
+    }
+    EXPECT_GE(lines, 1u) << "the family should include phone-wire lines";
+    EXPECT_GT(covered, 10000u);
+    std::printf("depth pre-pass against the colour output's depth: %zu pixels (%zu covered), equal\n", compared, covered);
 }
 
 }  // namespace

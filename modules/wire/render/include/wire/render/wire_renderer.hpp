@@ -60,15 +60,19 @@ struct Material {
 enum class Output : uint8_t {
     /// Lit colour: the default shading or RendererDesc::shading_glsl, receiving DrawSettings::shadow.
     color,
-    /// Depth only, of the surfaces facing the view: a depth pre-pass. Phone-wire lines (wires under a pixel of this
-    /// view across) write depth over one pixel, dithered to their opacity (true width / one pixel).
+    /// Depth only, of the surfaces facing the view: a depth pre-pass (the engine's later passes test against it).
+    /// The depth written equals what the colour output writes, value for value (the wire programs compute positions
+    /// invariantly); phone-wire lines (wires under a pixel of this view across, drawn translucent) are left out, as
+    /// the colour output writes no depth for them. The colour output itself tests with GL_LESS: draw it on a depth
+    /// buffer without the wires' pre-pass.
     depth,
     /// Depth only, as a shadow caster: draw from the light's view (engine::scene::directional_light_view,
     /// spot_light_view) into an engine::gfx::ShadowMap. The tube's far side from the light is written (back faces;
     /// strips and lines moved back by the radius): the side a wire shows the light is in front of its own map by
     /// about a diameter, so it never shadows itself (in stripes where the light's LOD or sides differ from the
-    /// camera's), and its silhouette, hence its shadow on anything else, is unchanged. Lines dither as in `depth`: a
-    /// filtered lookup darkens by the wire's true width on average, never by a whole texel.
+    /// camera's), and its silhouette, hence its shadow on anything else, is unchanged. Phone-wire lines write depth
+    /// over one pixel dithered to their opacity (true width / one pixel): a filtered lookup darkens by the wire's
+    /// true width on average, never by a whole texel.
     shadow,
     /// The surface into a G-buffer, for an engine's deferred lights: RendererDesc::gbuffer_glsl, or the default
     /// layout (colour attachment 0: world normal * 0.5 + 0.5, 1: albedo, 2: (roughness, 0, 0, 1)). The normal
@@ -209,8 +213,8 @@ public:
     /// The material table; DrawItem::material indexes it.
     [[nodiscard]] const std::vector<Material>& materials() const;
 
-    /// Uploads and draws `list` into the bound framebuffer with depth test and back-face culling (it does not
-    /// clear). All items go into one region of the stream buffer; one glMultiDraw*Indirect per (class,
+    /// Uploads and draws `list` into the bound framebuffer with depth test (GL_LESS) and back-face culling (it
+    /// does not clear), writing settings.output. All items go into one region of the stream buffer; one glMultiDraw*Indirect per (class,
     /// material); the region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material <
     /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
     DrawStats draw(const DrawList& list, const engine::scene::Camera& camera,
