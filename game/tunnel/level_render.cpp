@@ -44,7 +44,7 @@ Status Level::create_wire_renderer() {
 }
 
 namespace {
-constexpr int kHeadLampMapPx = 2048;
+constexpr int kHeadLampMapPx = 1024;  // a texel is 4.5 mm at 2 m: cables are 4 or more across
 constexpr float kHeadLampHalfAngle = 0.8f;  // radians
 constexpr float kHeadLampRange_m = 40.0f;
 
@@ -76,7 +76,9 @@ void Level::draw_shadow_map() {
     if (options_.draw_pieces) {  // the pieces' coarsest level: the lamp sees their shapes, not their detail
         const glm::dvec3 eye = camera_.position;
         const std::vector<curved_space::GpuSegment> records = curved_space::gpu_segments(chain_, eye);
-        s.pieces.begin({.clip_from_rel = engine::gfx::shadow_from_relative(map.light, eye), .segments = records});
+        s.pieces.begin({.clip_from_rel = engine::gfx::shadow_from_relative(map.light, eye),
+                        .segments = records,
+                        .depth_only = true});
         s.bucket.clear();
         for (int k = 0; k < piece_count(); ++k) s.bucket.push_back(static_cast<float>(kPieceLength * k));
         for (const Group& group : s.groups) s.pieces.draw(group.meshes[0], group.surface, group.albedo, s.bucket);

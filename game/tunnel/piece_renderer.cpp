@@ -151,6 +151,9 @@ struct GpuPieceMesh {
 
 struct PieceRenderer::State {
     gfx::Program program;
+    gfx::Program depth_program;  ///< the same vertex shader, an empty fragment shader
+    gfx::Program* current = nullptr;
+    int loc_depth_piece_z = -1;
     std::vector<GpuPieceMesh> meshes;
     gfx::Buffer segments;
     int loc_piece_z = -1;
@@ -174,6 +177,11 @@ Expected<PieceRenderer> PieceRenderer::create() {
     r.state_ = std::make_unique<State>();
     r.state_->program = std::move(program).value();
     r.state_->loc_piece_z = r.state_->program.uniform_location("u_piece_z");
+    Expected<gfx::Program> depth = gfx::make_program(
+        {.vertex = vertex, .fragment = "#version 450 core\nvoid main() {}\n", .label = "tunnel pieces depth"});
+    if (!depth) return depth.error();
+    r.state_->depth_program = std::move(depth).value();
+    r.state_->loc_depth_piece_z = r.state_->depth_program.uniform_location("u_piece_z");
     return r;
 }
 
@@ -232,6 +240,13 @@ std::size_t PieceRenderer::begin(const PieceFrame& frame) {
     gfx::set_opaque_state();
     s.wireframe = frame.wireframe;
     if (frame.wireframe) gfx::set_wireframe(true);
+    if (frame.depth_only) {
+        s.current = &s.depth_program;
+        s.depth_program.use();
+        s.depth_program.set("u_clip_from_rel", frame.clip_from_rel);
+        return bytes;
+    }
+    s.current = &s.program;
     s.program.use();
     s.program.set("u_clip_from_rel", frame.clip_from_rel);
     s.program.set("u_to_light", frame.to_light);
@@ -250,11 +265,15 @@ void PieceRenderer::draw(MeshHandle mesh, Surface surface, const glm::vec3& albe
                          std::span<const float> piece_z_m) {
     State& s = *state_;
     const GpuPieceMesh& m = s.meshes[mesh];
-    s.program.set("u_albedo", albedo);
-    s.program.set("u_surface", static_cast<int>(surface));
+    const bool depth = s.current == &s.depth_program;
+    const gfx::Program& program = depth ? s.depth_program : s.program;
+    if (!depth) {
+        program.set("u_albedo", albedo);
+        program.set("u_surface", static_cast<int>(surface));
+    }
     for (std::size_t first = 0; first < piece_z_m.size(); first += kMaxInstances) {
         const std::size_t count = std::min<std::size_t>(kMaxInstances, piece_z_m.size() - first);
-        s.program.set(s.loc_piece_z, piece_z_m.subspan(first, count));
+        program.set(depth ? s.loc_depth_piece_z : s.loc_piece_z, piece_z_m.subspan(first, count));
         gfx::draw_instanced(m.vao, m.index_count, count);
     }
 }

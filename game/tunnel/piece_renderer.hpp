@@ -48,6 +48,8 @@ struct PieceFrame {
     float head_cos_cone = 0.0f;  ///< cosine of the lamp's cone half angle (the beam fades over its outer fifth)
     const engine::gfx::ShadowMap* head_shadow = nullptr;
     glm::dvec3 eye_m{0.0};
+    /// Depth only (a shadow map's casters): the same bent positions, no shading (an empty fragment shader).
+    bool depth_only = false;
 };
 
 class PieceRenderer {
