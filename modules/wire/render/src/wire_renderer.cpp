@@ -185,16 +185,14 @@ struct WireRenderer::State {
         engine::scene::Camera camera;  ///< at the eye positions are relative to
         LodView lod;
     };
-    /// `camera` at settings.eye_m (if set) over the bound viewport; an orthographic camera is moved back to the
-    /// eye of LodView::orthographic() with its clip box unchanged (positions relative to that eye).
-    static View view_of(const engine::scene::Camera& camera, const DrawSettings& settings) {
+    /// `camera` over the bound viewport: positions are relative to its eye (offsets computed in double, sent as
+    /// float, projected with Camera::clip_from_relative(): wires far from the world origin keep their precision); an
+    /// orthographic camera is moved back to the eye of LodView::orthographic() with its clip box unchanged.
+    static View view_of(const engine::scene::Camera& camera) {
         GLint viewport[4] = {0, 0, 1, 1};
         glGetIntegerv(GL_VIEWPORT, viewport);
         const double w = std::max(viewport[2], 1), h = std::max(viewport[3], 1);
         View v{camera, {}};
-        const glm::dvec3 eye = settings.eye_m ? *settings.eye_m : camera.position;
-        v.camera.target += eye - camera.position;
-        v.camera.position = eye;
         const engine::scene::Camera& c = v.camera;
         if (!c.orthographic()) {
             v.lod = LodView::perspective(c.position, c.target, c.up, c.fov_y_rad, w, h, c.near_m, c.far_m);
@@ -255,7 +253,7 @@ struct WireRenderer::State {
         }
         const detail::NodeDrawContext ctx{*program, rings_vao, circle.id(), pattern_first, materials, textures,
                                           draw_parameters};
-        const View view = view_of(camera, settings);
+        const View view = view_of(camera);
         const bool drawn = nodes->prepare(list, view.lod, std::min(settings.view, kMaxViews - 1), *begun, ctx, stats);
         const bool streamed = node_stream && detail::stream_active(*node_stream);
         if (!stats.status.ok()) failed(stats, stats.status);
@@ -745,7 +743,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     stats.waited_for_gpu = region.waited;
 
     // Fill the region with sequential writes only (write-combined memory: never read it back).
-    const State::View view = State::view_of(camera, settings);
+    const State::View view = State::view_of(camera);
     const glm::dvec3 eye = view.camera.position;
     std::byte* base = region.data;
     const auto first_index_base = static_cast<uint32_t>((region.offset_bytes + index_offset) / sizeof(uint32_t));

@@ -37,7 +37,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -125,10 +124,6 @@ struct RendererDesc {
 struct DrawSettings {
     Light light{};           ///< the frame's directional light
     bool wireframe = false;  ///< glPolygonMode(GL_LINE) for this frame's wires
-    /// Overrides the eye (world metres); unset: camera.position, which is double itself (kept for callers that
-    /// predate the double camera). Offsets origin_m - eye are computed in double and sent as float, and the view
-    /// is Camera::clip_from_relative(), so wires far from the world origin keep their precision.
-    std::optional<glm::dvec3> eye_m{};
     /// What the draw writes (colour, depth only, G-buffer).
     Output output = Output::color;
     /// Which view this draw is, 0 .. kMaxViews - 1: a frame may draw the same list from several views (a camera,
