@@ -74,6 +74,8 @@ void Level::animate(double dt_s) {
         camera_.up = eye.normal;
     }
     s.context.camera = camera_;
+    s.context.other_views.clear();
+    if (options_.shadows) s.context.other_views.push_back(head_lamp_view(camera_));  // its casters stay listed
     s.context.viewport_width_px = s.width_px;
     s.context.viewport_height_px = s.height_px;
 }

@@ -47,8 +47,8 @@ namespace {
 constexpr int kHeadLampMapPx = 1024;  // a texel is 4.5 mm at 2 m: cables are 4 or more across
 constexpr float kHeadLampHalfAngle = 0.8f;  // radians
 constexpr float kHeadLampRange_m = 40.0f;
+}  // namespace
 
-/// The head lamp's view: 0.9 m above and 0.6 m right of the eye, looking where the camera looks.
 engine::scene::Camera head_lamp_view(const engine::scene::Camera& camera) {
     const glm::dvec3 forward = camera.forward();
     const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
@@ -56,7 +56,6 @@ engine::scene::Camera head_lamp_view(const engine::scene::Camera& camera) {
     return engine::scene::spot_light_view(camera.position + 0.9 * up + 0.6 * right, forward, kHeadLampHalfAngle,
                                           kHeadLampRange_m, 0.1f);
 }
-}  // namespace
 
 void Level::draw_shadow_map() {
     State& s = *state_;

@@ -80,6 +80,9 @@ inline double hash01(uint32_t x) {
 }
 
 // Everything the level owns besides what level.hpp shows.
+/// The head lamp's view (level_render.cpp): 0.9 m above and 0.6 m right of the eye, looking where the camera looks.
+engine::scene::Camera head_lamp_view(const engine::scene::Camera& camera);
+
 struct Level::State {
     LevelSettings settings;
     engine::ecs::Registry registry;

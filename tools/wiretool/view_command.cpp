@@ -380,9 +380,7 @@ int run_view(const ViewOptions& o) try {
     schedule.add("wire.render", [&](engine::ecs::Registry&, const engine::ecs::FrameContext&) {
         wire::render::DrawSettings settings;
         settings.light = {.to_light = glm::vec3(to_light), .ambient = 0.35f, .specular = 0.25f};
-        if (shadow_map) {
-            shadow_map->light = engine::scene::directional_light_view(to_light, frame_bounds.centre,
-                                                                       1.25 * std::max(frame_bounds.radius_m, 1e-6));
+        if (shadow_map) {  // its light was set with the frame's bounds, before the systems ran (other_views)
             shadow_map->begin();
             const wire::render::DrawStats cast = renderer.draw(
                 ctx.draw_list, shadow_map->light, {.output = wire::render::Output::shadow, .view = 1});
@@ -442,6 +440,13 @@ int run_view(const ViewOptions& o) try {
         const double distance = glm::length(pose.eye - b.centre);
         double far_m = 1.01 * (distance + reach);
         frame_bounds = b;
+        if (shadow_map) {
+            // The light's view: the systems keep the wires inside it in the list too (nodes path: a wire out of the
+            // camera's view still casts its shadow into it).
+            shadow_map->light =
+                engine::scene::directional_light_view(to_light, b.centre, 1.25 * std::max(b.radius_m, 1e-6));
+            ctx.other_views = {shadow_map->light};
+        }
         if (o.ground_y) {  // the ground reaches past the wires: so does the far plane
             const double drop = std::abs(b.centre.y - *o.ground_y);
             far_m = std::max(far_m, 1.01 * (distance + drop + 4.0 * reach + 20.0 * drop));

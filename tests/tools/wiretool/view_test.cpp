@@ -756,6 +756,41 @@ TEST_F(WiretoolView, NodesPathCsvHoldsTheRingsTheGpuDrew) {
     EXPECT_LE(sides_differ * 10, wire_frames);
 }
 
+// --ground and --light: a cable outside the camera's view (above and behind it) casts its shadow onto the ground the
+// camera sees, on the nodes path (the light's view keeps it in the draw list: WireContext::other_views). The shadow
+// is a dark band centred where the light projects the cable (analytically: z = -1 m, image row 113 of 720 for this
+// camera).
+TEST_F(WiretoolView, GroundAndLightShowTheShadowOfACableOutsideTheView) {
+    json wire{{"nodes", json::array()}, {"radius", 0.03}};
+    for (int i = 0; i <= 8; ++i) wire["nodes"].push_back({-2.0 + 0.5 * i, 1.0, -3.0});
+    const std::string in = write("outside.json", json{{"wires", json::array({wire})}}.dump());
+    ASSERT_EQ(run(in + " --camera 0,4,0,0,0,0 --fov 40 --ground 0 --light 0,1,-2 --png " + path("shadow.png") +
+                  " --stats " + path("shadow.json"))
+                  .status,
+              0);
+    const auto image = engine::platform::read_png(path("shadow.png"));
+    ASSERT_TRUE(image.ok());
+    // The camera looks straight down (image up is -z): ground z maps to row 360 + z * focal / 4, focal = 360 /
+    // tan(20 deg). The cable's shadow is centred at z = -1.
+    const double focal = 360.0 / std::tan(20.0 * std::numbers::pi / 180.0);
+    const int shadow_row = static_cast<int>(std::lround(360.0 - focal / 4.0));
+    // The darkening's centroid down the middle column; the band is 2 r sqrt(5) = 13.4 cm (33 px) wide.
+    const int lit = image->pixel(640, 600)[0];
+    int darkest = 255;
+    double mass = 0.0, moment = 0.0;
+    for (int y = 20; y < 700; ++y) {
+        const int v = image->pixel(640, y)[0];
+        darkest = std::min(darkest, v);
+        const double d = std::max(0.0, static_cast<double>(lit - v));
+        mass += d;
+        moment += d * y;
+    }
+    EXPECT_LT(darkest, lit * 3 / 4) << "no shadow: the darkest ground pixel of the middle column is " << darkest
+                                    << " against " << lit << " lit";
+    ASSERT_GT(mass, 0.0);
+    EXPECT_NEAR(moment / mass, shadow_row, 3.0) << "the shadow is not where the light projects the cable";
+}
+
 TEST_F(WiretoolView, HelpListsEveryOption) {
     const std::string out = path("help.txt");
     ASSERT_EQ(std::system((std::string(WIRETOOL_PATH) + " view --help > " + out).c_str()), 0);
@@ -763,7 +798,8 @@ TEST_F(WiretoolView, HelpListsEveryOption) {
     std::stringstream ss;
     ss << in.rdbuf();
     for (const char* option :
-         {"--camera", "--fov", "--size", "--tolerance-px", "--spline", "--path", "--png", "--csv", "--stats", "camera"})
+         {"--camera", "--fov", "--size", "--tolerance-px", "--spline", "--path", "--png", "--csv", "--stats", "--ground",
+          "--light", "camera"})
         EXPECT_NE(ss.str().find(option), std::string::npos) << option;
 }
 

@@ -13,13 +13,25 @@ void lod_system(Registry& registry, WireContext& ctx) {
         // blended curve); a wire without a sphere (c2, automatic: unknown overshoot) is sent and culled there.
         auto& storage = registry.storage<WireLodState>();
         const auto& curves = registry.storage<WireCurve>();  // looked up here: the workers only read it
+        // The other views' frusta (a square-pixel viewport of their aspect: the planes depend on it alone).
+        ctx.other_lod_views.clear();
+        for (const engine::scene::Camera& other : ctx.other_views) {
+            ctx.other_lod_views.push_back(lod_view(other, 1000.0 * static_cast<double>(other.aspect), 1000.0));
+        }
+        const auto outside_all = [&](const BoundingSphere& sphere) {
+            if (!sphere_outside_view(sphere, ctx.view)) return false;
+            for (const LodView& v : ctx.other_lod_views) {
+                if (!sphere_outside_view(sphere, v)) return false;
+            }
+            return true;
+        };
         constexpr std::size_t kBlock = 256;  // each wire writes only its own state
         parallel_over((storage.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
             for (std::size_t i = block * kBlock; i < std::min(storage.size(), (block + 1) * kBlock); ++i) {
                 const WireCurve* curve = curves.try_get(storage.at(i));
                 WireLodState& lod = storage.at_position(i);
                 const bool visible = curve != nullptr && curve->generation > 0 &&
-                                     (curve->bounds.radius_m < 0.0 || !sphere_outside_view(curve->bounds, ctx.view));
+                                     (curve->bounds.radius_m < 0.0 || !outside_all(curve->bounds));
                 if (visible != lod.lod.visible) ++lod.generation;
                 lod.lod.visible = visible;
                 lod.seen_curve = curve != nullptr ? curve->generation : 0;

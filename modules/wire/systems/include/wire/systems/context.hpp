@@ -51,6 +51,11 @@ struct WireContext {
     engine::scene::Camera camera{};      ///< the camera the wires are seen from (LOD and culling)
     double viewport_width_px = 1920.0;   ///< viewport the frame is drawn into, pixels (LOD screen error)
     double viewport_height_px = 1080.0;  ///< viewport height, pixels
+    /// The other views the frame draws the list from (a light's shadow map, a second camera): on the nodes path a
+    /// wire inside any of them, or the camera, stays in the draw list (each view then culls and chooses its LOD on
+    /// the GPU), so a cable above the camera's view still casts its shadow into it. cpu-mesh and gpu-rings build
+    /// rings for the camera only and ignore them.
+    std::vector<engine::scene::Camera> other_views;
     LodSettings lod{};                           ///< tolerance (px), max rings per segment, hysteresis
     UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_rings stops at ring records
     bool pop_free = true;                        ///< blend when node ids appear or vanish (pop_free.hpp)
@@ -68,6 +73,7 @@ struct WireContext {
 
     // ---- the systems' own bookkeeping ----
     LodView view{};                              ///< the camera as the LOD sees it (double)
+    std::vector<LodView> other_lod_views;        ///< other_views as the cull sees them (nodes path)
     uint64_t view_generation = 0;                ///< +1 whenever `view` or the LOD settings change
     LodSettings seen_lod{};                      ///< the LOD settings `view_generation` was taken with
     bool has_view = false;                       ///< `view` was computed at least once
