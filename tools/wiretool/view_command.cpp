@@ -100,7 +100,8 @@ struct CameraPose {
     double fov_deg = kDefaultFovDeg;
 };
 
-CameraPose parse_camera_option(const std::string& text) {
+/// `count` comma-separated finite numbers, or nothing.
+std::optional<std::vector<double>> parse_numbers(const std::string& text, std::size_t count) {
     std::vector<double> v;
     bool numbers = !text.empty() && text.back() != ',';
     std::stringstream ss(text);
@@ -109,8 +110,15 @@ CameraPose parse_camera_option(const std::string& text) {
         numbers = parse_number(cell, d);
         v.push_back(d);
     }
-    if (!numbers || v.size() != 6)
+    if (!numbers || v.size() != count) return std::nullopt;
+    return v;
+}
+
+CameraPose parse_camera_option(const std::string& text) {
+    const std::optional<std::vector<double>> parsed = parse_numbers(text, 6);
+    if (!parsed)
         throw BadInput{"--camera: expected EX,EY,EZ,TX,TY,TZ (6 finite numbers), got '" + text + "'"};
+    const std::vector<double>& v = *parsed;
     CameraPose c;
     c.eye = {v[0], v[1], v[2]};
     c.target = {v[3], v[4], v[5]};
@@ -119,16 +127,9 @@ CameraPose parse_camera_option(const std::string& text) {
 }
 
 glm::dvec3 parse_light_option(const std::string& text) {
-    std::vector<double> v;
-    bool numbers = !text.empty() && text.back() != ',';
-    std::stringstream ss(text);
-    for (std::string cell; numbers && std::getline(ss, cell, ',');) {
-        double d = 0;
-        numbers = parse_number(cell, d);
-        v.push_back(d);
-    }
-    if (!numbers || v.size() != 3) throw BadInput{"--light: expected DX,DY,DZ (3 finite numbers), got '" + text + "'"};
-    const glm::dvec3 d{v[0], v[1], v[2]};
+    const std::optional<std::vector<double>> v = parse_numbers(text, 3);
+    if (!v) throw BadInput{"--light: expected DX,DY,DZ (3 finite numbers), got '" + text + "'"};
+    const glm::dvec3 d{(*v)[0], (*v)[1], (*v)[2]};
     if (!(glm::length(d) > 0.0)) throw BadInput{"--light: the direction must not be zero"};
     return glm::normalize(d);
 }

@@ -6,7 +6,6 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <utility>
 
@@ -35,11 +34,7 @@ Expected<ShadowMap> ShadowMap::create(int size_px) {
     glNamedFramebufferReadBuffer(m.framebuffer_, GL_NONE);
     const GLenum status = glCheckNamedFramebufferStatus(m.framebuffer_, GL_DRAW_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
-        return Error{"shadow map: the depth framebuffer is incomplete (status 0x" + [&] {
-            char hex[16];
-            std::snprintf(hex, sizeof hex, "%x", status);
-            return std::string(hex);
-        }() + ")"};
+        return Error{"shadow map: the depth framebuffer is incomplete (status " + std::to_string(status) + ")"};
     }
     return m;
 }
