@@ -66,15 +66,16 @@ if(PYTHON_MODULE_DIR)
   endif()
 endif()
 file(GLOB_RECURSE installed "${prefix}/*")
-# Test support (modules/wire/testing: random families, exact references) is never installed: no header, and no
-# symbol of it in any installed library (wire::families, wire::testing, the Catenary reference, the pop-free family,
-# the curve stage's test hooks wire::detail::spread_test and node_segment_records).
+# Test support (modules/wire/testing: random families, exact references; modules/wire/render/testing: the compute
+# programs driven alone) is never installed: no header, and no symbol of it in any installed library
+# (wire::families, wire::testing, the Catenary reference, the pop-free family, the curve stage's test hooks
+# wire::detail::spread_test and node_segment_records, GpuCurvePass, GpuRingPass).
 foreach(f IN LISTS installed)
-  if(f MATCHES "/include/wire/testing/")
+  if(f MATCHES "/include/wire/testing/|/include/wire/render/testing/")
     message(FATAL_ERROR "package test: test-support header installed: ${f}")
   endif()
   if(f MATCHES "\\.(a|so)$")
-    file(STRINGS "${f}" support REGEX "wire8families|wire7testing|8Catenary|PopFreeFamily|13PopFreeEvent|11spread_test|20node_segment_records")
+    file(STRINGS "${f}" support REGEX "wire8families|wire7testing|8Catenary|PopFreeFamily|13PopFreeEvent|11spread_test|20node_segment_records|12GpuCurvePass|11GpuRingPass")
     if(support)
       list(GET support 0 first)
       message(FATAL_ERROR "package test: ${f} holds test-support code: ${first}")

@@ -1,11 +1,12 @@
-// Internal: what the GPU wire passes share. The per-wire header's GLSL (the same record as GpuCurveHeader), and the
+// Internal: what the GPU wire passes share. The per-wire header (its GLSL twin: shaders/wire_header.comp), and the
 // CPU side of a wire's upload: its curve nodes (float offsets from its origin, the radius in w), header and extras
-// (per-node tension, bias, continuity; per-segment stretch). GpuCurvePass and the renderer's nodes path use both.
+// (per-node tension, bias, continuity; per-segment stretch). The renderer's nodes path and the test passes (wire::render_testing) use both.
 #pragma once
 
 #include "wire/lod.hpp"
 #include "wire/packed_nodes.hpp"
-#include "wire/render/gpu_curves.hpp"
+#include "wire/curve.hpp"
+#include "wire/status.hpp"
 
 #include "engine/gfx/resources.hpp"
 
@@ -18,29 +19,36 @@
 
 namespace wire::render::detail {
 
-/// GpuCurveHeader in GLSL (std430, 64 bytes) and its flag bits; `GPU_WIRE_HEADER` in a source is replaced by it.
-inline constexpr const char* kWireHeaderGlsl = R"glsl(
-const uint kClosed = 1u, kCaps = 8u, kHasPerNode = 16u, kHasStretch = 32u, kGivenSegments = 64u, kFitMotion = 128u;
-struct Header {
-    uint node_first;     // this frame's curve nodes (the curve pass reads them)
-    uint node_count;     // curve nodes (merged)
-    uint segment_first;  // the wire's segments, and its per-segment ring counts
-    uint flags;          // bit 0 closed; 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2, 3 automatic); 3 caps; 4 per-node
-                         // values (kb, or the automatic spline's weights);
-                         // 5 stretch; 6 the segments are given (4 vec4 each at node_first); 7 the motion is
-                         // fitted on the GPU (the curve pass writes it); 8-15 the wire's
-                         // most sides (0: the LOD settings'); 16-31 material
-    vec4 kb;             // alpha, tension, bias, continuity (wire-wide)
-    uint extra_first;    // per-node kb (a vec4 a node), then stretch (4 segments a vec4), in the extras
-    uint slot;           // the wire's persistent slot (ring pass state)
-    float origin[3];     // the wire's origin, world metres (a point with float coordinates)
-    float motion[3];     // the rotation carrying the slot's last first normal here: a unit quaternion's x, y, z
+/// The per-wire record the passes read (std430, 64 bytes; its GLSL twin is shaders/wire_header.comp). Per-node
+/// tension, bias and continuity (Catmull-Rom wires that carry them, or the curvature-driven tension, computed on
+/// the CPU with build_curve's formula) and per-segment stretch travel in an "extras" array only for wires that have
+/// them.
+struct GpuCurveHeader {
+    uint32_t node_first = 0;     ///< first curve node of this upload
+    uint32_t node_count = 0;     ///< curve nodes (merged)
+    uint32_t segment_first = 0;  ///< first segment (and per-segment ring count) in the persistent storage
+    /// bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); bit 3 caps; bit 4 per-node kb in the extras
+    /// (a vec4 a node: tension, bias, continuity); bit 5 stretch in the extras (4 segments a vec4, after the kb);
+    /// bit 6 the segments are given (a blend); bit 7 the curve pass fits the motion (and writes it here, on the slot's
+    /// copy); bits 8-15 the wire's most sides; bits 16-31 material
+    uint32_t flags = 0;
+    float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
+    uint32_t extra_first = 0;  ///< first vec4 of the wire's extras
+    uint32_t slot = 0;         ///< the wire's persistent slot (LOD and frame state)
+    float origin_m[3] = {0.0f, 0.0f, 0.0f};  ///< the wire's origin (its nodes' box centre as float_point), metres
+    /// The rotation carrying the slot's last first normal to this upload: the vector part (sin(angle / 2) axis) of
+    /// wire::carried_rotation, whose w >= 0 the GPU recovers; zero: none (the plain projection).
+    float motion[3] = {0.0f, 0.0f, 0.0f};
 };
-)glsl";
+static_assert(sizeof(GpuCurveHeader) == 64, "GpuCurveHeader is the 64-byte std430 record");
+
+/// The most radial sides the GPU LOD gives (LodSettings::max_sides above it is taken as this).
+inline constexpr uint32_t kMaxSides = 256;
 
 /// The shader storage binding points of the curve and ring programs, dense from 0: GL guarantees 8 bindings and 8
 /// blocks a stage, NVIDIA 16 (a binding past that fails to link there, never on llvmpipe). The GLSL names them by
-/// macros of the same names in capitals (kRingJobs: RING_JOBS), defined by with_wire_header(), so both sides read
+/// macros of the same names in capitals (kRingJobs: RING_JOBS), defined by curve_program_source() and
+/// ring_program_source() (shaders.hpp), so both sides read
 /// one number.
 enum CurveBinding : uint32_t {
     kCurveHeaders, kCurveNodes, kCurveSegments, kCurveScratch, kCurveExtras, kCurveSlotHeaders, kCurveMotionRefs,
@@ -50,7 +58,7 @@ enum RingBinding : uint32_t {
     kRingHeaders, kRingSegments, kRingJobs, kRingCounts, kRingRings, kRingSlots, kRingCounter,
     kRingVisible, kRingDraws, kRingChunks, kRingBuckets, kRingCommands, kRingTemplates, kRingBindings
 };
-/// The binding macros with_wire_header() defines: (GLSL name, binding).
+/// The binding macros the compute programs define: (GLSL name, binding).
 struct BindingMacro {
     const char* name;
     uint32_t binding;
@@ -65,9 +73,6 @@ inline constexpr BindingMacro kBindingMacros[] = {
     {"RING_BUCKETS", kRingBuckets}, {"RING_COMMANDS", kRingCommands}, {"RING_TEMPLATES", kRingTemplates},
 };
 
-/// `source` with GPU_WIRE_HEADER replaced by the binding macros (kBindingMacros) and kWireHeaderGlsl.
-std::string with_wire_header(const char* source);
-
 inline constexpr uint32_t kHeaderClosed = 1u, kHeaderCaps = 8u, kHeaderPerNode = 16u, kHeaderStretch = 32u,
                           kHeaderGivenSegments = 64u, kHeaderFitMotion = 128u;
 /// The curve pass's per-slot motion reference (GLSL MotionRef): 12 vec4.
@@ -75,7 +80,7 @@ inline constexpr std::size_t kMotionRefBytes = 192;
 inline constexpr uint32_t kHeaderKindShift = 1u, kHeaderMaterialShift = 16u;
 inline constexpr uint32_t kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u, kKindAutomatic = 3u;
 
-/// The ring pass's per-dispatched-wire record (GLSL Job in ring_source(), std430).
+/// The ring pass's per-dispatched-wire record (GLSL Job in shaders/rings.comp, std430).
 struct Job {
     uint32_t ring_first = 0, ring_count = 0;
     uint32_t flags = 0;  ///< out bit 2: the rings came from the reserve (one a segment)
@@ -123,11 +128,6 @@ Status append_wire(const WireNodes& nodes, const SplineSettings& spline, uint32_
 
 /// The ring program's LOD uniforms for a view and settings (LodSettings' defaults applied as update_lod does).
 void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, const LodSettings& settings);
-
-/// The ring program's GLSL (GPU_WIRE_HEADER not yet replaced): gpu_rings.cpp.
-const char* ring_source();
-/// The curve program's GLSL (GPU_WIRE_HEADER not yet replaced): gpu_curves.cpp.
-const char* curve_source();
 
 /// Appends a curve given as segments (a wire in a pop-free blend): 4 vec4 a segment in `nodes` (b0 from the
 /// origin with its start node's radius in w; b1 - b0 with the end node's radius; b2 - b1 with the stretch;

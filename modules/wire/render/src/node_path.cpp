@@ -4,7 +4,6 @@
 #include "gpu_wire_data.hpp"
 #include "shaders.hpp"
 
-#include "wire/render/gpu_rings.hpp"
 #include "wire/render/upload_plan.hpp"
 
 #include <epoxy/gl.h>
@@ -63,9 +62,9 @@ void NodePath::set_lod(const LodSettings& lod) {
 
 Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     auto path = std::make_unique<NodePath>();
-    auto curve = gfx::make_program({.label = "wire nodes: curves", .compute = with_wire_header(curve_source())});
+    auto curve = gfx::make_program({.label = "wire nodes: curves", .compute = curve_program_source()});
     if (!curve) return curve.error();
-    auto rings = gfx::make_program({.label = "wire nodes: rings", .compute = with_wire_header(ring_source())});
+    auto rings = gfx::make_program({.label = "wire nodes: rings", .compute = ring_program_source()});
     if (!rings) return rings.error();
     path->curve_program_ = std::move(*curve);
     path->ring_program_ = std::move(*rings);

@@ -5,9 +5,9 @@
 #include "node_path.hpp"
 #include "node_stream_pass.hpp"
 #include "node_stream_state.hpp"
+#include "gpu_wire_data.hpp"
 
 #include "wire/packed_nodes.hpp"
-#include "wire/render/gpu_curves.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -24,6 +24,7 @@ constexpr std::size_t kAlign = 256;
 std::size_t align_up(std::size_t v) { return (v + kAlign - 1) / kAlign * kAlign; }
 }  // namespace
 
+using detail::GpuCurveHeader;
 using detail::StreamState;
 namespace gfx = engine::gfx;
 

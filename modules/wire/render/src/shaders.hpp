@@ -1,7 +1,9 @@
-// GLSL of the wire renderer (internal): one vertex shader per upload path, one fragment shader.
+// The wire programs' GLSL (internal; the text is in modules/wire/render/shaders): the curve and ring compute
+// programs, one vertex shader per upload path, the fragment shaders.
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 
@@ -34,5 +36,13 @@ enum class FragmentOutput { color, depth, gbuffer };
 /// lighting. `gbuffer` (gbuffer): optional GLSL declaring its outputs and defining void write_gbuffer(vec3 albedo,
 /// vec3 n, vec3 rel_m, float roughness); empty: the default layout. depth: a shader that writes nothing.
 std::string fragment_source(FragmentOutput output, std::string_view shading, std::string_view gbuffer);
+
+/// One program's GLSL: `#version 450 core`, then each piece after `#line 1 k` (k = 1, 2, ...), so a driver's
+/// message names piece k and its line ("k:line" on Mesa, "k(line)" on NVIDIA).
+std::string glsl_program(std::initializer_list<std::string_view> pieces);
+/// The curve program: the binding macros (kBindingMacros), wire_header.comp, curves*.comp.
+std::string curve_program_source();
+/// The ring program: the binding macros, wire_header.comp, rings*.comp.
+std::string ring_program_source();
 
 }  // namespace wire::render::detail

@@ -5,8 +5,8 @@
 // compared with build_curve of the nodes the GPU holds (rounded to float relative to the wire's origin); the
 // error is stated relative to the wire's extent (its largest node distance from that origin): float rounding of
 // an offset is 2^-24 of the extent (6e-8), and a control point is a short sum of such offsets and products.
-#include "wire/render/gpu_curves.hpp"
-#include "wire/render/gpu_rings.hpp"
+#include "wire/render/testing/gpu_curve_pass.hpp"
+#include "wire/render/testing/gpu_ring_pass.hpp"
 
 #include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"

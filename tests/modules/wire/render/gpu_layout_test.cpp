@@ -14,14 +14,12 @@
 #include "engine/platform/context.hpp"
 #include "gpu_wire_data.hpp"
 #include "shaders.hpp"
-#include "wire/render/gpu_curves.hpp"
 
 namespace {
 
 namespace gfx = engine::gfx;
 namespace platform = engine::platform;
 using namespace wire::render::detail;
-using wire::render::GpuCurveHeader;
 
 class GpuLayout : public ::testing::Test {
 protected:
@@ -51,7 +49,7 @@ protected:
     EXPECT_EQ(offset(program, glsl), static_cast<GLint>(offsetof(type, member))) << (glsl)
 
 TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
-    auto made = gfx::make_program({.label = "layout: rings", .compute = with_wire_header(ring_source())});
+    auto made = gfx::make_program({.label = "layout: rings", .compute = ring_program_source()});
     ASSERT_TRUE(made.ok()) << made.error().message;
     const gfx::Program& p = *made;
     // Job (the ring pass's per-wire record; read back by the nodes path and GpuRingPass).
@@ -91,7 +89,7 @@ TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
 }
 
 TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
-    auto curves = gfx::make_program({.label = "layout: curves", .compute = with_wire_header(curve_source())});
+    auto curves = gfx::make_program({.label = "layout: curves", .compute = curve_program_source()});
     ASSERT_TRUE(curves.ok()) << curves.error().message;
     EXPECT_EQ(stride(*curves, "headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
     EXPECT_FIELD(*curves, "headers[0].origin[0]", GpuCurveHeader, origin_m);
@@ -116,7 +114,7 @@ TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
 
 // The helper itself: a name the program does not have reads -1, so a renamed field cannot pass silently.
 TEST_F(GpuLayout, AnUnknownFieldReadsAsMissing) {
-    auto made = gfx::make_program({.label = "layout: rings", .compute = with_wire_header(ring_source())});
+    auto made = gfx::make_program({.label = "layout: rings", .compute = ring_program_source()});
     ASSERT_TRUE(made.ok()) << made.error().message;
     EXPECT_EQ(offset(*made, "jobs[0].no_such_field"), -1);
     EXPECT_GE(offset(*made, "jobs[0].totals"), 0);

@@ -50,8 +50,8 @@ TEST(ShaderResources, StorageBlocksFitEveryDesktopDriver) {
         std::size_t expected_bindings;  // 0: not a table of ours
     };
     const std::vector<Program> programs = {
-        {"curves", with_wire_header(curve_source()), kCurveBindings},
-        {"rings", with_wire_header(ring_source()), kRingBindings},
+        {"curves", curve_program_source(), kCurveBindings},
+        {"rings", ring_program_source(), kRingBindings},
         {"cpu-mesh vertex", vertex_source(true, true), 0},
         {"gpu-rings vertex", vertex_source(false, true), 0},
         {"gpu-rings vertex (attribute)", vertex_source(false, false), 0},
@@ -80,8 +80,8 @@ TEST(ShaderResources, DefaultUniformBlocksFitTheMinimumWithVec4Slots) {
     const std::map<std::string, int> slots = {{"float", 1}, {"int", 1}, {"uint", 1}, {"bool", 1}, {"vec2", 1},
                                               {"vec3", 1}, {"vec4", 1}, {"uvec4", 1}, {"mat3", 3}, {"mat4", 4},
                                               {"dvec3", 2}, {"double", 1}};
-    for (const auto& [name, source] : {std::pair{"curves", with_wire_header(curve_source())},
-                                       std::pair{"rings", with_wire_header(ring_source())}}) {
+    for (const auto& [name, source] : {std::pair{"curves", curve_program_source()},
+                                       std::pair{"rings", ring_program_source()}}) {
         const std::regex uniform(R"((?:^|\n)[ \t]*uniform\s+(\w+)\s+([^;]+);)");  // declarations, not comments
         int components = 0, declared = 0;
         for (auto it = std::sregex_iterator(source.begin(), source.end(), uniform); it != std::sregex_iterator(); ++it) {

@@ -1,5 +1,5 @@
-// The curve stage on the GPU (issue 30, step 1 of docs/issue30_plan.md): a compute pass that turns many wires'
-// nodes into their Bezier segments in one dispatch, one invocation per wire, the way wire::build_curve does on the
+// Test harness (wire::render_testing, never installed): the nodes path's curve program driven alone. A compute pass
+// that turns many wires' nodes into their Bezier segments in one dispatch, one invocation per wire, the way wire::build_curve does on the
 // CPU, which stays the reference (tests/modules/wire/render/gpu_curves_test.cpp compares the two).
 //
 //   auto pass = wire::render::GpuCurvePass::create();   // needs a current GL 4.5 context
@@ -28,6 +28,8 @@
 #include "wire/nodes.hpp"
 #include "wire/status.hpp"
 
+#include "gpu_wire_data.hpp"
+
 #include "engine/core/expected.hpp"
 #include "engine/gfx/resources.hpp"
 
@@ -52,28 +54,6 @@ struct GpuCurveWire {
     bool fit_motion = false;
 };
 
-/// The per-wire record the passes read (std430, 64 bytes; its GLSL twin is in src/gpu_wire_data.hpp). Per-node
-/// tension, bias and continuity (Catmull-Rom wires that carry them, or the curvature-driven tension, computed on
-/// the CPU with build_curve's formula) and per-segment stretch travel in an "extras" array only for wires that have
-/// them.
-struct GpuCurveHeader {
-    uint32_t node_first = 0;     ///< first curve node of this upload
-    uint32_t node_count = 0;     ///< curve nodes (merged)
-    uint32_t segment_first = 0;  ///< first segment (and per-segment ring count) in the persistent storage
-    /// bit 0 closed; bits 1-2 kind (0 linear, 1 Catmull-Rom, 2 c2); bit 3 caps; bit 4 per-node kb in the extras
-    /// (a vec4 a node: tension, bias, continuity); bit 5 stretch in the extras (4 segments a vec4, after the kb);
-    /// bit 6 the segments are given (a blend); bit 7 the curve pass fits the motion (and writes it here, on the slot's
-    /// copy); bits 8-15 the wire's most sides; bits 16-31 material
-    uint32_t flags = 0;
-    float alpha = 0.5f, tension = 0.0f, bias = 0.0f, continuity = 0.0f;
-    uint32_t extra_first = 0;  ///< first vec4 of the wire's extras
-    uint32_t slot = 0;         ///< the wire's persistent slot (LOD and frame state)
-    float origin_m[3] = {0.0f, 0.0f, 0.0f};  ///< the wire's origin (its nodes' box centre as float_point), metres
-    /// The rotation carrying the slot's last first normal to this upload: the vector part (sin(angle / 2) axis) of
-    /// wire::carried_rotation, whose w >= 0 the GPU recovers; zero: none (the plain projection).
-    float motion[3] = {0.0f, 0.0f, 0.0f};
-};
-static_assert(sizeof(GpuCurveHeader) == 64, "GpuCurveHeader is the 64-byte std430 record");
 
 /// One wire's segments read back: control points relative to `origin_m`.
 struct GpuCurveResult {
@@ -110,7 +90,7 @@ private:
     engine::gfx::Program program_;
     engine::gfx::Buffer headers_, nodes_, segments_, scratch_, extras_, motion_refs_;
     std::size_t motion_ref_wires_ = 0;  // wires motion_refs_ holds (kept between builds of as many wires)
-    std::vector<GpuCurveHeader> header_data_;
+    std::vector<detail::GpuCurveHeader> header_data_;
     std::vector<glm::dvec3> origins_;
     std::size_t segment_total_ = 0, node_bytes_ = 0, header_bytes_ = 0, extra_bytes_ = 0;
 };

@@ -1,4 +1,5 @@
-// The ring stage on the GPU (issue 30, step 3 of docs/issue30_plan.md): from the segments a GpuCurvePass built,
+// Test harness (wire::render_testing, never installed): the nodes path's ring program driven alone. From the
+// segments a GpuCurvePass built,
 // one compute dispatch writes every wire's ring records (wire::PackedRing, the 28-byte form the gpu-rings vertex
 // shader reads), one invocation per wire walking its rings in order, as wire::place_rings + wire::build_rings do
 // on the CPU, which stays the reference (tests/modules/wire/render/gpu_rings_test.cpp compares the two):
@@ -33,7 +34,7 @@
 
 #include "wire/lod.hpp"
 #include "wire/packed_ring.hpp"
-#include "wire/render/gpu_curves.hpp"
+#include "wire/render/testing/gpu_curve_pass.hpp"
 
 #include <glm/vec3.hpp>
 
@@ -57,9 +58,6 @@ struct GpuRingJob {
     /// previous_normal are then not read. A wire without a last build is seeded.
     bool carry_last = false;
 };
-
-/// The most radial sides the GPU LOD gives (LodSettings::max_sides above it is taken as this).
-inline constexpr uint32_t kMaxSides = 256;
 
 /// The LOD a build evaluates on the GPU.
 struct GpuLodFrame {
