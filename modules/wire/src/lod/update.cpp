@@ -1,12 +1,13 @@
 // The LOD update: ring counts by screen-space error (Wang counts at the hull's nearest depth, or merged spans of
-// the hierarchy walk), side counts from the projected radius, the per-segment passes, hysteresis, the coherence
-// reuse of the last update.
+// the hierarchy walk), side counts from the projected radius, hysteresis; the per-segment passes and the coherence
+// reuse of the last update are in lod/update_passes.cpp.
 #include "wire/lod.hpp"
 
 #include "lod/bounds.hpp"
 #include "lod/cull.hpp"
 #include "lod/span_kernels.hpp"
 #include "lod/span_walk.hpp"
+#include "lod/update_passes.hpp"
 #include "lod/view.hpp"
 
 #include <glm/geometric.hpp>
@@ -25,8 +26,8 @@ using namespace lod_stage;
 
 namespace {
 
-uint32_t wang_px(const CubicBezier& c, const HullDepth& h, const LodView& view, double tolerance_px,
-                 uint32_t max_rings, bool* clamped) {
+uint32_t wang_px(const CubicBezier& c, const HullDepth& h, const LodView& view, double tolerance_px, uint32_t max_rings,
+                 bool* clamped) {
     const double eps_world = tolerance_px * h.z_min / (view.focal_px * h.k);
     const uint32_t n = wang_ring_count(c, eps_world, max_rings);
     if (clamped != nullptr && n >= max_rings) {
@@ -41,8 +42,8 @@ uint32_t wang_px(const CubicBezier& c, const HullDepth& h, const LodView& view, 
 
 uint32_t segment_ring_count_px(const CubicBezier& segment, const LodView& view, double tolerance_px,
                                uint32_t max_rings) {
-    return wang_px(segment, hull_depth(ViewTransform(view).hull(segment), view), view, tolerance_or_default(tolerance_px),
-                   max_rings ? max_rings : default_max_rings, nullptr);
+    return wang_px(segment, hull_depth(ViewTransform(view).hull(segment), view), view,
+                   tolerance_or_default(tolerance_px), max_rings ? max_rings : default_max_rings, nullptr);
 }
 
 uint32_t sides_for_radius(double radius_m, double z_m, double k, const LodView& view, double tolerance_px,
@@ -84,224 +85,6 @@ uint32_t drawn_sides_for(double radius_px, uint32_t sides, uint32_t old_drawn, c
     return sides;
 }
 
-struct Limits {
-    double eps;
-    uint32_t max_rings, max_sides;
-    double band;
-    explicit Limits(const LodSettings& settings)
-        : eps(tolerance_or_default(settings.tolerance_px)),
-          max_rings(settings.max_rings_per_segment ? settings.max_rings_per_segment : default_max_rings),
-          max_sides(std::max<uint32_t>(settings.max_sides ? settings.max_sides : default_max_sides, 3)),
-          band(settings.hysteresis_band == 0.0 ? default_band : settings.hysteresis_band) {}
-};
-
-// Every segment's hull depth, off-axis factor and plane mask, into scratch(): z_min, k, outside.
-// with_planes = false: the depths only (scratch().outside is left as it is).
-void hull_depths(const Curve& curve, const LodView& view, double radius_m, bool with_planes = true) {
-    const std::size_t n = curve.segment_count();
-    Scratch& sc = scratch();
-    sc.z_min.resize(n);
-    sc.k.resize(n);
-    if (with_planes) sc.outside.resize(n);
-    const ViewTransform tf(view);
-    const PlaneTest planes(view, radius_m);
-    HullConstants h{};
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) h.m[3 * c + r] = tf.rotation[c][r];
-    for (int r = 0; r < 3; ++r) h.t[r] = tf.translation[r];
-    h.near = view.near_m;
-    h.far = view.far_m;
-    h.tx = view.tan_half_x;
-    h.ty = view.tan_half_y;
-    h.neg_rx = -planes.rx;
-    h.neg_ry = -planes.ry;
-    h.neg_r = -planes.r;
-    span_kernels().hull_depths(curve.segments.data(), n, h, sc.z_min.data(), sc.k.data(),
-                               with_planes ? sc.outside.data() : nullptr);
-}
-
-// Per-segment pass: required Wang counts (and visibility, depth) of every segment from the hull depths and the
-// bounds' cached Wang's M. Returns false if the wire is culled by the hull test.
-bool per_segment_required(const Curve& curve, const LodView& view, const LodSettings& settings,
-                          const Limits& lim, const LodBounds& bounds, double radius, WireLod& lod,
-                          double& wire_z, double& wire_k) {
-    const std::size_t n = curve.segment_count();
-    hull_depths(curve, view, radius);
-    Scratch& sc = scratch();
-    const double* zmin = sc.z_min.data();
-    const double* ks = sc.k.data();
-    unsigned wire_outside = 63u;
-    for (std::size_t i = 0; i < n; ++i) wire_outside &= sc.outside[i];
-    if (wire_outside != 0) return false;
-
-    lod.required.resize(n);
-    wire_z = std::numeric_limits<double>::infinity();
-    wire_k = 1.0;
-    const double scale = lim.eps / view.focal_px;
-    // Wang's M of every segment (cached in the bounds), then every segment's count and clamp flag in a lane kernel
-    // (computed for all; used where the segment needs them).
-    const double* mm = &bounds.data[bounds.data.size() - bounds.segments];  // wang_m(0 .. n): segments == n here
-    sc.raw.resize(n);
-    sc.clamped.resize(n);
-    span_kernels().wang_counts(zmin, ks, mm, n, scale, static_cast<double>(lim.max_rings), sc.raw.data(),
-                               sc.clamped.data());
-    uint32_t visible = 0, clamped = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const bool seg_visible = sc.outside[i] == 0;
-        uint32_t raw = 1;
-        if (seg_visible || !settings.coarse_offscreen_segments) {
-            raw = static_cast<uint32_t>(sc.raw[i]);  // an integer in [1, max_rings]
-            clamped += sc.clamped[i] != 0.0 ? 1u : 0u;
-            if (seg_visible) {
-                ++visible;
-                wire_z = std::min(wire_z, zmin[i]);
-                wire_k = std::max(wire_k, ks[i]);
-            }
-        }
-        lod.required[i] = raw;
-    }
-    lod.visible_segments += visible;
-    lod.clamped_segments += clamped;
-    return true;
-}
-
-bool same_settings(const WireLod::Coherence& c, const Limits& lim, const LodSettings& s) {
-    return c.tolerance_px == lim.eps && c.band == lim.band && c.max_sides == lim.max_sides &&
-           c.max_rings == lim.max_rings && c.coarse_offscreen == s.coarse_offscreen_segments &&
-           c.keep_node_resolution == s.keep_node_resolution;
-}
-
-// The coherence test (WireLod::Coherence): true if the state of the last update stands for this camera.
-bool reuse(const Curve& curve, const LodView& view, const LodSettings& settings, const Limits& lim,
-           const LodBounds& bounds, WireLod& lod) {
-    const WireLod::Coherence& c = lod.coherence;
-    if (!c.valid || c.bounds != &bounds || c.bounds_version != bounds.version || !lod.visible ||
-        lod.counts.size() != curve.segment_count() || !same_settings(c, lim, settings)) {
-        return false;
-    }
-    const SphereScreenBound sb = sphere_screen_bound(bounds.sphere.centre_m, bounds.sphere.radius_m, view, lim.eps);
-    if (!sb.inside) return false;
-    if (!c.exact_sides &&
-        sides_for_radius(bounds.radius_max_m, sb.z_lo_m, sb.k, view, lim.eps, lim.max_sides) != 3) {
-        return false;
-    }
-    if (!c.whole && !one_ring_per_segment(bounds, sb)) return false;
-    // Every point of the sphere moved by at most delta in view space: |R' - R| |p - e'| + |e' - e|.
-    const ViewTransform tf(view);
-    double rf = 0.0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            const double d = tf.rotation[i][j] - c.rotation[i][j];
-            rf += d * d;
-        }
-    const double delta = std::sqrt(rf) * (glm::length(bounds.sphere.centre_m - view.eye_m) + bounds.sphere.radius_m) +
-                         glm::length(view.eye_m - c.eye_m);
-    if (!(c.z_lo_m - delta > view.near_m)) return false;
-    const double kr = sb.k / c.k;
-    const double factor = std::max(kr * c.z_lo_m / (c.z_lo_m - delta), (c.z_lo_m + delta) / (c.z_lo_m * kr));
-    if (!(factor * (1.0 + 1e-9) < c.margin)) return false;
-    double z_min = sb.z_lo_m;
-    if (c.exact_sides) {
-        // The segments' nearest depth moved by at most delta, their off-axis factors as a = |x|/z allows:
-        // sqrt(k^2 - 1) within (sqrt(k^2 - 1) -+ sqrt2 e) / (1 +- e), e = delta / z. The side count must not move.
-        const double e = delta / c.wire_z_m;
-        if (!(e < 0.5) || !(c.wire_z_m - delta > view.near_m)) return false;
-        const double ka = std::sqrt(std::max(c.wire_k * c.wire_k - 1.0, 0.0));
-        const double ka_hi = (ka + std::numbers::sqrt2 * e) / (1.0 - e);
-        const double ka_lo = std::max(0.0, (ka - std::numbers::sqrt2 * e) / (1.0 + e));
-        const double r = bounds.radius_max_m;
-        const uint32_t most =
-            sides_for_radius(r, c.wire_z_m - delta, std::sqrt(1.0 + ka_hi * ka_hi), view, lim.eps, lim.max_sides);
-        const uint32_t least =
-            sides_for_radius(r, c.wire_z_m + delta, std::sqrt(1.0 + ka_lo * ka_lo), view, lim.eps, lim.max_sides);
-        if (most != lod.required_sides || least != lod.required_sides) return false;
-        z_min = c.wire_z_m - delta;  // a lower bound of the segments' nearest depth
-    }
-    lod.z_min_m = z_min;
-    lod.changed_counts = 0;
-    ++lod.reused;
-    return true;
-}
-
-// Wang's count of one segment from its hull depth, with the cached M (wang_ring_count() on it).
-uint32_t wang_cached(double m, double eps_world, const Limits& lim, uint32_t& clamped) {
-    if (!(eps_world > 0.0) || !std::isfinite(m)) return lim.max_rings;
-    const double c = std::ceil(std::sqrt(3.0 * m / (4.0 * eps_world)));
-    const uint32_t raw = !(c < static_cast<double>(lim.max_rings)) ? lim.max_rings
-                                                                     : std::max<uint32_t>(1, static_cast<uint32_t>(c));
-    if (raw >= lim.max_rings && !(c <= static_cast<double>(lim.max_rings))) ++clamped;
-    return raw;
-}
-
-enum class SegmentPass { done, culled, fallback };
-
-// The per-segment pass of a wire partly out of view whose side count the wire's sphere already fixes at 3:
-// each segment's sphere (LodBounds level 0) decides it when it lies inside the frustum (visible; one ring when
-// the sphere's depth allows) or outside a plane (off screen, so is its hull); only the other segments take the
-// hull test and hull depth. The same required counts and visibility as per_segment_required(); the depth kept
-// is a lower bound. `fallback` when no segment was found visible (the hull test must then decide culling).
-SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const Limits& lim, const LodBounds& b,
-                                double radius, WireLod& lod, double& wire_z) {
-    const std::size_t n = curve.segment_count();
-    const ViewTransform tf(view);
-    const PlaneTest planes(view, radius);
-    const double tx = view.tan_half_x, ty = view.tan_half_y;
-    const double sx = edge_factors(view).sx, sy = edge_factors(view).sy;
-    const double scale = lim.eps / view.focal_px;
-    lod.required.resize(n);
-    unsigned wire_outside = 63u;
-    wire_z = std::numeric_limits<double>::infinity();
-    uint32_t visible = 0, clamped = 0;
-    const double* d0 = b.level_data(0);  // level 0: centre x, y, z and radius of each segment's sphere
-    for (std::size_t i = 0; i < n; ++i) {
-        const glm::dvec3 q = tf(glm::dvec3(d0[i], d0[n + i], d0[2 * n + i]));
-        const double r0 = d0[3 * n + i], ri = r0 + radius;
-        const double l = q.x + q.z * tx, rt = q.z * tx - q.x, bt = q.y + q.z * ty, tp = q.z * ty - q.y;
-        const double ne = q.z - view.near_m, fa = view.far_m - q.z;
-        const double rx = ri * sx, ry = ri * sy;
-        const unsigned outside = (l < -rx ? 1u : 0u) | (rt < -rx ? 2u : 0u) | (bt < -ry ? 4u : 0u) |
-                                 (tp < -ry ? 8u : 0u) | (ne < -ri ? 16u : 0u) | (fa < -ri ? 32u : 0u);
-        if (outside != 0) {  // every control point is outside these planes: the hull test says off screen too
-            wire_outside &= outside;
-            lod.required[i] = 1;
-            continue;
-        }
-        const bool inside = l >= rx && rt >= rx && bt >= ry && tp >= ry && ne >= ri && fa >= ri;
-        if (inside) {
-            const double zl = q.z - r0;  // > near: the sphere is in front of the near plane
-            const double a = std::min(tx, (std::abs(q.x) + r0) / zl), c = std::min(ty, (std::abs(q.y) + r0) / zl);
-            const double k = std::sqrt(1.0 + a * a + c * c);
-            wire_outside = 0;
-            ++visible;
-            if (3.0 * b.wang_m(i) <= 4.0 * (scale * zl / k) * (1.0 - 1e-9)) {
-                lod.required[i] = 1;  // the hull's depth is larger and its k smaller: the exact count is 1 too
-                wire_z = std::min(wire_z, zl);
-                continue;
-            }
-            const HullDepth h = hull_depth(tf.hull(curve.segments[i]), view);
-            lod.required[i] = wang_cached(b.wang_m(i), scale * h.z_min / h.k, lim, clamped);
-            wire_z = std::min(wire_z, h.z_min);
-            continue;
-        }
-        const ViewHull hull = tf.hull(curve.segments[i]);
-        const unsigned o = planes.outside(hull);
-        wire_outside &= o;
-        if (o != 0) {
-            lod.required[i] = 1;
-            continue;
-        }
-        ++visible;
-        const HullDepth h = hull_depth(hull, view);
-        lod.required[i] = wang_cached(b.wang_m(i), scale * h.z_min / h.k, lim, clamped);
-        wire_z = std::min(wire_z, h.z_min);
-    }
-    if (wire_outside != 0) return SegmentPass::culled;  // a superset of the hull test's planes: culled as well
-    if (visible == 0) return SegmentPass::fallback;
-    lod.visible_segments = visible;
-    lod.clamped_segments = clamped;
-    return SegmentPass::done;
-}
-
 // built_levels: the hierarchy levels of `bounds` that were built (all but for update_lod_once(), which leaves out
 // levels an update of a wire inside the frustum cannot read: see TopLevels).
 bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
@@ -340,8 +123,8 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     } else {
         sb.k = edge_factors(view).corner;
     }
-    SpanMerger merger(bounds, view, lim.eps, sb.inside, sb.k, curve.closed,
-                      settings.coarse_offscreen_segments, lim.band < 0.0 ? 1.0 : 1.0 / (1.0 + lim.band), old);
+    SpanMerger merger(bounds, view, lim.eps, sb.inside, sb.k, curve.closed, settings.coarse_offscreen_segments,
+                      lim.band < 0.0 ? 1.0 : 1.0 / (1.0 + lim.band), old);
     // The margin only serves a Coherence, which is kept for bounds that outlive this update and a wire inside.
     const bool keeps_coherence = use_bound && !bounds.transient && sb.inside;
     if (!keeps_coherence) merger.skip_margin();
@@ -358,7 +141,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     if (use_bound && bounds.sphere.radius_m >= 0.0 && sb.inside) {
         const std::size_t root = merger.root_level();
         // A root not built has a ratio above 1 (TopLevels): not one interval.
-        const double root_ratio = !merge                  ? 0.0
+        const double root_ratio = !merge                ? 0.0
                                   : root < built_levels ? merger.ratio(root, 0)
                                                         : std::numeric_limits<double>::infinity();
         if (merge) merger.note(root_ratio);
@@ -453,9 +236,10 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     lod.z_min_m = std::isfinite(wire_z) ? wire_z : 0.0;
     // conservative_sides: the bound's call above, with these very arguments (the visible segments are all of
     // them), gave 3 (and so does the non-finite case).
-    lod.required_sides = conservative_sides       ? 3u
-                         : std::isfinite(wire_z) ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides)
-                                                 : 3u;
+    lod.required_sides = conservative_sides ? 3u
+                         : std::isfinite(wire_z)
+                             ? sides_for_radius(radius, wire_z, wire_k, view, lim.eps, lim.max_sides)
+                             : 3u;
     // Clamped before the comparison: a lowered max_sides changes the sides, and the caller must hear of it.
     const uint32_t sides = std::min(
         restart ? lod.required_sides : hysteresis_count(lod.sides, lod.required_sides, lim.band), lim.max_sides);
@@ -503,8 +287,7 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
     } else {
         compute_lod_bounds(curve, lb);
     }
-    return update_lod_impl(curve, view, settings, lod, lb, bounds != nullptr && bounds->radius_m >= 0.0,
-                           false);
+    return update_lod_impl(curve, view, settings, lod, lb, bounds != nullptr && bounds->radius_m >= 0.0, false);
 }
 
 bool update_lod(const Curve& curve, const LodView& view, const LodSettings& settings, WireLod& lod,
@@ -515,22 +298,22 @@ bool update_lod(const Curve& curve, const LodView& view, const LodSettings& sett
     return update_lod_impl(curve, view, settings, lod, bounds, true, true);
 }
 
-bool update_lod_once(const Curve& curve, const BoundingSphere& sphere, const LodView& view,
-                     const LodSettings& settings, WireLod& lod) {
+bool update_lod_once(const Curve& curve, const BoundingSphere& sphere, const LodView& view, const LodSettings& settings,
+                     WireLod& lod) {
     thread_local LodBounds bounds;
     bounds.transient = true;  // no Coherence: the next update has new bounds
     // The stop of TopLevels where its conditions hold: a merging wire whose sphere is inside the frustum, finite
     // and bounded coordinates (the sphere's box here, level 0's probe for NaN), a positive finite z_hi.
     const double eps = tolerance_or_default(settings.tolerance_px);
-    const SphereScreenBound sb = sphere.radius_m >= 0.0 ? sphere_screen_bound(sphere.centre_m, sphere.radius_m, view, eps)
-                                                        : SphereScreenBound{};
+    const SphereScreenBound sb =
+        sphere.radius_m >= 0.0 ? sphere_screen_bound(sphere.centre_m, sphere.radius_m, view, eps) : SphereScreenBound{};
     const double zh = std::max(sb.z_hi_m, view.near_m);
-    const double extent = (std::abs(sphere.centre_m.x) + std::abs(sphere.centre_m.y) + std::abs(sphere.centre_m.z)) +
-                          sphere.radius_m;
+    const double extent =
+        (std::abs(sphere.centre_m.x) + std::abs(sphere.centre_m.y) + std::abs(sphere.centre_m.z)) + sphere.radius_m;
     const double eye = (std::abs(view.eye_m.x) + std::abs(view.eye_m.y)) + std::abs(view.eye_m.z);
     const TopLevels stop{view.focal_px / eps, sb.k, zh + 1e-6 * ((zh + extent) + eye)};
-    const bool may_stop = sb.inside && !settings.keep_node_resolution && extent <= 1e149 && eye <= 1e149 &&
-                          zh > 0.0 && zh <= 1e149 && std::isfinite(stop.c * stop.k);
+    const bool may_stop = sb.inside && !settings.keep_node_resolution && extent <= 1e149 && eye <= 1e149 && zh > 0.0 &&
+                          zh <= 1e149 && std::isfinite(stop.c * stop.k);
     const std::size_t built = compute_lod_bounds_impl(curve, bounds, &sphere, may_stop ? &stop : nullptr);
     return update_lod_impl(curve, view, settings, lod, bounds, false, true, built, &sb);
 }

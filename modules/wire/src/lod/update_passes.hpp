@@ -1,0 +1,48 @@
+// Internal: the LOD update's passes before the hierarchy walk (lod/update_passes.cpp), shared with the update itself
+// (lod/update.cpp): the limits from the settings, the coherence test, the hull depths and the per-segment passes.
+#pragma once
+
+#include "wire/lod.hpp"
+
+#include "lod/view.hpp"
+
+#include <algorithm>
+#include <cstdint>
+
+namespace wire::lod_stage {
+
+struct Limits {
+    double eps;
+    uint32_t max_rings, max_sides;
+    double band;
+    explicit Limits(const LodSettings& settings)
+        : eps(tolerance_or_default(settings.tolerance_px)),
+          max_rings(settings.max_rings_per_segment ? settings.max_rings_per_segment : default_max_rings),
+          max_sides(std::max<uint32_t>(settings.max_sides ? settings.max_sides : default_max_sides, 3)),
+          band(settings.hysteresis_band == 0.0 ? default_band : settings.hysteresis_band) {}
+};
+
+// The coherence test (WireLod::Coherence): true if the state of the last update stands for this camera.
+bool reuse(const Curve& curve, const LodView& view, const LodSettings& settings, const Limits& lim,
+           const LodBounds& bounds, WireLod& lod);
+
+// Every segment's hull depth, off-axis factor and plane mask, into scratch(): z_min, k, outside.
+// with_planes = false: the depths only (scratch().outside is left as it is).
+void hull_depths(const Curve& curve, const LodView& view, double radius_m, bool with_planes = true);
+
+// Per-segment pass: required Wang counts (and visibility, depth) of every segment from the hull depths and the
+// bounds' cached Wang's M. Returns false if the wire is culled by the hull test.
+bool per_segment_required(const Curve& curve, const LodView& view, const LodSettings& settings, const Limits& lim,
+                          const LodBounds& bounds, double radius, WireLod& lod, double& wire_z, double& wire_k);
+
+enum class SegmentPass { done, culled, fallback };
+
+// The per-segment pass of a wire partly out of view whose side count the wire's sphere already fixes at 3:
+// each segment's sphere (LodBounds level 0) decides it when it lies inside the frustum (visible; one ring when
+// the sphere's depth allows) or outside a plane (off screen, so is its hull); only the other segments take the
+// hull test and hull depth. The same required counts and visibility as per_segment_required(); the depth kept
+// is a lower bound. `fallback` when no segment was found visible (the hull test must then decide culling).
+SegmentPass per_segment_bounded(const Curve& curve, const LodView& view, const Limits& lim, const LodBounds& b,
+                                double radius, WireLod& lod, double& wire_z);
+
+}  // namespace wire::lod_stage
