@@ -60,6 +60,7 @@ if(WIRE_BUILD_TESTS)
   wires_add_doc_check(api_docs_game_api
     ${src}/modules/wire/include/wire/nodes.hpp ${src}/modules/wire/include/wire/draw.hpp
     ${src}/modules/wire/render/include/wire/render/wire_renderer.hpp
+    ${src}/modules/wire/render/include/wire/render/install.hpp
     ${src}/engine/ecs/include/engine/ecs/registry.hpp ${src}/engine/ecs/include/engine/ecs/entity.hpp
     ${src}/engine/ecs/include/engine/ecs/schedule.hpp
     ${src}/engine/platform/include/engine/platform/context.hpp

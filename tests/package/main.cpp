@@ -1,6 +1,7 @@
 // Consumer of the installed wires package: runs README.md's "Wires from game code" example unchanged in a
 // headless GL context, then checks that the wire was drawn where its nodes project. Exit 0 on success, 1 with
 // a message on failure.
+#include <wire/render/install.hpp>
 #include <wire/render/wire_renderer.hpp>
 #include <wire/systems/api.hpp>
 #include <wire/systems/systems.hpp>
