@@ -1,5 +1,5 @@
 // Internal: the span hierarchy walk (SpanMerger) and the update's per-thread working memory. A header so that the
-// update inlines the walk (one translation unit: lod/update.cpp).
+// update inlines the walk (it runs in lod/update.cpp; lod/update_passes.cpp shares the working memory).
 #pragma once
 
 #include "lod/span_kernels.hpp"
