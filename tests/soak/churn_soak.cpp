@@ -493,7 +493,7 @@ void Soak::check_errors() {
 Sample Soak::sample(const wire::render::DrawStats& fs) {
     const GlObjects gl = count_gl_objects();
     // The nodes path compiles its two compute programs on its first frame.
-    const int programs = baseline_.programs + static_cast<int>(renderer_->node_path_programs());
+    const int programs = baseline_.programs + static_cast<int>(renderer_->info().node_path_programs);
     if (gl.textures != baseline_.textures || gl.vertex_arrays != baseline_.vertex_arrays ||
         gl.programs != programs || gl.shaders != baseline_.shaders ||
         gl.framebuffers != baseline_.framebuffers)
@@ -504,12 +504,12 @@ Sample Soak::sample(const wire::render::DrawStats& fs) {
     // Every live GL buffer is either one the renderer made before the soak, or a stream buffer still alive.
     // (The retained ring storage likewise: its current buffer plus retired ones waiting for fences; and the nodes
     // path's buffers.)
-    const int allowed = baseline_.buffers + static_cast<int>(renderer_->live_stream_buffers()) - 1 +
-                        static_cast<int>(renderer_->live_ring_buffers()) - 1 +
-                        static_cast<int>(renderer_->node_path_buffers());
+    const int allowed = baseline_.buffers + static_cast<int>(renderer_->info().live_stream_buffers) - 1 +
+                        static_cast<int>(renderer_->info().live_ring_buffers) - 1 +
+                        static_cast<int>(renderer_->info().node_path_buffers);
     if (gl.buffers > allowed)
         fail("%d GL buffers live, at most %d expected (%d at start, %zu live stream buffers): a buffer leaks",
-             gl.buffers, allowed, baseline_.buffers, renderer_->live_stream_buffers());
+             gl.buffers, allowed, baseline_.buffers, renderer_->info().live_stream_buffers);
     if (gl.highest_buffer + 64 > kNameScan) fail("GL buffer names reach %u: widen the probe", gl.highest_buffer);
     return {frame_, rss_kb(), gl.buffers, good_.size() + bad_.size(), fs.vertices, fs.bytes_uploaded};
 }
@@ -538,7 +538,7 @@ void Soak::check_curve(const std::vector<Sample>& curve) {
     if (h2 > limit) fail("RSS grows: %ld KiB peak in the last half > %ld KiB (second quarter %ld KiB + 10%% + 8 MiB)",
                          h2, limit, q2);
 #endif
-    const int gl_limit = baseline_.buffers + 3 + static_cast<int>(renderer_->node_path_buffers());
+    const int gl_limit = baseline_.buffers + 3 + static_cast<int>(renderer_->info().node_path_buffers);
     if (gl_max > gl_limit) fail("GL buffers peaked at %d > %d", gl_max, gl_limit);
 }
 
@@ -624,8 +624,8 @@ int Soak::run() {
         growths_ += fs.buffer_grew ? 1 : 0;
         uploaded_ += fs.bytes_uploaded;
         ++frames_[context_.path == wire::UploadPath::cpu_mesh ? 0 : context_.path == wire::UploadPath::gpu_rings ? 1 : 2];
-        max_live_stream_ = std::max(max_live_stream_, renderer_->live_stream_buffers());
-        if (renderer_->live_stream_buffers() > 3) fail("%zu live stream buffers", renderer_->live_stream_buffers());
+        max_live_stream_ = std::max(max_live_stream_, renderer_->info().live_stream_buffers);
+        if (renderer_->info().live_stream_buffers > 3) fail("%zu live stream buffers", renderer_->info().live_stream_buffers);
 
         if (frame_ % opt_.every == 0 || frame_ + 1 == opt_.frames) {
             const auto t2 = std::chrono::steady_clock::now();
@@ -670,11 +670,11 @@ int Soak::run() {
     int gl_max = 0;
     for (const Sample& s : curve) gl_max = std::max(gl_max, s.gl_buffers);
     std::printf("gl buffers: %d at the start, at most %d; at most %zu live stream buffers, %zu allocated\n",
-                baseline_.buffers, gl_max, max_live_stream_, renderer_->allocated_stream_buffers().size());
+                baseline_.buffers, gl_max, max_live_stream_, renderer_->info().allocated_stream_buffers.size());
     std::printf("ring storage (gpu-rings retained): %zu bytes capacity, %zu live, %zu wires resident, %zu "
                 "buffers allocated\n",
-                renderer_->ring_storage_capacity(), renderer_->ring_storage_live_bytes(),
-                renderer_->resident_wires(), renderer_->allocated_ring_buffers().size());
+                renderer_->info().ring_storage_capacity, renderer_->info().ring_storage_live_bytes,
+                renderer_->info().resident_wires, renderer_->info().allocated_ring_buffers.size());
     for (const engine::ecs::SystemStats& st : schedule_.stats())
         std::printf("  %-15s mean %.3f ms\n", st.name.c_str(), st.mean_ms);
     std::printf("  %-15s mean %.3f ms\n", "checks", check_s_ * 1e3 / static_cast<double>(opt_.frames));

@@ -241,7 +241,7 @@ public:
         std::erase_if(row.f.gpu_ms, [](double v) { return v < 0.0; });
         row.f.systems_ms = run.frame_wall_ms;  // per measured frame, the same frames as the draws
         row.wire_memory_bytes = static_cast<double>(run.memory.visible_bytes + run.memory.culled_bytes);
-        row.gpu_buffer_bytes = static_cast<double>(3 * renderer.region_bytes() + renderer.ring_storage_capacity());
+        row.gpu_buffer_bytes = static_cast<double>(3 * renderer.info().region_bytes + renderer.info().ring_storage_capacity);
         rows.push_back(std::move(row));
     }
 

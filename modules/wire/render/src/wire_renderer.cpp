@@ -154,37 +154,25 @@ void WireRenderer::set_material(uint32_t index, const Material& material) {
 const std::vector<Material>& WireRenderer::materials() const {
     return state_->materials;
 }
-bool WireRenderer::uses_draw_parameters() const {
-    return state_->draw_parameters;
+RendererInfo WireRenderer::info() const {
+    const State& s = *state_;
+    RendererInfo i;
+    i.draw_parameters = s.draw_parameters;
+    i.region_bytes = s.stream.region_bytes();
+    i.live_stream_buffers = s.stream.live_buffers();
+    i.allocated_stream_buffers = s.stream.allocated_buffers();
+    i.resident_wires = s.residency.resident_wires();
+    i.ring_storage_live_bytes = s.ring_storage.live_bytes();
+    i.ring_storage_capacity = s.ring_storage.capacity_bytes();
+    i.live_ring_buffers = s.ring_storage.live_buffers();
+    i.allocated_ring_buffers = s.ring_storage.allocated_buffers();
+    if (s.nodes) {
+        i.node_path_buffers = s.nodes->gl_buffers();
+        i.node_path_programs = 2;
+        i.node_path_wires = s.nodes->resident_wires();
+    }
+    return i;
 }
-std::size_t WireRenderer::live_stream_buffers() const {
-    return state_->stream.live_buffers();
-}
-const std::vector<unsigned>& WireRenderer::allocated_stream_buffers() const {
-    return state_->stream.allocated_buffers();
-}
-std::size_t WireRenderer::region_bytes() const {
-    return state_->stream.region_bytes();
-}
-std::size_t WireRenderer::resident_wires() const {
-    return state_->residency.resident_wires();
-}
-std::size_t WireRenderer::ring_storage_live_bytes() const {
-    return state_->ring_storage.live_bytes();
-}
-std::size_t WireRenderer::ring_storage_capacity() const {
-    return state_->ring_storage.capacity_bytes();
-}
-std::size_t WireRenderer::live_ring_buffers() const {
-    return state_->ring_storage.live_buffers();
-}
-const std::vector<unsigned>& WireRenderer::allocated_ring_buffers() const {
-    return state_->ring_storage.allocated_buffers();
-}
-
-std::size_t WireRenderer::node_path_buffers() const { return state_->nodes ? state_->nodes->gl_buffers() : 0; }
-std::size_t WireRenderer::node_path_programs() const { return state_->nodes ? 2 : 0; }
-std::size_t WireRenderer::node_path_wires() const { return state_->nodes ? state_->nodes->resident_wires() : 0; }
 
 UploadPath WireRenderer::preferred_path() {
     State& s = *state_;

@@ -338,7 +338,7 @@ TEST_F(NodeStreamTest, BadNodesAreRefusedWithTheEcsMessagesAndTheRestDraws) {
             if (f == 0) {
                 EXPECT_TRUE(wrote);
                 EXPECT_TRUE(stream.errors().empty());
-                buffers = renderer.node_path_buffers();
+                buffers = renderer.info().node_path_buffers;
                 continue;
             }
             EXPECT_FALSE(wrote);
@@ -350,7 +350,7 @@ TEST_F(NodeStreamTest, BadNodesAreRefusedWithTheEcsMessagesAndTheRestDraws) {
             EXPECT_EQ(errors[0].message, "stream wire 3: " + want.message);
             EXPECT_EQ(errors[0].node, want.index);
             EXPECT_EQ(stats.wires_uploaded, 3u);  // the bad wire's last curve stays on the GPU
-            EXPECT_EQ(renderer.node_path_buffers(), buffers) << "GL buffers grew";
+            EXPECT_EQ(renderer.info().node_path_buffers, buffers) << "GL buffers grew";
         }
         // Removed and added again: the slot comes back, nothing grows.
         stream.remove(wires[3]);

@@ -624,8 +624,8 @@ TEST(WireRendererTest, DrawIndexAttributeFallbackMatches) {
     ASSERT_NE(ctx, nullptr);
     WireRenderer preferred = make_renderer();
     WireRenderer fallback = make_renderer({.force_draw_index_attribute = true});
-    std::printf("ARB_shader_draw_parameters used: %s\n", preferred.uses_draw_parameters() ? "yes" : "no");
-    EXPECT_FALSE(fallback.uses_draw_parameters());
+    std::printf("ARB_shader_draw_parameters used: %s\n", preferred.info().draw_parameters ? "yes" : "no");
+    EXPECT_FALSE(fallback.info().draw_parameters);
     const Scene scene = test_scene();
     for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
         const platform::Image a = render(*ctx, preferred, scene.list(path), scene_camera());
@@ -793,22 +793,22 @@ TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
             const platform::Image want = render(*ctx, roomy, list, scene_camera());
             ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
             EXPECT_TRUE(got.rgba == want.rgba) << count << " wires";
-            EXPECT_GE(growing.region_bytes(), stats.bytes_uploaded);
+            EXPECT_GE(growing.info().region_bytes, stats.bytes_uploaded);
             growths += stats.buffer_grew ? 1 : 0;
-            max_live = std::max(max_live, growing.live_stream_buffers());
+            max_live = std::max(max_live, growing.info().live_stream_buffers);
         }
         glFinish();
         render(*ctx, growing, all, scene_camera());  // retired buffers are collected at the start of a frame
-        const std::vector<unsigned>& allocated = growing.allocated_stream_buffers();
+        const std::vector<unsigned> allocated = growing.info().allocated_stream_buffers;
         std::printf("%s: %zu growths to %zu bytes a region, at most %zu live buffers, %zu live at the end\n",
-                    path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings", growths, growing.region_bytes(),
-                    max_live, growing.live_stream_buffers());
+                    path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings", growths, growing.info().region_bytes,
+                    max_live, growing.info().live_stream_buffers);
         EXPECT_GE(growths, 2u);
         EXPECT_EQ(allocated.size(), growths + 1);
         EXPECT_LE(max_live, 3u);
-        EXPECT_EQ(growing.live_stream_buffers(), 1u);
+        EXPECT_EQ(growing.info().live_stream_buffers, 1u);
         // Gone, or recycled by the driver: for the current buffer, one of the roomy renderer's, or another object.
-        const auto& other = roomy.allocated_stream_buffers();
+        const std::vector<unsigned> other = roomy.info().allocated_stream_buffers;
         for (std::size_t i = 0; i + 1 < allocated.size(); ++i) {
             const unsigned name = allocated[i];
             const bool recycled = name == allocated.back() ||
@@ -1082,13 +1082,13 @@ TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
     }
     std::printf("churn: %zu spawned, %zu changed, %zu destroyed; %zu ring bytes written into a %zu-byte storage "
                 "(%zu buffer(s)); vs cpu-mesh: worst frame %zu px over 2/255, max difference %d/255\n",
-                spawned, changed, destroyed, ring_bytes_total, retained.ring_storage_capacity(),
-                retained.allocated_ring_buffers().size(), worst_mismatch, worst_difference);
+                spawned, changed, destroyed, ring_bytes_total, retained.info().ring_storage_capacity,
+                retained.info().allocated_ring_buffers.size(), worst_mismatch, worst_difference);
     EXPECT_GT(spawned, 10u);
     EXPECT_GT(changed, 10u);
     EXPECT_GT(destroyed, 10u);
-    EXPECT_GT(ring_bytes_total, 2 * retained.ring_storage_capacity()) << "ranges must have been reused";
-    EXPECT_EQ(retained.allocated_ring_buffers().size(), 1u) << "reuse, not growth";
+    EXPECT_GT(ring_bytes_total, 2 * retained.info().ring_storage_capacity) << "ranges must have been reused";
+    EXPECT_EQ(retained.info().allocated_ring_buffers.size(), 1u) << "reuse, not growth";
 
     // Every wire destroyed: after the retention window the storage holds nothing.
     for (Wire& w : wires) w.alive = false;
@@ -1097,9 +1097,9 @@ TEST(WireRendererTest, RetainedRingsFollowSpawnChangeDestroy) {
         glFinish();
     }
     render(*ctx, retained, list(UploadPath::gpu_rings), scene_camera());
-    EXPECT_EQ(retained.resident_wires(), 0u);
-    EXPECT_EQ(retained.ring_storage_live_bytes(), 0u);
-    EXPECT_EQ(retained.live_ring_buffers(), 1u);
+    EXPECT_EQ(retained.info().resident_wires, 0u);
+    EXPECT_EQ(retained.info().ring_storage_live_bytes, 0u);
+    EXPECT_EQ(retained.info().live_ring_buffers, 1u);
 }
 
 // Wires whose rings change every frame (a simulation moving them) are streamed with the frame on the retained
@@ -1143,8 +1143,8 @@ TEST(WireRendererTest, MovingWiresAreStreamedNotReallocated) {
             EXPECT_EQ(rs.wires_streamed, moving) << "frame " << frame;
             EXPECT_EQ(rs.wires_uploaded, moving) << "frame " << frame;
             // Ranges are rounded up to the storage's alignment (< 256 B each): the still wires' ranges only.
-            EXPECT_GE(retained.ring_storage_live_bytes(), still_bytes) << "frame " << frame;
-            EXPECT_LT(retained.ring_storage_live_bytes(), still_bytes + 256 * (base.items.size() - moving))
+            EXPECT_GE(retained.info().ring_storage_live_bytes, still_bytes) << "frame " << frame;
+            EXPECT_LT(retained.info().ring_storage_live_bytes, still_bytes + 256 * (base.items.size() - moving))
                 << "frame " << frame;
         } else if (frame == kStop + 1) {  // still again: stored once
             EXPECT_EQ(rs.wires_streamed, 0u);
@@ -1156,8 +1156,8 @@ TEST(WireRendererTest, MovingWiresAreStreamedNotReallocated) {
                                              rs.indirect_commands * wire::render::kCommandBytes);
         }
     }
-    EXPECT_EQ(retained.resident_wires(), base.items.size());
-    EXPECT_EQ(retained.allocated_ring_buffers().size(), 1u);
+    EXPECT_EQ(retained.info().resident_wires, base.items.size());
+    EXPECT_EQ(retained.info().allocated_ring_buffers.size(), 1u);
 }
 
 // Turning the camera away and back: wires culled for fewer than retain_frames frames come back without
@@ -1178,11 +1178,11 @@ TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {
                                         stats.chunks * wire::render::kChunkRecordBytes +
                                         stats.indirect_commands * wire::render::kCommandBytes);
     for (int f = 0; f < 5; ++f) render(*ctx, renderer, none, scene_camera());
-    EXPECT_EQ(renderer.resident_wires(), all.items.size());
+    EXPECT_EQ(renderer.info().resident_wires, all.items.size());
     render(*ctx, renderer, all, scene_camera(), {}, &stats);
     EXPECT_EQ(stats.wires_uploaded, 0u) << "culled for 5 frames: still resident";
     for (int f = 0; f < 6; ++f) render(*ctx, renderer, none, scene_camera(), {}, &stats);
-    EXPECT_EQ(renderer.resident_wires(), 0u);
+    EXPECT_EQ(renderer.info().resident_wires, 0u);
     render(*ctx, renderer, all, scene_camera(), {}, &stats);
     EXPECT_EQ(stats.wires_uploaded, all.items.size()) << "culled for 6 frames: evicted";
 }
@@ -1212,20 +1212,20 @@ TEST(WireRendererTest, RetainedRingStorageGrowsWithoutLeaks) {
         EXPECT_TRUE(got.rgba == want.rgba) << count << " wires";
         EXPECT_EQ(stats.wires_uploaded, count == 1 ? 1u : 2u) << "only the new wires";
         growths += stats.buffer_grew ? 1 : 0;
-        max_live = std::max(max_live, growing.live_ring_buffers());
+        max_live = std::max(max_live, growing.info().live_ring_buffers);
     }
     glFinish();
     render(*ctx, growing, all, scene_camera());  // retired buffers are collected at the start of a frame
-    const std::vector<unsigned>& allocated = growing.allocated_ring_buffers();
+    const std::vector<unsigned> allocated = growing.info().allocated_ring_buffers;
     std::printf("ring storage: %zu growths to %zu bytes, at most %zu live buffers\n", growths,
-                growing.ring_storage_capacity(), max_live);
+                growing.info().ring_storage_capacity, max_live);
     EXPECT_GE(growths, 3u);
     EXPECT_GE(allocated.size(), growths + 1);  // a frame may grow more than once
     EXPECT_LE(max_live, 4u);
-    EXPECT_EQ(growing.live_ring_buffers(), 1u);
+    EXPECT_EQ(growing.info().live_ring_buffers, 1u);
     // A retired buffer's name is gone, or the driver recycled it: for this renderer's current ring buffer, for
     // one of the roomy renderer's, or for another object (another label).
-    const auto& other = roomy.allocated_ring_buffers();
+    const std::vector<unsigned> other = roomy.info().allocated_ring_buffers;
     for (std::size_t i = 0; i + 1 < allocated.size(); ++i) {
         const unsigned name = allocated[i];
         const bool recycled = name == allocated.back() || std::find(other.begin(), other.end(), name) != other.end() ||

@@ -184,6 +184,24 @@ struct DrawnRings {
     RingSet rings;
 };
 
+/// What a renderer holds (WireRenderer::info()).
+struct RendererInfo {
+    /// gpu-rings: the chunk index comes from gl_BaseInstanceARB + gl_InstanceID (ARB_shader_draw_parameters), not
+    /// from the instanced attribute.
+    bool draw_parameters = false;
+    std::size_t region_bytes = 0;         ///< capacity of one stream-buffer region now
+    std::size_t live_stream_buffers = 0;  ///< stream buffers alive: 1 plus retired ones still waiting for their fences
+    std::vector<unsigned> allocated_stream_buffers;  ///< GL names of every stream buffer allocated (the first: initial)
+    std::size_t resident_wires = 0;           ///< gpu-rings retained: wires whose rings are resident
+    std::size_t ring_storage_live_bytes = 0;  ///< gpu-rings retained: bytes in live ranges
+    std::size_t ring_storage_capacity = 0;    ///< gpu-rings retained: capacity of the ring buffer, bytes
+    std::size_t live_ring_buffers = 0;        ///< gpu-rings retained: ring buffers alive (1 plus retired ones)
+    std::vector<unsigned> allocated_ring_buffers;  ///< gpu-rings retained: GL names of every ring buffer allocated
+    /// gpu-nodes: GL buffers and programs the nodes path holds (0 before its first frame, which compiles its
+    /// programs), and the wires it keeps a slot for.
+    std::size_t node_path_buffers = 0, node_path_programs = 0, node_path_wires = 0;
+};
+
 /// Draws DrawLists (see the file comment). Owns GL objects: create, use and destroy it with the same context
 /// current. Move-only.
 class WireRenderer {
@@ -235,31 +253,8 @@ public:
     /// path) on the first call; NodeStream::usable() says why not where the context lacks compute.
     NodeStream& node_stream();
 
-    /// True when the gpu-rings chunk index comes from gl_BaseInstanceARB + gl_InstanceID
-    /// (ARB_shader_draw_parameters), false when from the instanced attribute.
-    [[nodiscard]] bool uses_draw_parameters() const;
-    /// GL buffers of the stream buffer alive now (1 plus retired buffers still waiting for their fences).
-    [[nodiscard]] std::size_t live_stream_buffers() const;
-    /// GL names of every stream buffer allocated so far (the first is the initial one).
-    [[nodiscard]] const std::vector<unsigned>& allocated_stream_buffers() const;
-    /// Capacity of one stream-buffer region now, bytes.
-    [[nodiscard]] std::size_t region_bytes() const;
-    /// Retained ring storage: wires resident, bytes in live ranges, buffer capacity, GL buffers alive, and every
-    /// GL buffer it allocated (tests check growth retires the old ones).
-    [[nodiscard]] std::size_t resident_wires() const;
-    /// Retained ring storage: bytes in live ranges.
-    [[nodiscard]] std::size_t ring_storage_live_bytes() const;
-    /// Retained ring storage: capacity of its buffer, bytes.
-    [[nodiscard]] std::size_t ring_storage_capacity() const;
-    /// Retained ring storage: GL buffers alive now (1 plus retired ones still waiting for their fences).
-    [[nodiscard]] std::size_t live_ring_buffers() const;
-    /// Retained ring storage: GL names of every buffer it allocated so far (the first is the initial one).
-    [[nodiscard]] const std::vector<unsigned>& allocated_ring_buffers() const;
-    /// gpu-nodes: GL buffers and programs the nodes path holds (0 before its first frame; its programs are compiled
-    /// then), and the wires it keeps a slot for.
-    [[nodiscard]] std::size_t node_path_buffers() const;
-    [[nodiscard]] std::size_t node_path_programs() const;
-    [[nodiscard]] std::size_t node_path_wires() const;
+    /// What the renderer holds now (GL buffers, capacities, resident wires): for tests, soak runs and benchmarks.
+    [[nodiscard]] RendererInfo info() const;
 
 private:
     struct State;
