@@ -1,4 +1,6 @@
-// The renderer's nodes path (see node_path.hpp).
+// The nodes path's resources (node_path.hpp): its programs, persistent and per-view buffers, slots and segment
+// ranges, the region size a frame needs, the draws (submit) and the read-back of what was drawn. A frame's CPU side
+// is in node_path_gather.cpp, its GPU side in node_path_frame.cpp.
 #include "node_path.hpp"
 
 #include "gpu_wire_data.hpp"
@@ -7,32 +9,15 @@
 #include "wire/render/upload_plan.hpp"
 
 #include <epoxy/gl.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <optional>
-#include <cstring>
 #include <string>
-#include <tuple>
 
 namespace wire::render::detail {
 namespace {
 
 namespace gfx = engine::gfx;
-
-constexpr std::size_t kAlign = 256;  // >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT everywhere we know
-constexpr uint32_t kReadbackSlots = 3;
-// The ring pass's Counter: rings, wires that did not fit, reserve rings, triangles.
-constexpr std::size_t kCounterBytes = 16;
-constexpr std::size_t kJobBytes = 64, kSlotStateBytes = 32, kSegmentBytes = 64, kDrawBytes = 32;
-
-std::size_t align_up(std::size_t v) { return (v + kAlign - 1) / kAlign * kAlign; }
-
-void clear_range(const gfx::Buffer& buffer, std::size_t offset, std::size_t bytes) {
-    glClearNamedBufferSubData(buffer.id(), GL_R32UI, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes),
-                              GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-}
 
 /// Fails, naming the limit, when `program` uses more shader storage blocks or bindings than this driver allows
 /// (checked at create: a link that succeeds can still exceed a limit some drivers enforce only at dispatch).
@@ -54,6 +39,11 @@ Status check_storage_limits(const gfx::Program& program, const char* label, uint
 }
 
 }  // namespace
+
+void clear_range(const gfx::Buffer& buffer, std::size_t offset, std::size_t bytes) {
+    glClearNamedBufferSubData(buffer.id(), GL_R32UI, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes),
+                              GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+}
 
 void NodePath::set_lod(const LodSettings& lod) {
     lod_ = lod;
@@ -242,366 +232,7 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
     // prepare()'s layout: each array at least one record (a buffer range of 0 bytes cannot be bound).
     visible += stream_ != nullptr ? stream_wires() : 0;  // the stream's unchanged wires are listed here too
     return align_up(std::max<std::size_t>(headers, 64)) + align_up(std::max<std::size_t>(nodes, 16)) +
-           align_up(std::max<std::size_t>(extras, 16)) + align_up(std::max<std::size_t>(4 * visible, 4)) + kAlign;
-}
-
-bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_index, const gfx::StreamRegion& region,
-                       const NodeDrawContext& ctx, DrawStats& stats) {
-    ++frame_;
-    // The ring buffer's size: the counts the GPU reported kReadbackSlots frames ago, read only once the fence
-    // after their copy has signalled (else the capacity stays: a late GPU delays growth, never feeds it garbage),
-    // and kept within what one shader storage block may hold.
-    if (GLsync& fence = readback_fence_[frame_ % kReadbackSlots]; fence != nullptr) {
-        const GLenum waited = glClientWaitSync(fence, GL_SYNC_FLUSH_COMMANDS_BIT, 0);
-        if (waited == GL_ALREADY_SIGNALED || waited == GL_CONDITION_SATISFIED) {
-            const auto* seen = static_cast<const uint32_t*>(readback_map_) + kCounterBytes / 4 * (frame_ % kReadbackSlots);
-            const std::size_t most = max_block_bytes_ / sizeof(PackedRing) * 2 / 3;
-            if (seen[0] > ring_capacity_ * 3 / 4) ring_capacity_ = std::min(std::size_t{seen[0]} * 3 / 2, most);
-            stats.wires_coarse = seen[1];
-            stats.triangles = seen[3];
-            glDeleteSync(fence);
-            fence = nullptr;
-        }
-    }
-    thread_local WireUpload up;  // headers, and the nodes made here (not packed by the systems)
-    up.clear();
-    node_pieces_.clear(), extra_pieces_.clear();
-    std::size_t node_total = 0, extra_total = 0;  // vec4s in the region's node and extra arrays
-    visible_slots_.clear();
-    dispatched_.clear(), listed_.clear(), changed_wires_.clear();
-    material_used_.assign(ctx.materials.size(), 0);
-    std::size_t segments_visible = 0;
-    for (std::size_t i = 0; i < list.items.size(); ++i) {
-        const DrawItem& item = list.items[i];
-        const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
-        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
-        if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
-        if (item.material >= ctx.materials.size()) {
-            // The other paths assert this; here the GPU would index past its buckets: skipped, said once.
-            ++stats.wires_skipped;
-            if (stats.status.ok()) stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": material " +
-                                         std::to_string(item.material) + " is out of range (" +
-                                         std::to_string(ctx.materials.size()) + " materials): not drawn");
-            continue;
-        }
-        Slot* known = i < item_slot_.size() ? item_slot_[i] : nullptr;
-        bool fresh = false;
-        auto it = slots_.end();
-        if (known == nullptr) {
-            std::tie(it, fresh) = slots_.try_emplace(item.wire_id);
-            known = &it->second;
-        }
-        Slot& slot = *known;
-        if (slot.last_frame == frame_) {
-            // A second item with this wire_id: both would write one slot's curve and state. The first is drawn.
-            ++stats.wires_skipped;
-            if (stats.status.ok()) stats.status = Status::error("wire " + std::to_string(item.wire_id) +
-                                         ": listed twice in the draw list (ids must be unique): drawn once");
-            continue;
-        }
-        if (fresh) {
-            const std::optional<uint32_t> index = acquire_slot();
-            if (!index) {
-                slots_.erase(it);
-                continue;
-            }
-            slot.index = *index;
-        }
-        slot.last_frame = frame_;
-        const bool changed = i < changed_item_.size() && changed_item_[i] != 0;
-        if (changed) {
-            uint32_t segments = 0;
-            const std::size_t nodes_before = up.nodes.size(), extras_before = up.extras.size();
-            const std::size_t node_pieces_before = node_pieces_.size(), extra_pieces_before = extra_pieces_.size();
-            const std::size_t node_total_before = node_total, extra_total_before = extra_total;
-            if (packed) {
-                // Packed by the systems: the header here, the nodes copied straight from them into the region.
-                const PackedNodes& p = *item.packed_nodes;
-                up.headers.push_back(packed_header(p, slot.segment_first, slot.index, item.material, item.caps,
-                                                   {item.motion, item.fit_motion}, static_cast<uint32_t>(node_total),
-                                                   static_cast<uint32_t>(extra_total)));
-                node_pieces_.push_back({p.nodes.data(), 0, p.nodes.size(), node_total});
-                node_total += p.nodes.size();
-                if (!p.extras.empty()) {
-                    extra_pieces_.push_back({p.extras.data(), 0, p.extras.size(), extra_total});
-                    extra_total += p.extras.size();
-                }
-                segments = static_cast<uint32_t>(p.segment_count());
-            } else {
-                // Made here (a blended curve's segments; nodes not packed by the systems): into `up`, then copied.
-                if (has_curve) {
-                    append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps,
-                                    {item.motion, false}, up);
-                    segments = static_cast<uint32_t>(item.curve->segment_count());
-                } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
-                                        item.caps, {item.motion, item.fit_motion}, up, segments)) {
-                    ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build is skipped here
-                    continue;
-                }
-                GpuCurveHeader& h = up.headers.back();
-                h.node_first = static_cast<uint32_t>(node_total), h.extra_first = static_cast<uint32_t>(extra_total);
-                node_pieces_.push_back({nullptr, nodes_before, up.nodes.size() - nodes_before, node_total});
-                node_total += up.nodes.size() - nodes_before;
-                extra_pieces_.push_back({nullptr, extras_before, up.extras.size() - extras_before, extra_total});
-                extra_total += up.extras.size() - extras_before;
-            }
-            // The wire's most sides (the LOD's max_sides for it; its Style's): header bits 8-15.
-            up.headers.back().flags |= std::min<uint32_t>(std::max<uint32_t>(item.sides, 3u), 255u) << 8;
-            if (segments != slot.segments) {
-                free_segments(slot.segment_first, slot.segments);
-                uint32_t first = 0;
-                if (!allocate_segments(segments, first)) {
-                    up.headers.pop_back();
-                    up.nodes.resize(nodes_before), up.extras.resize(extras_before);
-                    node_pieces_.resize(node_pieces_before), extra_pieces_.resize(extra_pieces_before);
-                    node_total = node_total_before, extra_total = extra_total_before;
-                    slot.segments = 0, slot.built = false;
-                    ++stats.wires_skipped;
-                    continue;
-                }
-                slot.segment_first = first, slot.segments = segments;
-                up.headers.back().segment_first = first;
-                clear_slot_state(slot.index, 16);  // the LOD starts afresh
-            }
-            slot.generation = item.nodes_generation;
-            slot.built = true;
-            changed_wires_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
-        }
-        if (!slot.built) continue;
-        // The ring pass takes the changed wires' slots from their headers: only the others are listed.
-        if (!changed) {
-            visible_slots_.push_back(slot.index);
-            listed_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
-        }
-        segments_visible += slot.segments;
-        material_used_[item.material] = 1;
-    }
-    // Wires not drawn for a while give their slot and segments back: looked for every 16th frame (a walk over
-    // every resident wire; evicted up to 15 frames after retain_frames, which changes nothing that is drawn).
-    for (auto it = frame_ % 16 == 0 ? slots_.begin() : slots_.end(); it != slots_.end();) {
-        if (it->second.last_frame + retain_frames_ < frame_) {
-            free_segments(it->second.segment_first, it->second.segments);
-            free_slots_.push_back(it->second.index);
-            it = slots_.erase(it);
-            ++stats.wires_evicted;
-        } else {
-            ++it;
-        }
-    }
-    changed_ = up.headers.size();
-    // The streamed wires (node_stream.cpp): their headers into the stream's region, the unchanged ones listed.
-    stream_changed_ = 0;
-    if (stream_ != nullptr) stream_changed_ = emit_stream(ctx.materials.size(), segments_visible, stats);
-    unchanged_ = visible_slots_.size();
-    visible_ = changed_ + stream_changed_ + unchanged_;
-    stats.wires_uploaded = changed_ + stream_changed_;
-    // The ring pass's order: the listed wires, then this frame's curve passes' (the list's, then the stream's).
-    dispatched_ = listed_;
-    dispatched_.insert(dispatched_.end(), changed_wires_.begin(), changed_wires_.end());
-    dispatched_.insert(dispatched_.end(), stream_wires_.begin(), stream_wires_.end());
-    if (visible_ == 0) return false;
-    // A frame that cannot be computed draws nothing and says why; the wires it would have uploaded stay unbuilt
-    // (their slots hold no curve), so the next frame sends them again.
-    const auto fail = [&](const Status& why) {
-        for (const Dispatched& d : changed_wires_) {
-            if (auto it = slots_.find(d.wire_id); it != slots_.end()) it->second.built = false;
-        }
-        if (stream_ != nullptr) unbuild_stream();
-        dispatched_.clear();
-        stats.wires_skipped += visible_;
-        stats.status = Status::error("wire nodes: " + why.message);
-        return false;
-    };
-
-    // The region: headers | nodes | extras | visible slots of the unchanged wires.
-    const std::size_t real_node_bytes = node_total * sizeof(glm::vec4);
-    const std::size_t real_extra_bytes = extra_total * sizeof(glm::vec4);
-    const std::size_t header_bytes = std::max<std::size_t>(up.headers.size() * sizeof(GpuCurveHeader), 64);
-    const std::size_t node_bytes = std::max<std::size_t>(real_node_bytes, sizeof(glm::vec4));
-    const std::size_t extra_bytes = std::max<std::size_t>(real_extra_bytes, sizeof(glm::vec4));
-    const std::size_t visible_bytes = std::max<std::size_t>(visible_slots_.size() * 4, 4);
-    const std::size_t list_bytes = std::max<std::size_t>(visible_ * 4, 4);  // unchanged, then the curve passes'
-    const std::size_t node_at = align_up(header_bytes), extra_at = node_at + align_up(node_bytes);
-    const std::size_t visible_at = extra_at + align_up(extra_bytes);
-    if (visible_at + visible_bytes > region.size_bytes) {
-        // Never (upload_bytes() sized the region for this layout); were it to, nothing is written past the region.
-        return fail(Status::error("the stream region holds " + std::to_string(region.size_bytes) + " bytes, the frame needs " +
-                                  std::to_string(visible_at + visible_bytes)));
-    }
-    std::byte* base = region.data;
-    if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
-    // The nodes, copied once from where they are (the systems' packed nodes) into the region: on worker threads
-    // when there are many (the one per-byte cost of the frame on the render thread).
-    const auto copy = [&](const std::vector<Piece>& pieces, const std::vector<glm::vec4>& own, std::byte* to,
-                          std::size_t first, std::size_t last) {
-        for (std::size_t k = first; k < last; ++k) {
-            const Piece& piece = pieces[k];
-            const glm::vec4* from = piece.src != nullptr ? piece.src : own.data() + piece.own;
-            if (piece.count != 0) std::memcpy(to + piece.dst * sizeof(glm::vec4), from, piece.count * sizeof(glm::vec4));
-        }
-    };
-    if (real_node_bytes >= (std::size_t{256} << 10) && node_pieces_.size() >= 64) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_pieces_.size(), 32), [&](const auto& r) {
-            copy(node_pieces_, up.nodes, base + node_at, r.begin(), r.end());
-        });
-    } else {
-        copy(node_pieces_, up.nodes, base + node_at, 0, node_pieces_.size());
-    }
-    copy(extra_pieces_, up.extras, base + extra_at, 0, extra_pieces_.size());
-    // The list of unchanged visible wires stays on the GPU while it is the same (a still scene, or still wires
-    // under a camera that keeps them in view): then nothing is sent for them.
-    const bool same_list = visible_slots_ == last_visible_ && visible_kept_.id() != 0 && list_bytes <= visible_kept_bytes_;
-    (void)visible_bytes;
-    if (!same_list && !visible_slots_.empty()) {
-        std::memcpy(base + visible_at, visible_slots_.data(), visible_slots_.size() * 4);
-    }
-    stats.bytes_uploaded = (changed_ ? up.headers.size() * sizeof(GpuCurveHeader) + real_node_bytes : 0) +
-                           real_extra_bytes + (same_list ? 0 : visible_slots_.size() * 4) + stream_bytes_;
-    const auto range = [&](GLuint binding, std::size_t offset, std::size_t bytes) {
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, binding, region.buffer,
-                          static_cast<GLintptr>(region.offset_bytes + offset), static_cast<GLsizeiptr>(bytes));
-    };
-
-    // Per-frame GPU buffers.
-    if (ring_capacity_ == 0) ring_capacity_ = std::max<std::size_t>(4096, 8 * segments_visible + visible_);
-    side_slots_ = max_sides_ + 1;
-    materials_ = ctx.materials.size();
-    const std::size_t buckets = materials_ * side_slots_ * 6;
-    // The reserve after the ring buffer's estimate: one ring a segment for every visible wire (what a wire that
-    // does not fit is drawn with, until the buffer has grown from the count read back).
-    const std::size_t reserve = segments_visible + visible_;
-    const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
-    // c2 scratch, 2 dvec4 a node: the list's wires', then the stream's (at an aligned offset).
-    const std::size_t stream_scratch_at = changed_ ? align_up(node_total * 2 * 32) : 0;
-    const std::size_t scratch_need = stream_scratch_at + (stream_changed_ ? stream_nodes() * 2 * 32 : 0);
-    const auto need = [&](gfx::Buffer& b, std::size_t& capacity, std::size_t bytes, const char* label) {
-        return ensure(b, capacity, bytes, label, false);
-    };
-    Status made = need(scratch_, scratch_bytes_, std::max<std::size_t>(scratch_need, 64), "wire nodes: c2 scratch");
-    if (made) made = need(jobs_, job_bytes_, visible_ * kJobBytes, "wire nodes: jobs");
-    if (made) made = need(draws_, draw_bytes_, visible_ * kDrawBytes, "wire nodes: draws");
-    if (made) made = need(rings_, ring_bytes_, (ring_capacity_ + reserve) * sizeof(PackedRing), "wire nodes: rings");
-    if (made) made = need(chunks_, chunk_bytes_, chunk_capacity * 8, "wire nodes: chunks");
-    if (made) made = need(buckets_, bucket_bytes_, 2 * buckets * 4, "wire nodes: buckets");
-    if (made) made = need(commands_, command_bytes_, buckets * 20, "wire nodes: commands");
-    if (made) made = need(counter_, counter_bytes_, kCounterBytes, "wire nodes: ring counter");
-    if (!made) return fail(made);
-    if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
-        // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
-        std::vector<uint32_t> t(2 * 6 * side_slots_, 0);
-        for (uint32_t d = 1; d < side_slots_; ++d) {
-            const uint32_t pattern = d < ctx.pattern_first.size() ? ctx.pattern_first[d] : 0;
-            const uint32_t band_indices = d > 2 ? 6 * d : 6;
-            for (uint32_t kind = 0; kind < kChunkKinds; ++kind) {
-                const uint32_t count = kind == 0 ? (d > 2 ? 6 * d : 0) : chunk_kind_bands(kind) * band_indices;
-                const uint32_t first = kind == 0 || d <= 2 ? pattern : pattern + 6 * d;
-                t[2 * (6 * d + kind)] = count;
-                t[2 * (6 * d + kind) + 1] = first;
-            }
-        }
-        auto made = gfx::make_buffer(std::span<const uint32_t>(t), "wire nodes: command templates");
-        if (!made) return fail(made.error());
-        templates_ = std::move(*made);
-        template_sides_ = side_slots_;
-        template_patterns_ = ctx.pattern_first.size();
-    }
-    clear_range(counter_, 0, kCounterBytes);
-    clear_range(buckets_, 0, buckets * 4);
-    if (!same_list) {
-        // The unchanged wires' slots, kept for the next frames: copied on the GPU out of the region (the curve
-        // passes write the changed wires' after them).
-        if (Status st = ensure(visible_kept_, visible_kept_bytes_, list_bytes, "wire nodes: visible slots", false); !st)
-            return fail(st);
-        if (!visible_slots_.empty()) {
-            glCopyNamedBufferSubData(region.buffer, visible_kept_.id(), static_cast<GLintptr>(region.offset_bytes + visible_at),
-                                     0, static_cast<GLsizeiptr>(visible_slots_.size() * 4));
-        }
-        last_visible_ = visible_slots_;
-    }
-
-    // (1) Curves of the wires whose nodes changed, into their slots' segments and headers: the list's (headers and
-    // nodes in this frame's region), then the stream's (in the stream's region). Both write disjoint slots, list
-    // entries and c2 scratch (the stream's after the list's), so they need no barrier between them.
-    const auto curve_pass = [&](unsigned buffer, std::size_t header_at, std::size_t header_size, std::size_t nodes_at,
-                                std::size_t nodes_size, std::size_t scratch_at, std::size_t wires, std::size_t list_first) {
-        curve_program_.use();
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveHeaders, buffer, static_cast<GLintptr>(header_at),
-                          static_cast<GLsizeiptr>(header_size));
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveNodes, buffer, static_cast<GLintptr>(nodes_at),
-                          static_cast<GLsizeiptr>(nodes_size));
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSegments, segments_.id());
-        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kCurveScratch, scratch_.id(), static_cast<GLintptr>(scratch_at),
-                          static_cast<GLsizeiptr>(scratch_bytes_ - scratch_at));
-        range(kCurveExtras, extra_at, extra_bytes);  // the streamed wires carry none (the list's range, unread)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotHeaders, slot_headers_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveMotionRefs, motion_refs_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kCurveSlotList, visible_kept_.id());
-        glUniform1ui(curve_program_.uniform_location("u_wires"), static_cast<GLuint>(wires));
-        glUniform1i(curve_program_.uniform_location("u_persist"), 1);
-        glUniform1i(curve_program_.uniform_location("u_motion"), 1);
-        glUniform1i(curve_program_.uniform_location("u_list"), 1);
-        glUniform1ui(curve_program_.uniform_location("u_list_first"), static_cast<GLuint>(list_first));
-        glDispatchCompute(static_cast<GLuint>((wires + 63) / 64), 1, 1);
-    };
-    if (changed_ != 0) {
-        curve_pass(region.buffer, region.offset_bytes, header_bytes, region.offset_bytes + node_at, node_bytes, 0, changed_,
-                   unchanged_);
-    }
-    if (stream_changed_ != 0) {
-        const StreamLayout layout = stream_layout();
-        curve_pass(layout.buffer, layout.header_at, layout.header_bytes, layout.node_at, layout.node_bytes,
-                   stream_scratch_at, stream_changed_, unchanged_ + changed_);
-    }
-    if (changed_ + stream_changed_ != 0) glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    // (2) LOD, (3) commands, (4) rings and records, over the visible wires. They overwrite the per-frame buffers the
-    // last draw read (the previous view of this frame, or the last frame): the barrier orders those reads first.
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-    ring_program_.use();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingHeaders, slot_headers_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSegments, segments_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingJobs, jobs_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounts, counts_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingRings, rings_.id());
-    const gfx::Buffer* state = view_state(view_index);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSlots, state != nullptr ? state->id() : slot_state_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCounter, counter_.id());
-    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kRingVisible, visible_kept_.id(), 0, static_cast<GLsizeiptr>(list_bytes));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingDraws, draws_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingChunks, chunks_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingBuckets, buckets_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCommands, commands_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingTemplates, templates_.id());
-    const auto at = [&](const char* name) { return ring_program_.uniform_location(name); };
-    set_lod_uniforms(ring_program_, view, lod_);
-    glUniform1i(at("u_lod"), 1);
-    glUniform1i(at("u_draw"), 1);
-    glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
-    glUniform1ui(at("u_unchanged"), static_cast<GLuint>(unchanged_));
-    glUniform1ui(at("u_ring_capacity"), static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
-    glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, 0xffffffffu)));
-    glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
-    glUniform1ui(at("u_side_slots"), side_slots_);
-    const auto groups = static_cast<GLuint>((visible_ + 63) / 64);
-    glUniform1ui(at("u_stage"), 1u);
-    glDispatchCompute(groups, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUniform1ui(at("u_stage"), 2u);
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUniform1ui(at("u_stage"), 3u);
-    glDispatchCompute(groups, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    // The counter, read kReadbackSlots frames later (the ring buffer's size).
-    glCopyNamedBufferSubData(counter_.id(), readback_.id(), 0,
-                             static_cast<GLintptr>(kCounterBytes * (frame_ % kReadbackSlots)), kCounterBytes);
-    GLsync& fence = readback_fence_[frame_ % kReadbackSlots];
-    if (fence != nullptr) glDeleteSync(fence);  // an older copy into the slot, not read: this one supersedes it
-    fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-    glUseProgram(0);
-    buckets_used_ = buckets;
-    stats.draw_items = visible_;
-    stats.indirect_commands = buckets;
-    return true;
+           align_up(std::max<std::size_t>(extras, 16)) + align_up(std::max<std::size_t>(4 * visible, 4)) + kSectionAlign;
 }
 
 void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, Lines lines) {

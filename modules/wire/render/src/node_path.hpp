@@ -30,7 +30,20 @@
 
 namespace wire::render::detail {
 
+/// Alignment of the sections of a stream region: >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every driver.
+inline constexpr std::size_t kSectionAlign = 256;
+inline std::size_t align_up(std::size_t v) { return (v + kSectionAlign - 1) / kSectionAlign * kSectionAlign; }
+/// Frames between the ring pass's counts and their read on the CPU (the ring buffer's size).
+inline constexpr uint32_t kReadbackSlots = 3;
+/// The ring pass's Counter: rings, wires that did not fit, reserve rings, triangles.
+inline constexpr std::size_t kCounterBytes = 16;
+/// The nodes path's GPU records (gpu_wire_data.hpp has their C++ mirrors): a job, a slot's state, a segment, a draw.
+inline constexpr std::size_t kJobBytes = 64, kSlotStateBytes = 32, kSegmentBytes = 64, kDrawBytes = 32;
+/// Zeroes `bytes` of `buffer` from `offset` (a multiple of 4).
+void clear_range(const engine::gfx::Buffer& buffer, std::size_t offset, std::size_t bytes);
+
 struct StreamState;
+struct WireUpload;
 
 /// What the nodes path borrows from the renderer to draw.
 struct NodeDrawContext {
@@ -113,6 +126,18 @@ private:
     [[nodiscard]] std::size_t stream_nodes() const;
     [[nodiscard]] std::size_t stream_wires() const;  ///< the stream's wire records (live or not)
     void unbuild_stream();
+    // The frame's CPU side (node_path_gather.cpp).
+    /// The ring pass's counts of kReadbackSlots frames ago, once the fence after their copy has signalled: the ring
+    /// buffer's size, and the coarse wires and triangles they report.
+    void read_counts(DrawStats& stats);
+    /// What gather() found: vec4s for the region's node and extra arrays, segments of the visible wires.
+    struct Gathered {
+        std::size_t node_total = 0, extra_total = 0, segments_visible = 0;
+    };
+    /// The list's items into slots (new, changed, unchanged): the changed wires' headers into `up` and their nodes
+    /// as pieces to copy, the unchanged ones listed; slots not drawn for a while evicted. Skipped items are counted
+    /// in `stats` (a material out of range, an id listed twice: its status says which).
+    Gathered gather(const DrawList& list, std::size_t materials, WireUpload& up, DrawStats& stats);
 
     engine::gfx::Program curve_program_, ring_program_;
     LodSettings lod_{};
@@ -136,7 +161,7 @@ private:
     std::size_t ring_capacity_ = 0;  ///< rings the ring buffer holds
     void* readback_map_ = nullptr;   ///< per readback slot: the ring counter and overflow, read 3 frames later
     /// Per readback slot: the fence after the copy into it (null: nothing in flight), read only once signalled.
-    std::array<GLsync, 3> readback_fence_{};
+    std::array<GLsync, kReadbackSlots> readback_fence_{};
     std::size_t max_block_bytes_ = std::size_t{1} << 27;  ///< GL_MAX_SHADER_STORAGE_BLOCK_SIZE
     uint32_t template_sides_ = 0;    ///< side slots the templates were built for
     std::size_t template_patterns_ = 0;

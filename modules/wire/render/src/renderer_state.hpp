@@ -43,17 +43,10 @@ struct DrawElementsIndirectCommand {
 static_assert(sizeof(DrawElementsIndirectCommand) == kCommandBytes);
 static_assert(sizeof(GpuDraw) == kDrawRecordBytes);
 
-/// Alignment of the sections of a stream region: >= GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT on every
-/// driver.
-inline constexpr std::size_t kSectionAlign = 256;
 /// cpu-mesh: the vertex's draw index; gpu-rings without draw parameters: the chunk index.
 inline constexpr unsigned kRecordLocation = 3;
 /// The ring patterns are built for 3 .. max(this, the largest side count seen).
 inline constexpr uint32_t kPatternMinSides = 16;
-
-inline std::size_t align_up(std::size_t v) {
-    return (v + kSectionAlign - 1) / kSectionAlign * kSectionAlign;
-}
 
 /// Phone-wire lines (sides 1) are drawn blended, after the opaque tubes and strips.
 inline bool blended(const DrawItem& item) {
