@@ -274,6 +274,66 @@ TEST(LodProof, ScreenErrorWithinTolerance) {
     }
 }
 
+// LodSettings::resolved() is what every LOD reads (the CPU's update_lod here; the nodes path sets its uniforms from
+// it): over random settings (each field left 0, set, or out of range: negative, NaN, denormal, max_sides 1-2) and
+// random wires and cameras, update_lod with the settings and with their resolved() give the same state, resolved()
+// holds no 0 and is its own resolved(). Two runs of the same frames (hysteresis carried) are compared.
+TEST(LodSettingsResolved, EveryStageReadsTheResolvedSettings) {
+    Rng rng(20261205);
+    const auto maybe = [&](double value) { return uniform(rng, 0.0, 1.0) < 0.4 ? 0.0 : value; };
+    std::size_t cases = 0, visible = 0, differing_defaults = 0;
+    for (int w = 0; w < 60; ++w) {
+        LodSettings s;
+        const double pick = uniform(rng, 0.0, 1.0);
+        s.tolerance_px = pick < 0.1   ? std::numeric_limits<double>::quiet_NaN()
+                         : pick < 0.2 ? -1.0
+                         : pick < 0.3 ? 1e-310
+                                      : maybe(std::pow(10.0, uniform(rng, -1.0, 1.0)));
+        s.max_rings_per_segment = static_cast<uint32_t>(maybe(std::floor(uniform(rng, 1.0, 64.0))));
+        s.max_sides = static_cast<uint32_t>(maybe(std::floor(uniform(rng, 1.0, 48.0))));
+        s.hysteresis_band = maybe(uniform(rng, -0.5, 1.0));
+        s.strip_radius_px = maybe(uniform(rng, -1.0, 6.0));
+        s.line_radius_px = maybe(uniform(rng, -1.0, 1.5));
+        s.keep_node_resolution = uniform(rng, 0.0, 1.0) < 0.3;
+        s.coarse_offscreen_segments = uniform(rng, 0.0, 1.0) < 0.7;
+        const LodSettings r = s.resolved();
+        EXPECT_EQ(r.resolved(), r) << "case " << w;
+        EXPECT_GT(r.tolerance_px, 0.0);
+        EXPECT_NE(r.max_rings_per_segment, 0u);
+        EXPECT_GE(r.max_sides, 3u);
+        EXPECT_NE(r.hysteresis_band, 0.0);
+        EXPECT_NE(r.strip_radius_px, 0.0);
+        EXPECT_NE(r.line_radius_px, 0.0);
+        differing_defaults += s == r ? 0 : 1;
+        const Shape shape = static_cast<Shape>(w % 3);
+        const WireNodes nodes = make_wire(shape, rng);
+        Curve curve;
+        ASSERT_TRUE(build_curve(nodes, SplineSettings{.radius_m = static_cast<float>(uniform(rng, 0.001, 0.1))}, curve).ok());
+        WireLod a, b;
+        for (CameraKind kind : {CameraKind::near_fill, CameraKind::far_few_px, CameraKind::grazing,
+                                CameraKind::partly_behind}) {
+            const LodView view = make_camera(kind, curve, rng);
+            update_lod(curve, view, s, a);
+            update_lod(curve, view, r, b);
+            ++cases;
+            visible += a.visible ? 1 : 0;
+            EXPECT_EQ(a.counts, b.counts) << "case " << w << ", camera " << name(kind);
+            EXPECT_EQ(a.required, b.required) << "case " << w;
+            EXPECT_EQ(a.sides, b.sides) << "case " << w;
+            EXPECT_EQ(a.drawn_sides, b.drawn_sides) << "case " << w;
+            EXPECT_EQ(a.visible, b.visible) << "case " << w;
+            EXPECT_EQ(a.radius_px, b.radius_px) << "case " << w;
+        }
+    }
+    std::printf("resolved settings: %zu updates (%zu visible), %zu of 60 settings with a default or clamp applied\n",
+                cases, visible, differing_defaults);
+    EXPECT_GT(visible, cases / 3);
+    EXPECT_GT(differing_defaults, 40u);
+    EXPECT_EQ(LodSettings{}.resolved(), (LodSettings{.tolerance_px = 0.5, .max_rings_per_segment = 256, .max_sides = 32,
+                                                     .hysteresis_band = 0.25, .strip_radius_px = 2.0,
+                                                     .line_radius_px = 0.5}));
+}
+
 // The measurement used by the proof is an upper bound of the brute-force distance to the whole polyline and
 // it notices too few rings: with half the required counts the tolerance is exceeded.
 TEST(LodProof, MeasurementAgreesWithBruteForceAndDetectsUnderTessellation) {

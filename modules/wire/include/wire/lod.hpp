@@ -130,6 +130,12 @@ struct LodSettings {
     double strip_radius_px = 0.0;
     double line_radius_px = 0.0;
 
+    /// These settings as every LOD reads them, on the CPU (update_lod) and on the GPU (the nodes path): each 0
+    /// replaced by its default (0.5 px, 256 rings, 32 sides, band 0.25, strips below 2 px, lines below 0.5 px), a
+    /// tolerance that is not positive (or NaN) by 0.5 px and one below 1e-6 px by 1e-6 px, max_sides below 3 by 3.
+    /// resolved() of a resolved value is itself; update_lod gives the same result for both.
+    [[nodiscard]] LodSettings resolved() const;
+
     friend bool operator==(const LodSettings&, const LodSettings&) = default;
 };
 

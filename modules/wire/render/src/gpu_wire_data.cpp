@@ -97,16 +97,16 @@ void set_lod_uniforms(const engine::gfx::Program& program, const LodView& v, con
     glUniform1f(at("u_tan_y"), static_cast<float>(v.tan_half_y));
     glUniform1f(at("u_near"), static_cast<float>(v.near_m));
     glUniform1f(at("u_far"), static_cast<float>(v.far_m));
-    // LodSettings' defaults, as update_lod reads them (lod/view.hpp, Limits in lod/update.cpp).
-    const double tol = st.tolerance_px > 0.0 ? std::max(st.tolerance_px, 1e-6) : 0.5;
-    glUniform1f(at("u_eps"), static_cast<float>(tol));
-    glUniform1f(at("u_band"), static_cast<float>(st.hysteresis_band == 0.0 ? 0.25 : st.hysteresis_band));
-    glUniform1f(at("u_strip_px"), static_cast<float>(st.strip_radius_px == 0.0 ? 2.0 : st.strip_radius_px));
-    glUniform1f(at("u_line_px"), static_cast<float>(st.line_radius_px == 0.0 ? 0.5 : st.line_radius_px));
-    glUniform1ui(at("u_max_rings"), st.max_rings_per_segment ? st.max_rings_per_segment : 256u);
-    glUniform1ui(at("u_max_sides"), std::clamp<uint32_t>(st.max_sides ? st.max_sides : 32u, 3u, kMaxSides));
-    glUniform1i(at("u_coarse"), st.coarse_offscreen_segments ? 1 : 0);
-    glUniform1i(at("u_merge"), st.keep_node_resolution ? 0 : 1);
+    // The settings as update_lod reads them (LodSettings::resolved), sides capped at what the GPU's table holds.
+    const LodSettings r = st.resolved();
+    glUniform1f(at("u_eps"), static_cast<float>(r.tolerance_px));
+    glUniform1f(at("u_band"), static_cast<float>(r.hysteresis_band));
+    glUniform1f(at("u_strip_px"), static_cast<float>(r.strip_radius_px));
+    glUniform1f(at("u_line_px"), static_cast<float>(r.line_radius_px));
+    glUniform1ui(at("u_max_rings"), r.max_rings_per_segment);
+    glUniform1ui(at("u_max_sides"), std::min(r.max_sides, kMaxSides));
+    glUniform1i(at("u_coarse"), r.coarse_offscreen_segments ? 1 : 0);
+    glUniform1i(at("u_merge"), r.keep_node_resolution ? 0 : 1);
     static_assert(kMaxSides + 1 <= 4 * 65, "u_sagitta4 holds n = 0 .. kMaxSides");
     static const std::array<float, 4 * 65> sagitta = [] {
         std::array<float, 4 * 65> t{};

@@ -47,7 +47,7 @@ void clear_range(const gfx::Buffer& buffer, std::size_t offset, std::size_t byte
 
 void NodePath::set_lod(const LodSettings& lod) {
     lod_ = lod;
-    max_sides_ = std::clamp<uint32_t>(lod.max_sides ? lod.max_sides : 32u, 3u, kMaxSides);
+    max_sides_ = std::min(lod.resolved().max_sides, kMaxSides);
 }
 
 Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {

@@ -77,8 +77,9 @@ namespace {
 /// not alternate between two modes while the camera drifts.
 uint32_t drawn_sides_for(double radius_px, uint32_t sides, uint32_t old_drawn, const LodSettings& settings,
                          double band) {
-    const double strip = settings.strip_radius_px == 0.0 ? 2.0 : settings.strip_radius_px;
-    const double line = settings.line_radius_px == 0.0 ? 0.5 : settings.line_radius_px;
+    const LodSettings resolved = settings.resolved();
+    const double strip = resolved.strip_radius_px;
+    const double line = resolved.line_radius_px;
     const double keep = 1.0 + std::max(band, 0.0);
     if (line > 0.0 && (radius_px < line || (old_drawn == 1 && radius_px < line * keep))) return 1;
     if (strip > 0.0 && (radius_px < strip || (old_drawn == 2 && radius_px < strip * keep))) return 2;

@@ -15,11 +15,10 @@ struct Limits {
     double eps;
     uint32_t max_rings, max_sides;
     double band;
-    explicit Limits(const LodSettings& settings)
-        : eps(tolerance_or_default(settings.tolerance_px)),
-          max_rings(settings.max_rings_per_segment ? settings.max_rings_per_segment : default_max_rings),
-          max_sides(std::max<uint32_t>(settings.max_sides ? settings.max_sides : default_max_sides, 3)),
-          band(settings.hysteresis_band == 0.0 ? default_band : settings.hysteresis_band) {}
+    explicit Limits(const LodSettings& settings) {
+        const LodSettings r = settings.resolved();
+        eps = r.tolerance_px, max_rings = r.max_rings_per_segment, max_sides = r.max_sides, band = r.hysteresis_band;
+    }
 };
 
 // The coherence test (WireLod::Coherence): true if the state of the last update stands for this camera.

@@ -85,4 +85,16 @@ SphereScreenBound sphere_screen_bound(const glm::dvec3& centre_m, double radius_
     return b;
 }
 
+LodSettings LodSettings::resolved() const {
+    using namespace lod_stage;
+    LodSettings r = *this;
+    r.tolerance_px = tolerance_or_default(tolerance_px);
+    r.max_rings_per_segment = max_rings_per_segment ? max_rings_per_segment : default_max_rings;
+    r.max_sides = std::max<uint32_t>(max_sides ? max_sides : default_max_sides, 3);
+    r.hysteresis_band = hysteresis_band == 0.0 ? default_band : hysteresis_band;
+    r.strip_radius_px = strip_radius_px == 0.0 ? default_strip_radius_px : strip_radius_px;
+    r.line_radius_px = line_radius_px == 0.0 ? default_line_radius_px : line_radius_px;
+    return r;
+}
+
 }  // namespace wire

@@ -18,6 +18,8 @@ constexpr double default_tolerance_px = 0.5;
 constexpr uint32_t default_max_rings = 256;
 constexpr uint32_t default_max_sides = 32;
 constexpr double default_band = 0.25;
+constexpr double default_strip_radius_px = 2.0;
+constexpr double default_line_radius_px = 0.5;
 
 inline double tolerance_or_default(double tolerance_px) {
     // Below 1e-6 px a finer tolerance changes nothing on screen, and a denormal one underflows the world-space
