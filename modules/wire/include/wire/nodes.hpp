@@ -35,6 +35,26 @@ struct WireNodes {
     [[nodiscard]] std::size_t size() const { return positions.size(); }
 };
 
+/// Calls f(name, member) for each optional per-node array of WireNodes (every one but positions), in declaration
+/// order, with its name as in error messages and a pointer to the member (`nodes.*member` is the array): the one
+/// list of them that inserting and removing a node, copying, sizing and validating walk.
+template <class F>
+constexpr void for_each_node_array(F&& f) {
+    f("ids", &WireNodes::ids);
+    f("stretch", &WireNodes::stretch);
+    f("radius_m", &WireNodes::radius_m);
+    f("theta_rad", &WireNodes::theta_rad);
+    f("iz_m4", &WireNodes::iz_m4);
+    f("length_m", &WireNodes::length_m);
+    f("delta_length_m", &WireNodes::delta_length_m);
+    f("area_m2", &WireNodes::area_m2);
+    f("kb_tension", &WireNodes::kb_tension);
+    f("kb_bias", &WireNodes::kb_bias);
+    f("kb_continuity", &WireNodes::kb_continuity);
+}
+static_assert(sizeof(WireNodes) == 12 * sizeof(std::vector<double>),
+              "WireNodes: an array added? list it in for_each_node_array");
+
 /// The curve through the nodes.
 enum class SplineKind : uint8_t {
     catmull_rom = 0,  ///< local, C1; any alpha; cardinal tension / Kochanek-Bartels / curvature tension apply

@@ -46,34 +46,22 @@ bool size_ok(const std::vector<T>& v, std::size_t n) { return v.empty() || v.siz
 
 Status check_sizes(const WireNodes& w) {
     const std::size_t n = w.positions.size();
-    // The common case in one branch-free test (every array empty or one per node); the messages below.
-    const auto fits = [n](std::size_t size) { return (size == 0) | (size == n); };
-    if (fits(w.ids.size()) & fits(w.stretch.size()) & fits(w.radius_m.size()) & fits(w.theta_rad.size()) &
-        fits(w.iz_m4.size()) & fits(w.length_m.size()) & fits(w.delta_length_m.size()) & fits(w.area_m2.size()) &
-        fits(w.kb_tension.size()) & fits(w.kb_bias.size()) & fits(w.kb_continuity.size())) {
-        return Status::success();
-    }
-    struct Named { const char* name; std::size_t size; bool ok; };
-    const Named arrays[] = {
-        {"ids", w.ids.size(), size_ok(w.ids, n)},
-        {"stretch", w.stretch.size(), size_ok(w.stretch, n)},
-        {"radius_m", w.radius_m.size(), size_ok(w.radius_m, n)},
-        {"theta_rad", w.theta_rad.size(), size_ok(w.theta_rad, n)},
-        {"iz_m4", w.iz_m4.size(), size_ok(w.iz_m4, n)},
-        {"length_m", w.length_m.size(), size_ok(w.length_m, n)},
-        {"delta_length_m", w.delta_length_m.size(), size_ok(w.delta_length_m, n)},
-        {"area_m2", w.area_m2.size(), size_ok(w.area_m2, n)},
-        {"kb_tension", w.kb_tension.size(), size_ok(w.kb_tension, n)},
-        {"kb_bias", w.kb_bias.size(), size_ok(w.kb_bias, n)},
-        {"kb_continuity", w.kb_continuity.size(), size_ok(w.kb_continuity, n)},
-    };
-    for (const Named& a : arrays) {
-        if (!a.ok) {
-            return Status::error(std::string(a.name) + " has " + std::to_string(a.size) + " entries for " +
-                                 std::to_string(n) + " nodes (must be empty or one per node)");
+    // The common case in one branch-free test (every array empty or one per node); the message below.
+    bool fits = true;
+    for_each_node_array([&](const char*, auto member) {
+        const std::size_t size = (w.*member).size();
+        fits &= (size == 0) | (size == n);
+    });
+    if (fits) return Status::success();
+    Status first = Status::success();
+    for_each_node_array([&](const char* name, auto member) {
+        const std::size_t size = (w.*member).size();
+        if (first.ok() && !size_ok(w.*member, n)) {
+            first = Status::error(std::string(name) + " has " + std::to_string(size) + " entries for " +
+                                  std::to_string(n) + " nodes (must be empty or one per node)");
         }
-    }
-    return Status::success();
+    });
+    return first;
 }
 
 Status check_settings(const SplineSettings& s) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <string_view>
 #include <utility>
 
 namespace wire::systems {
@@ -61,17 +62,10 @@ uint32_t insert_node(Registry& registry, Entity wire, std::size_t at, const glm:
     uint32_t id = 0;
     for (const uint32_t existing : n.ids) id = std::max(id, existing + 1);
     n.positions.insert(n.positions.begin() + static_cast<std::ptrdiff_t>(at), position_m);
+    for_each_node_array([&](std::string_view name, auto member) {
+        if (name != "ids") insert_like_neighbour(n.*member, at);  // the others take their neighbour's value
+    });
     n.ids.insert(n.ids.begin() + static_cast<std::ptrdiff_t>(at), id);
-    insert_like_neighbour(n.stretch, at);
-    insert_like_neighbour(n.radius_m, at);
-    insert_like_neighbour(n.theta_rad, at);
-    insert_like_neighbour(n.iz_m4, at);
-    insert_like_neighbour(n.length_m, at);
-    insert_like_neighbour(n.delta_length_m, at);
-    insert_like_neighbour(n.area_m2, at);
-    insert_like_neighbour(n.kb_tension, at);
-    insert_like_neighbour(n.kb_bias, at);
-    insert_like_neighbour(n.kb_continuity, at);
     return id;
 }
 
@@ -85,17 +79,7 @@ void remove_node(Registry& registry, Entity wire, std::size_t at) {
         for (std::size_t i = 0; i < n.ids.size(); ++i) n.ids[i] = static_cast<uint32_t>(i);
     }
     erase_at(n.positions, at);
-    erase_at(n.ids, at);
-    erase_at(n.stretch, at);
-    erase_at(n.radius_m, at);
-    erase_at(n.theta_rad, at);
-    erase_at(n.iz_m4, at);
-    erase_at(n.length_m, at);
-    erase_at(n.delta_length_m, at);
-    erase_at(n.area_m2, at);
-    erase_at(n.kb_tension, at);
-    erase_at(n.kb_bias, at);
-    erase_at(n.kb_continuity, at);
+    for_each_node_array([&](std::string_view, auto member) { erase_at(n.*member, at); });
 }
 
 const WireError* wire_error(const Registry& registry, Entity wire) { return registry.try_get<WireError>(wire); }

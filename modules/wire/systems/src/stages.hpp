@@ -162,15 +162,10 @@ inline void release_curve(WireCurve& c) {
 /// to = from. The optional per-node arrays are usually empty on both sides: they are assigned only when either
 /// has entries (a vector assignment is a call even for two empty vectors, 11 a wire a frame otherwise).
 inline void copy_nodes(WireNodes& to, const WireNodes& from) {
-    static_assert(sizeof(WireNodes) == 12 * sizeof(std::vector<double>), "copy_nodes: a WireNodes array added?");
     to.positions = from.positions;
-    const auto copy = [](auto& t, const auto& f) {
-        if (!t.empty() || !f.empty()) t = f;
-    };
-    copy(to.ids, from.ids), copy(to.stretch, from.stretch), copy(to.radius_m, from.radius_m);
-    copy(to.theta_rad, from.theta_rad), copy(to.iz_m4, from.iz_m4), copy(to.length_m, from.length_m);
-    copy(to.delta_length_m, from.delta_length_m), copy(to.area_m2, from.area_m2);
-    copy(to.kb_tension, from.kb_tension), copy(to.kb_bias, from.kb_bias), copy(to.kb_continuity, from.kb_continuity);
+    for_each_node_array([&](const char*, auto member) {
+        if (!(to.*member).empty() || !(from.*member).empty()) to.*member = from.*member;
+    });
 }
 
 /// Rebuilds a released curve from the last valid nodes with the settings it was built with. It was built by
@@ -197,9 +192,9 @@ inline std::size_t bytes_of(const Curve& c) {
 }
 
 inline std::size_t bytes_of(const WireNodes& n) {
-    return bytes_of(n.positions) + bytes_of(n.ids) + bytes_of(n.stretch) + bytes_of(n.radius_m) +
-           bytes_of(n.theta_rad) + bytes_of(n.iz_m4) + bytes_of(n.length_m) + bytes_of(n.delta_length_m) +
-           bytes_of(n.area_m2) + bytes_of(n.kb_tension) + bytes_of(n.kb_bias) + bytes_of(n.kb_continuity);
+    std::size_t bytes = bytes_of(n.positions);
+    for_each_node_array([&](const char*, auto member) { bytes += bytes_of(n.*member); });
+    return bytes;
 }
 
 inline std::size_t bytes_of(const RingSet& r) {
