@@ -70,8 +70,8 @@ std::string num(std::size_t v);
 // (exit_ok, or exit_failure when a file could not be written).
 int run_systems_bench(const Options& o);   ///< bench.csv, bench.md
 int run_accuracy_bench(const Options& o);  ///< accuracy.csv, accuracy.md, speed_vs_error.png (gnuplot)
-int run_pop_free_bench(const Options& o);
-int run_gl_scale_bench(const Options& o);    ///< bench_gl.csv, bench_gl.md (systems/gl_scale.cpp)    ///< remedy_families.csv, remedy_families.md (accuracy/pop_free.cpp)
+int run_pop_free_bench(const Options& o);   ///< pop_free_families.csv/.md (and remedy_families.*: accuracy/pop_free.cpp)
+int run_gl_scale_bench(const Options& o);   ///< bench_gl.csv, bench_gl.md (systems/gl_scale.cpp)
 /// The DESIGN §5 hard cases as a Markdown section (case, result, max error).
 std::string stability_report();
 

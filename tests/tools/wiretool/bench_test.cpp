@@ -132,7 +132,7 @@ void check_accuracy_csv(const fs::path& dir) {
         csv.header,
         "scene,method,tolerance_px,rings,sides,vertices,bytes_cpu_mesh,bytes_gpu_rings,ns_per_vertex,"
         "us_per_wire_cpu_mesh,us_per_wire_gpu_rings,max_world_error_m,max_screen_error_px,max_twist_deg,"
-        "max_pop_m,max_pop_remedy_m");
+        "max_pop_m,max_pop_blended_m,max_pop_remedy_m");
     EXPECT_TRUE(fs::exists(dir / "accuracy.md"));
     EXPECT_TRUE(fs::exists(dir / "stability.md"));
     const std::vector<std::string> scenes = {"catenary", "helix", "stretched_bend", "churn"};
@@ -195,13 +195,15 @@ void check_accuracy_figures(const fs::path& dir) {
              {"linear", "uniform", "centripetal", "chordal", "c2", "auto", "curvature_tension"}) {
             const auto* r = find(csv.rows, {{"scene", scene}, {"method", method}, {"tolerance_px", "0.5"}});
             ASSERT_TRUE(r);
-            EXPECT_LT(number(*r, "max_pop_remedy_m"), 1e-3) << scene << " " << method;
-            EXPECT_LE(number(*r, "max_pop_remedy_m"), 0.2 * number(*r, "max_pop_m") * (1.0 + 1e-3) + 1e-12)
+            EXPECT_LT(number(*r, "max_pop_blended_m"), 1e-3) << scene << " " << method;
+            EXPECT_LE(number(*r, "max_pop_blended_m"), 0.2 * number(*r, "max_pop_m") * (1.0 + 1e-3) + 1e-12)
                 << scene << " " << method;
             if (std::string(method) !=
                 "linear") {  // a node inserted on a polyline changes nothing: no pop to pop-free blend
-                EXPECT_LT(number(*r, "max_pop_remedy_m"), number(*r, "max_pop_m")) << scene << " " << method;
+                EXPECT_LT(number(*r, "max_pop_blended_m"), number(*r, "max_pop_m")) << scene << " " << method;
             }
+            // The old column name, kept for one release, repeats the new one.
+            EXPECT_EQ(r->at("max_pop_remedy_m"), r->at("max_pop_blended_m")) << scene << " " << method;
         }
     }
     for (const char* method : {"auto", "curvature_tension", "linear"}) {
@@ -238,12 +240,19 @@ void check_stability_and_plot(const fs::path& dir) {
 // held. Uniform Catmull-Rom is the known exception (docs/speed_vs_error.md): its parameter speed varies so much
 // inside a segment that the parameter-to-parameter correspondence of a few events slides far along the curve.
 void check_pop_free_csv(const fs::path& dir) {
-    const Csv csv = read_csv(dir / "remedy_families.csv");
+    const Csv csv = read_csv(dir / "pop_free_families.csv");
     EXPECT_EQ(csv.header,
               "family,method,events,closed_events,overlapped_events,frames,pop_median_m,pop_p90_m,pop_max_m,"
               "jump_median_m,jump_p90_m,jump_max_m,lag_median_m,lag_p90_m,lag_max_m,settle_median_s,settle_p90_s,"
               "settle_max_s,max_jump_over_pop,max_lag_over_pop,max_settled_gap_m,large_events");
-    EXPECT_TRUE(fs::exists(dir / "remedy_families.md"));
+    EXPECT_TRUE(fs::exists(dir / "pop_free_families.md"));
+    // The old names, kept for one release: the same files.
+    const auto text = [](const fs::path& file) {
+        std::ifstream in(file);
+        return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    };
+    EXPECT_EQ(text(dir / "remedy_families.csv"), text(dir / "pop_free_families.csv"));
+    EXPECT_EQ(text(dir / "remedy_families.md"), text(dir / "pop_free_families.md"));
     ASSERT_EQ(csv.rows.size(), 6u);
     for (const auto& r : csv.rows) {
         const std::string& m = r.at("method");
@@ -337,7 +346,7 @@ TEST(WiretoolBench, QuickRunHonoursTheContract) {
     fs::remove_all(dir);
     const std::string cmd =
         std::string(WIRETOOL_PATH) +
-        " bench --quick --scenes standard,offscreen,catenary,helix,stretched_bend,churn,remedy_families --out " +
+        " bench --quick --scenes standard,offscreen,catenary,helix,stretched_bend,churn,pop_free_families --out " +
         dir.string() + " > " + (dir.string() + ".log") + " 2>&1";
     const int raw = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << "see " << dir.string() << ".log";
@@ -358,7 +367,7 @@ TEST(WiretoolBench, QuickRunHonoursTheContract) {
         check_stability_and_plot(dir);
     }
     {
-        SCOPED_TRACE("remedy_families.csv");
+        SCOPED_TRACE("pop_free_families.csv");
         check_pop_free_csv(dir);
     }
     if (!::testing::Test::HasFailure()) {

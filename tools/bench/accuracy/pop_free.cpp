@@ -1,5 +1,5 @@
-// `wiretool bench`: the pop-free blend over random node-event families (wire/remedy_family.hpp), per spline
-// method: remedy_families.csv and remedy_families.md (distributions of the instant pop, the per-frame jump, the
+// `wiretool bench`: the pop-free blend over random node-event families (wire/testing/pop_free_family.hpp), per
+// spline method: pop_free_families.csv and .md (distributions of the instant pop, the per-frame jump, the
 // lag and the settling time; the worst ratios and the worst case).
 #include "bench/common.hpp"
 #include "wiretool/commands.hpp"
@@ -45,14 +45,14 @@ int run_pop_free_bench(const Options& o) {
                   "max_jump_over_pop", "max_lag_over_pop", "max_settled_gap_m", "large_events"};
     std::string worst;
     for (std::size_t k = 0; k < std::size(methods); ++k) {
-        std::fprintf(stderr, "bench: remedy family %s\n", methods[k].name);
+        std::fprintf(stderr, "bench: pop-free family %s\n", methods[k].name);
         wire::PopFreeFamilySettings s;
         s.spline = methods[k].spline;
         s.cables = o.quick ? 10 : 40;  // 130 or 520 events, half on closed loops
         s.seed = 17 + k;
         const wire::PopFreeFamilyResult r = wire::run_pop_free_family(s);
         if (!r.error.empty()) {
-            std::fprintf(stderr, "wiretool bench: remedy family %s: %s\n", methods[k].name, r.error.c_str());
+            std::fprintf(stderr, "wiretool bench: pop-free family %s: %s\n", methods[k].name, r.error.c_str());
             return exit_failure;
         }
         std::vector<double> pop, jump, lag, settle;
@@ -71,11 +71,7 @@ int run_pop_free_bench(const Options& o) {
         worst += std::string("- `") + methods[k].name + "`: largest jump/pop at " + r.worst_jump + "; largest lag/pop at " +
                  r.worst_lag + "\n";
     }
-    if (!csv.write_csv(o.out_dir / "remedy_families.csv")) {
-        std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "remedy_families.csv").c_str());
-        return exit_failure;
-    }
-    std::string md = "# wiretool bench: the pop-free remedy over random node events\n\n";
+    std::string md = "# wiretool bench: the pop-free blend over random node events\n\n";
     md += "Per method, " + std::string(o.quick ? "10" : "40") +
           " random 20-40 m cables (half hanging catenaries, half closed loops; 16-48 nodes), 13 events each: a node "
           "inserted exactly on the curve, a node removed anywhere (a loop's seam node included), an end node "
@@ -87,9 +83,13 @@ int run_pop_free_bench(const Options& o) {
           "whose offset exceeds what 2 mm a frame can carry within the longest geomorph (they move by up to "
           "1.5 max|D| / N_max a frame).\n\n";
     md += csv.markdown() + "\nWorst cases:\n\n" + worst;
-    if (!write_text(o.out_dir / "remedy_families.md", md)) {
-        std::fprintf(stderr, "wiretool bench: cannot write %s\n", (o.out_dir / "remedy_families.md").c_str());
-        return exit_failure;
+    // pop_free_families.*, and the same files under their old name remedy_families.* for one release.
+    for (const char* name : {"pop_free_families", "remedy_families"}) {
+        const std::filesystem::path file = o.out_dir / (std::string(name) + ".csv");
+        if (!csv.write_csv(file) || !write_text(o.out_dir / (std::string(name) + ".md"), md)) {
+            std::fprintf(stderr, "wiretool bench: cannot write %s and its .md\n", file.c_str());
+            return exit_failure;
+        }
     }
     return exit_ok;
 }
