@@ -89,48 +89,6 @@ struct Row {
     double wire_memory_bytes = 0.0, gpu_buffer_bytes = 0.0;
 };
 
-// What the nodes path sends (node_path.hpp): for a wire whose curve generation it has not sent, a 64-byte header
-// and its curve nodes (16 bytes each; coincident ones merged, as the bench's never are) or, for a curve built on
-// the CPU (a pop-free blend), 64 bytes a segment; per-node kb and stretch (the extras); 4 bytes for each other
-// visible wire (its slot) when that list differs from the last frame's (the renderer keeps it on the GPU).
-struct NodesModel {
-    std::unordered_map<uint64_t, uint64_t> seen;  // the generation each wire's curve was sent at
-    std::vector<uint64_t> still, last_still;      // the unchanged visible wires (their slot list), this and last frame
-};
-
-std::size_t nodes_plan(const wire::DrawList& list, NodesModel& model) {
-    std::size_t bytes = 0, extras = 0;
-    model.still.clear();
-    for (const wire::DrawItem& item : list.items) {
-        auto [it, fresh] = model.seen.try_emplace(item.wire_id, 0);
-        if (!fresh && item.nodes_generation != 0 && it->second == item.nodes_generation) {
-            model.still.push_back(item.wire_id);  // an unchanged wire: its slot, sent when the list changes
-            continue;
-        }
-        it->second = item.nodes_generation;
-        bytes += 64;
-        if (item.curve != nullptr) {
-            bytes += 64 * item.curve->segment_count();
-            continue;
-        }
-        if (item.packed_nodes != nullptr) {
-            bytes += 16 * (item.packed_nodes->nodes.size() + item.packed_nodes->extras.size());
-            continue;
-        }
-        const wire::WireNodes& n = *item.nodes;
-        bytes += 16 * n.size();
-        const bool kb = item.spline.kind == wire::SplineKind::catmull_rom &&
-                        (!n.kb_tension.empty() || !n.kb_bias.empty() || !n.kb_continuity.empty() ||
-                         (item.spline.curvature_tension && !n.theta_rad.empty()));
-        if (kb) extras += 16 * n.size();
-        const std::size_t segs = item.spline.closed ? n.size() : n.size() - 1;
-        if (!n.stretch.empty()) extras += 16 * ((segs + 3) / 4);
-    }
-    if (model.still != model.last_still) bytes += 4 * model.still.size();
-    std::swap(model.still, model.last_still);
-    return bytes + extras;
-}
-
 std::size_t visible_nodes(const wire::DrawList& list) {
     std::size_t n = 0;
     for (const wire::DrawItem& item : list.items) {
@@ -173,7 +131,7 @@ public:
         row.scene = scene_name(kind), row.wires = wires, row.threads = threads, row.path = path, row.thin = thin;
         row.f.timer = engine::gfx::GpuTimer::create();
         wire::render::RingResidency model;  // what the retained renderer should send
-        NodesModel seen;  // gpu-nodes: what the renderer has on the GPU
+        wire::render::NodesPlan seen;  // gpu-nodes: what the renderer has on the GPU
         MergedMesh merged;
         std::fprintf(stderr, "bench --gl: %s, %d wires, %dx%d, %d thread(s), %s%s\n", row.scene.c_str(), wires,
                      o.width_px, o.height_px, threads, path_name(path), thin ? "" : ", strips and lines off");
@@ -202,7 +160,7 @@ public:
             } else if (path == GlPathKind::gpu_retained) {
                 computed = wire::render::plan_retained_frame(ctx.draw_list, model).bytes;
             } else if (path == GlPathKind::gpu_nodes) {
-                computed = nodes_plan(ctx.draw_list, seen);
+                computed = wire::render::plan_nodes_frame(ctx.draw_list, seen);
             } else {
                 computed = upload_bytes(ctx.draw_list);
             }

@@ -1,6 +1,8 @@
 // Ring packing, draw counts and the residency bookkeeping of the wire renderer (no GL).
 #include "wire/render/upload_plan.hpp"
 
+#include "wire/packed_nodes.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -153,6 +155,55 @@ RetainedFrame plan_retained_frame(const DrawList& list, RingResidency& residency
     f.wires_evicted = residency.evict().size();
     f.bytes += f.ring_bytes;
     return f;
+}
+
+std::size_t plan_nodes_frame(const DrawList& list, NodesPlan& plan) {
+    ++plan.frame;
+    std::size_t bytes = 0, drawn = 0;
+    plan.listed.clear();
+    thread_local PackedNodes packed;
+    for (const DrawItem& item : list.items) {
+        const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
+        const bool has_packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
+        if (!has_curve && !has_packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
+        auto [it, fresh] = plan.sent.try_emplace(item.wire_id);
+        NodesPlan::Sent& s = it->second;
+        if (!fresh && s.last_frame == plan.frame) continue;  // listed twice: drawn once
+        s.last_frame = plan.frame;
+        if (!fresh && item.nodes_generation != 0 && s.generation == item.nodes_generation) {
+            plan.listed.push_back(item.wire_id);
+            ++drawn;
+            continue;
+        }
+        std::size_t wire_bytes = 64;  // the header
+        if (has_curve) {
+            wire_bytes += 64 * item.curve->segment_count();
+        } else if (has_packed) {
+            wire_bytes += 16 * (item.packed_nodes->nodes.size() + item.packed_nodes->extras.size());
+        } else if (pack_nodes(*item.nodes, item.spline, packed).ok()) {
+            wire_bytes += 16 * (packed.nodes.size() + packed.extras.size());
+        } else {
+            plan.sent.erase(it);  // not drawn; sent again next frame
+            continue;
+        }
+        s.generation = item.nodes_generation;
+        bytes += wire_bytes;
+        ++drawn;
+    }
+    if (plan.frame % 16 == 0) {
+        std::erase_if(plan.sent,
+                      [&](const auto& e) { return e.second.last_frame + plan.retain_frames < plan.frame; });
+    }
+    if (drawn == 0) return 0;  // nothing drawn: the renderer stops before the list
+    // The kept list: resent when it changed or outgrew its buffer (grown as the renderer grows it).
+    const std::size_t list_bytes = std::max<std::size_t>(4 * drawn, 4);
+    if (plan.listed != plan.last_listed || plan.kept_bytes == 0 || list_bytes > plan.kept_bytes) {
+        bytes += 4 * plan.listed.size();
+        const std::size_t need = std::max<std::size_t>(list_bytes, 16);
+        if (need > plan.kept_bytes) plan.kept_bytes = std::max(need, plan.kept_bytes + plan.kept_bytes / 2);
+        plan.last_listed = plan.listed;
+    }
+    return bytes;
 }
 
 }  // namespace wire::render

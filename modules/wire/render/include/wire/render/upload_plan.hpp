@@ -139,4 +139,26 @@ struct RetainedFrame {
 };
 RetainedFrame plan_retained_frame(const DrawList& list, RingResidency& residency);
 
+/// What the nodes path has of each wire (the renderer's slots, as plan_nodes_frame() follows them): the nodes
+/// generation it got, the frame it was last drawn (slots not drawn for retain_frames are evicted, looked for
+/// every 16th frame as the renderer does), and the list of unchanged drawn wires it keeps on the GPU.
+struct NodesPlan {
+    uint32_t retain_frames = 180;  ///< RendererDesc::retain_frames (0 there: 180)
+    uint64_t frame = 0;
+    struct Sent {
+        uint64_t generation = 0, last_frame = 0;
+    };
+    std::unordered_map<uint64_t, Sent> sent{};
+    std::vector<uint64_t> listed{}, last_listed{};  ///< this frame's and the kept list of unchanged drawn wires
+    std::size_t kept_bytes = 0;                 ///< capacity of the kept list on the GPU (0: none yet)
+};
+
+/// The bytes one draw() of `list` on the nodes path writes (its DrawStats::bytes_uploaded, node stream aside), with
+/// `plan` updated as the renderer updates its slots: for each drawn wire whose nodes it has not got (new, evicted,
+/// or nodes_generation changed or 0) a 64-byte header and its nodes as wire::pack_nodes packs them (16 bytes each,
+/// and the extras) or its CPU-built curve's segments (64 bytes each); 4 bytes for each other drawn wire when
+/// that list differs from the one kept on the GPU (or outgrew its buffer). Frames the GPU side could not compute
+/// (buffers that could not be made) are not modelled.
+std::size_t plan_nodes_frame(const DrawList& list, NodesPlan& plan);
+
 }  // namespace wire::render
