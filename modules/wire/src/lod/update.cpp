@@ -75,12 +75,9 @@ namespace {
 /// Tube, strip (2) or line (1) for a projected radius. Hysteresis: a thinner mode used last update is kept
 /// until the radius exceeds its threshold by the band (like the counts), so a wire at the switch distance does
 /// not alternate between two modes while the camera drifts.
-uint32_t drawn_sides_for(double radius_px, uint32_t sides, uint32_t old_drawn, const LodSettings& settings,
-                         double band) {
-    const LodSettings resolved = settings.resolved();
-    const double strip = resolved.strip_radius_px;
-    const double line = resolved.line_radius_px;
-    const double keep = 1.0 + std::max(band, 0.0);
+uint32_t drawn_sides_for(double radius_px, uint32_t sides, uint32_t old_drawn, const Limits& lim) {
+    const double strip = lim.strip_px, line = lim.line_px;
+    const double keep = 1.0 + std::max(lim.band, 0.0);
     if (line > 0.0 && (radius_px < line || (old_drawn == 1 && radius_px < line * keep))) return 1;
     if (strip > 0.0 && (radius_px < strip || (old_drawn == 2 && radius_px < strip * keep))) return 2;
     return sides;
@@ -247,7 +244,7 @@ bool update_lod_impl(const Curve& curve, const LodView& view, const LodSettings&
     changed = changed || sides != lod.sides;
     lod.sides = sides;
     lod.radius_px = std::isfinite(wire_z) ? radius * view.focal_px * wire_k / std::max(wire_z, view.near_m) : 0.0;
-    lod.drawn_sides = drawn_sides_for(lod.radius_px, lod.sides, lod.drawn_sides, settings, lim.band);
+    lod.drawn_sides = drawn_sides_for(lod.radius_px, lod.sides, lod.drawn_sides, lim);
     if (keeps_coherence && lod.bounded && merger.margin() > 1.0) {
         WireLod::Coherence& c = lod.coherence;
         c.valid = true;

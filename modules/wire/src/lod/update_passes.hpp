@@ -11,13 +11,15 @@
 
 namespace wire::lod_stage {
 
+/// The settings' values an update reads (LodSettings::resolved), resolved once per update.
 struct Limits {
     double eps;
     uint32_t max_rings, max_sides;
-    double band;
+    double band, strip_px, line_px;
     explicit Limits(const LodSettings& settings) {
         const LodSettings r = settings.resolved();
         eps = r.tolerance_px, max_rings = r.max_rings_per_segment, max_sides = r.max_sides, band = r.hysteresis_band;
+        strip_px = r.strip_radius_px, line_px = r.line_radius_px;
     }
 };
 
