@@ -5,18 +5,15 @@
 // Kochanek-Bartels tangents at j (the same formulas as catmull_rom_tangents in modules/wire/src/spline/build.cpp,
 // in float); node j writes its incoming segment (put_segment), holding its outgoing tangent for the next node.
 layout(local_size_x = 64) in;
-layout(std430, binding = CURVE_HEADERS) readonly buffer Headers { Header headers[]; };
+layout(std430, binding = CURVE_HEADERS) readonly buffer Headers { GpuCurveHeader headers[]; };
 layout(std430, binding = CURVE_NODES) readonly buffer Nodes { vec4 nodes[]; };  // xyz: offset from the origin; w: radius
 layout(std430, binding = CURVE_SEGMENTS) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: see put_segment
 layout(std430, binding = CURVE_SCRATCH) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
-// Per-node tension, bias, continuity (vec4 a node), then stretch (4 segments a vec4), from Header.extra_first.
+// Per-node tension, bias, continuity (vec4 a node), then stretch (4 segments a vec4), from GpuCurveHeader.extra_first.
 layout(std430, binding = CURVE_EXTRAS) readonly buffer Extras { vec4 extras[]; };
 // u_persist: each wire's header goes on to its slot (the ring pass reads it there every frame).
-layout(std430, binding = CURVE_SLOT_HEADERS) writeonly buffer SlotHeaders { Header slot_headers[]; };
-// u_motion: per slot, the motion reference of its last upload (motion_reference's samples of its curve nodes:
-// origin.xyz the upload's origin, origin.w the determinacy; counts.x samples, counts.y nodes, 0 samples: none;
-// p[k].xyz the sample's offset from the origin, p[k].w its weight).
-struct MotionRef { vec4 origin; uvec4 counts; vec4 p[10]; };
+layout(std430, binding = CURVE_SLOT_HEADERS) writeonly buffer SlotHeaders { GpuCurveHeader slot_headers[]; };
+// u_motion: per slot, the motion reference of its last upload (MotionRef).
 layout(std430, binding = CURVE_MOTION_REFS) buffer MotionRefs { MotionRef refs[]; };
 // u_list: each wire's slot goes to slot_list[u_list_first + w] (the ring pass's list of this frame's wires).
 layout(std430, binding = CURVE_SLOT_LIST) writeonly buffer SlotList { uint slot_list[]; };
@@ -26,7 +23,7 @@ uniform uint u_list_first;
 uniform bool u_persist;
 uniform bool u_motion;
 
-vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
+vec3 node(GpuCurveHeader h, uint j) { return nodes[h.node_first + j].xyz; }
 
 // c2 (kind 2): node tangents per unit chord D from the C2 spline's tangent system with chordal knots (rows
 // a D[j-1] + 2 D[j] + c D[j+1] = 3 (a e_in + c e_out), a = h_out / (h_in + h_out), c = h_in / (h_in + h_out));
@@ -35,11 +32,11 @@ vec3 node(Header h, uint j) { return nodes[h.node_first + j].xyz; }
 // not-a-knot end D0 = (r0 - D1) / beta0 cancels by the ratio of the first two chords (beta0 = h1 / (h0 + h1)),
 // which in float moved a 4-node wire with 100:1 chords by 1e-4 of its extent; the float nodes' differences are
 // exact in double. D[j] goes to scratch[2 (first + j)].xyz.
-uint sidx(Header h, uint j) { return 2u * (h.node_first + j); }
-dvec3 dnode(Header h, uint j) { return dvec3(node(h, j % h.node_count)); }
-dvec3 chord(Header h, uint k) { return dnode(h, k + 1u) - dnode(h, k); }
-double hlen(Header h, uint k) { return length(chord(h, k)); }
-dvec3 unit_chord(Header h, uint k) { return chord(h, k) / hlen(h, k); }
+uint sidx(GpuCurveHeader h, uint j) { return 2u * (h.node_first + j); }
+dvec3 dnode(GpuCurveHeader h, uint j) { return dvec3(node(h, j % h.node_count)); }
+dvec3 chord(GpuCurveHeader h, uint k) { return dnode(h, k + 1u) - dnode(h, k); }
+double hlen(GpuCurveHeader h, uint k) { return length(chord(h, k)); }
+dvec3 unit_chord(GpuCurveHeader h, uint k) { return chord(h, k) / hlen(h, k); }
 
 // Row j of the interior system: (a, b, c) and its right-hand side.
 // The automatic spline (kind 3): the c2 system with node j's tension weight w_j on the diagonal (Nielson's
@@ -48,24 +45,24 @@ dvec3 unit_chord(Header h, uint k) { return chord(h, k) / hlen(h, k); }
 // operations in double; the weights' exponentials in float: GLSL has no double exp), then each node's tension
 // scaling both its tangents (build_curve's end_curve): 1 - t, t wire-wide or, for nodes that carry tension or the
 // physics arrays, per node in the extras (x).
-bool automatic(Header h) { return ((h.flags >> 1u) & 3u) == 3u; }
-double keep_at(Header h, uint j) {
+bool automatic(GpuCurveHeader h) { return ((h.flags >> kHeaderKindShift) & kHeaderKindMask) == kKindAutomatic; }
+double keep_at(GpuCurveHeader h, uint j) {
     if (!automatic(h)) return 1.0;
-    return 1.0lf - double((h.flags & kHasPerNode) != 0u ? extras[h.extra_first + j].x : h.kb.y);
+    return 1.0lf - double((h.flags & kHeaderPerNode) != 0u ? extras[h.extra_first + j].x : h.kb.y);
 }
-dvec3 e_out(Header h, uint j) { return unit_chord(h, j % h.node_count); }
-dvec3 e_in(Header h, uint j) { return unit_chord(h, (j + h.node_count - 1u) % h.node_count); }
+dvec3 e_out(GpuCurveHeader h, uint j) { return unit_chord(h, j % h.node_count); }
+dvec3 e_in(GpuCurveHeader h, uint j) { return unit_chord(h, (j + h.node_count - 1u) % h.node_count); }
 // Curvature vector and chord-bisector tangent of node j (an open wire's end nodes take their neighbour's).
-uint inner(Header h, uint j) {
-    bool closed = (h.flags & kClosed) != 0u;
+uint inner(GpuCurveHeader h, uint j) {
+    bool closed = (h.flags & kHeaderClosed) != 0u;
     return closed ? j % h.node_count : clamp(j, 1u, h.node_count - 2u);
 }
-dvec3 kvec(Header h, uint j) {
+dvec3 kvec(GpuCurveHeader h, uint j) {
     j = inner(h, j);
     uint n = h.node_count;
     return (e_out(h, j) - e_in(h, j)) * (2.0lf / (hlen(h, (j + n - 1u) % n) + hlen(h, j)));
 }
-dvec3 tvec(Header h, uint j) {
+dvec3 tvec(GpuCurveHeader h, uint j) {
     j = inner(h, j);
     dvec3 b = e_in(h, j) + e_out(h, j);
     double lb = length(b);
@@ -83,9 +80,9 @@ float smoothstep_d(double e0, double e1, double x) {
     return float(t * t * (3.0lf - 2.0lf * t));
 }
 // (w, g, max(g, straight)) of node j: 0 where its neighbours predict its turn (the spread test).
-vec3 turn_weights(Header h, uint j) {
+vec3 turn_weights(GpuCurveHeader h, uint j) {
     uint n = h.node_count;
-    bool closed = (h.flags & kClosed) != 0u;
+    bool closed = (h.flags & kHeaderClosed) != 0u;
     if (!automatic(h) || n < 3u || (!closed && (j == 0u || j + 1u >= n))) return vec3(0.0);
     uint jp = (j + n - 1u) % n, jn = (j + 1u) % n;
     double hin = hlen(h, jp), hout = hlen(h, j);
@@ -112,7 +109,7 @@ vec3 turn_weights(Header h, uint j) {
     return vec3(w, g, max(g, straight));
 }
 
-void row(Header h, uint j, out dvec3 abc, out dvec3 rhs) {
+void row(GpuCurveHeader h, uint j, out dvec3 abc, out dvec3 rhs) {
     uint n = h.node_count;
     uint kin = (j + n - 1u) % n, kout = j % n;
     double hin = hlen(h, kin), hout = hlen(h, kout), sum = hin + hout;
@@ -121,7 +118,7 @@ void row(Header h, uint j, out dvec3 abc, out dvec3 rhs) {
     rhs = 3.0 * (a * unit_chord(h, kin) + c * unit_chord(h, kout));
 }
 
-void c2_tangents(Header h, bool closed) {
+void c2_tangents(GpuCurveHeader h, bool closed) {
     uint n = h.node_count;
     if (closed) {
         // Rows 0 .. n-1 (row j is node j's, wrapping); Thomas on the modified matrix for x (rhs) and z (u) at once.
@@ -226,12 +223,12 @@ void c2_tangents(Header h, bool closed) {
 // 1e-4 of a segment).
 // The w components carry what the ring pass reads per segment: the radii of its start and end nodes and its
 // stretch.
-float seg_stretch(Header h, uint k) {
-    if ((h.flags & kHasStretch) == 0u) return 1.0;
-    uint base = h.extra_first + ((h.flags & kHasPerNode) != 0u ? h.node_count : 0u);
+float seg_stretch(GpuCurveHeader h, uint k) {
+    if ((h.flags & kHeaderStretch) == 0u) return 1.0;
+    uint base = h.extra_first + ((h.flags & kHeaderPerNode) != 0u ? h.node_count : 0u);
     return extras[base + k / 4u][k % 4u];
 }
-void put_segment(Header h, uint k, vec3 p0, vec3 t0, vec3 t1, vec3 chord_k) {
+void put_segment(GpuCurveHeader h, uint k, vec3 p0, vec3 t0, vec3 t1, vec3 chord_k) {
     uint s = 4u * (h.segment_first + k);
     segments[s] = vec4(p0, nodes[h.node_first + k].w);
     segments[s + 1u] = vec4(t0 / 3.0, nodes[h.node_first + (k + 1u) % h.node_count].w);

@@ -1,28 +1,28 @@
 void main() {
     uint w = gl_GlobalInvocationID.x;
     if (w >= u_wires) return;
-    Header h = headers[w];
+    GpuCurveHeader h = headers[w];
     if (u_list) slot_list[u_list_first + w] = h.slot;
     if (u_persist && u_motion) {
         // This upload's reference (none for given segments) and, when asked, the motion fitted against the last.
         MotionRef to;
         to.counts = uvec4(0u);
-        if ((h.flags & kGivenSegments) == 0u) to = make_ref(h);
-        if ((h.flags & kFitMotion) != 0u) {
+        if ((h.flags & kHeaderGivenSegments) == 0u) to = make_ref(h);
+        if ((h.flags & kHeaderFitMotion) != 0u) {
             vec4 q = fit_motion(refs[h.slot], to);
             h.motion[0] = q.x, h.motion[1] = q.y, h.motion[2] = q.z;
         }
         refs[h.slot] = to;
     }
     if (u_persist) slot_headers[h.slot] = h;
-    if ((h.flags & kGivenSegments) != 0u) {  // a blended curve: its segments as they came
-        uint segs = (h.flags & 1u) != 0u ? h.node_count : h.node_count - 1u;
+    if ((h.flags & kHeaderGivenSegments) != 0u) {  // a blended curve: its segments as they came
+        uint segs = (h.flags & kHeaderClosed) != 0u ? h.node_count : h.node_count - 1u;
         for (uint k = 0u; k < 4u * segs; ++k) segments[4u * h.segment_first + k] = nodes[h.node_first + k];
         return;
     }
     uint n = h.node_count;
-    bool closed = (h.flags & 1u) != 0u;
-    uint kind = (h.flags >> 1u) & 3u;
+    bool closed = (h.flags & kHeaderClosed) != 0u;
+    uint kind = (h.flags >> kHeaderKindShift) & kHeaderKindMask;
     uint segs = closed ? n : n - 1u;
     if (kind >= 2u) {
         c2_tangents(h, closed);
@@ -57,7 +57,7 @@ void main() {
             t0 = dout;
             t1 = din;
         } else {
-            if ((h.flags & kHasPerNode) != 0u) {
+            if ((h.flags & kHeaderPerNode) != 0u) {
                 vec4 k = extras[h.extra_first + j];
                 keep = 1.0 - k.x;
                 b = k.y;

@@ -1,4 +1,4 @@
-// The wire's motion since its last upload (kFitMotion), as wire/motion.cpp fits it on the CPU: the reference
+// The wire's motion since its last upload (kHeaderFitMotion), as wire/motion.cpp fits it on the CPU: the reference
 // (motion_reference: nodes 0, 1, 2, 3, then steps growing 1.5x, the last node; weights (1 + s / 4l)^-4 with the
 // reach l grown 4x from two elements until the determinacy 2 e2 / e1^2 reaches 1e-3), Horn's weighted fit (the
 // top eigenvector of his 4x4 matrix by Theobald's characteristic polynomial: Newton from the spread, then the
@@ -30,7 +30,7 @@ double determinacy(dvec3 p[10], double wt[10], uint m) {
     if (!(e1 > 0.0lf)) return 0.0lf;
     return max(0.0lf, 2.0lf * e2 / (e1 * e1));
 }
-MotionRef make_ref(Header h) {
+MotionRef make_ref(GpuCurveHeader h) {
     MotionRef r;
     uint at[10];
     uint m = ref_indices(h.node_count, at);
@@ -55,7 +55,7 @@ MotionRef make_ref(Header h) {
         if (det >= 1e-3lf || !(reach < whole)) break;
         reach *= 4.0lf;
     }
-    r.origin = vec4(h.origin[0], h.origin[1], h.origin[2], float(det));
+    r.origin = vec4(h.origin_m[0], h.origin_m[1], h.origin_m[2], float(det));
     for (uint k = 0u; k < 10u; ++k) r.p[k] = vec4(vec3(p[k]), float(wt[k]));
     return r;
 }

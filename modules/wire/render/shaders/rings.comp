@@ -2,25 +2,10 @@
 // One invocation per wire. The CPU reference for every function named after one: modules/wire/src/rings.cpp
 // (build_rings, radius, u) and modules/wire/src/frames.cpp (compute_frames, mirrors, Transporter).
 layout(local_size_x = 64) in;
-// Per dispatched wire: inputs (previous normal for the tests' path) and what the passes found.
-struct Job {
-    uint ring_first;     // out: first ring record (allocated by the LOD stage)
-    uint ring_count;     // out: rings (0: culled, or the ring buffer was full)
-    uint flags;          // in (stage 0): bit 1 the job gives the previous normal (bit 0: previous_normal is one);
-                         // else the slot's last frame's ring 0 normal is carried. Out: bit 2 the rings came from
-                         // the reserve (one a segment)
-    uint sides;          // out: drawn sides (3.. a tube, 2 a strip, 1 a line)
-    vec4 previous_normal;
-    vec4 first_normal;   // out: ring 0's r
-    vec4 totals;         // out: u where a closed loop closes, length, holonomy, projected radius (pixels)
-};
-// Per slot, kept between frames: the LOD's state (sides, drawn sides, 1 when it holds a previous frame's, 1
-// visible) and ring 0's normal of the last frame (w = 1 when set). A slot is zeroed when it is given to a wire.
-struct SlotState { uvec4 lod; vec4 first_normal; };
-layout(std430, binding = RING_HEADERS) readonly buffer Headers { Header headers[]; };  // by slot
+layout(std430, binding = RING_HEADERS) readonly buffer Headers { GpuCurveHeader headers[]; };  // by slot
 layout(std430, binding = RING_SEGMENTS) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2; w: see below
 layout(std430, binding = RING_JOBS) buffer Jobs { Job jobs[]; };
-// Rings per segment (at Header.segment_first): the caller's, or (u_lod) the LOD's, over the previous frame's.
+// Rings per segment (at GpuCurveHeader.segment_first): the caller's, or (u_lod) the LOD's, over the previous frame's.
 layout(std430, binding = RING_COUNTS) buffer Counts { uint counts[]; };
 layout(std430, binding = RING_RINGS) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
 layout(std430, binding = RING_SLOTS) buffer Slots { SlotState slot_state[]; };
@@ -34,9 +19,8 @@ layout(std430, binding = RING_COUNTER) buffer Counter {
 // The slot of each dispatched wire: the first u_unchanged were listed by the CPU (their nodes did not change), the
 // others by this frame's curve passes (their nodes changed: CURVE_SLOT_LIST).
 layout(std430, binding = RING_VISIBLE) readonly buffer Visible { uint visible[]; };
-// u_draw: the single draw's records (wire::render's GpuDraw, the chunk records and the indirect commands).
-struct Draw { vec3 offset_m; uint ring_first; uint ring_count; uint sides; uint flags; float u_close; };
-layout(std430, binding = RING_DRAWS) writeonly buffer Draws { Draw draws[]; };
+// u_draw: the single draw's records (GpuDraw, the chunk records and the indirect commands).
+layout(std430, binding = RING_DRAWS) writeonly buffer Draws { GpuDraw draws[]; };
 layout(std430, binding = RING_CHUNKS) writeonly buffer Chunks { uvec2 chunks[]; };
 layout(std430, binding = RING_BUCKETS) buffer Buckets { uint buckets[]; };  // u_buckets chunk counts, then as many cursors
 layout(std430, binding = RING_COMMANDS) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
@@ -64,6 +48,6 @@ const float kPi = 3.14159265358979;
 const float kSplitCos = 0.70710678;  // a step turning more than 45 degrees is split
 const uint kMaxDepth = 10u;          // FrameSettings::max_subdivision_depth's default
 
-Header H;
+GpuCurveHeader H;
 uint N, SEGS, RING_FIRST;
 bool CLOSED;

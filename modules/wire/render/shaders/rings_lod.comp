@@ -257,7 +257,7 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
         slot_state[slot].lod = uvec4(0u);  // culled: the next frame starts afresh (cull_lod)
         return 0u;
     }
-    uint wire_max = (H.flags >> 8u) & 255u;  // the wire's own most sides, if it has one
+    uint wire_max = (H.flags >> kHeaderSidesShift) & kHeaderSidesMask;  // the wire's own most sides, if it has one
     uint max_sides = wire_max == 0u ? u_max_sides : max(3u, min(u_max_sides, wire_max));
     uint required_sides = visible == 0u ? 3u : sides_for_radius(radius, wire_z, wire_k, max_sides);
     uint sides = min(fresh ? required_sides : hysteresis_count(state.x, required_sides, u_band), max_sides);

@@ -80,7 +80,7 @@ uint chunk_count_of(uint kind, uint rings, uint drawn, bool caps) {
 }
 uint bucket_of(uint material, uint drawn, uint kind) { return (material * u_side_slots + drawn) * 6u + kind; }
 
-// v turned by the unit quaternion (sqrt(1 - |m|^2), m) (Header.motion; no trigonometry: a rotation by angle a has
+// v turned by the unit quaternion (sqrt(1 - |m|^2), m) (GpuCurveHeader.motion; no trigonometry: a rotation by angle a has
 // |m| = sin(a / 2), and w from it loses precision only near a half turn in one frame).
 vec3 turned(vec3 v, vec3 m) {
     float w = sqrt(max(0.0, 1.0 - dot(m, m)));
@@ -91,7 +91,7 @@ vec3 turned(vec3 v, vec3 m) {
 void load_wire(uint slot) {
     H = headers[slot];
     N = H.node_count;
-    CLOSED = (H.flags & kClosed) != 0u;
+    CLOSED = (H.flags & kHeaderClosed) != 0u;
     SEGS = CLOSED ? N : N - 1u;
 }
 
@@ -117,8 +117,8 @@ void main() {
     if (w >= u_wires) return;
     uint slot = visible[w];
     load_wire(slot);
-    uint material = H.flags >> 16u;
-    bool caps = (H.flags & kCaps) != 0u;
+    uint material = H.flags >> kHeaderMaterialShift;
+    bool caps = (H.flags & kHeaderCaps) != 0u;
     Job job = jobs[w];
     uint n = CLOSED ? 0u : 1u;
     float radius_px = 0.0;
@@ -134,11 +134,11 @@ void main() {
     }
     if (u_stage != 3u) {
         // Stage 0 (GpuRingPass) has the caller's job flags; the nodes path (stage 1) carries from the slot.
-        uint flags = u_stage == 0u ? jobs[w].flags & 3u : 0u;
+        uint flags = u_stage == 0u ? jobs[w].flags & (kJobHasPrevious | kJobGivesPrevious) : 0u;
         jobs[w].flags = flags;
         // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
         if (u_lod) {
-            vec3 offset = vec3(dvec3(H.origin[0], H.origin[1], H.origin[2]) - u_eye);
+            vec3 offset = vec3(dvec3(H.origin_m[0], H.origin_m[1], H.origin_m[2]) - u_eye);
             n = lod(slot, offset, radius_px);
             drawn = slot_state[slot].lod.y;
         } else {
@@ -159,7 +159,7 @@ void main() {
             if (first + fewest > u_ring_capacity + u_ring_reserve) return;
             n = fewest;
             jobs[w].ring_first = first;
-            jobs[w].flags = flags | 4u;
+            jobs[w].flags = flags | kJobFromReserve;
         }
         jobs[w].ring_count = n;
         if (u_draw) {
@@ -180,15 +180,14 @@ void main() {
         if (n == 0u) return;
     }
     RING_FIRST = job.ring_first;
-    FEWEST = (job.flags & 4u) != 0u;
+    FEWEST = (job.flags & kJobFromReserve) != 0u;
     // The first normal: the carried previous one projected onto the first tangent, else seeded from an axis.
     vec3 t0 = unit_tangent(load_seg(0u), 0.0);
     if (t0 == vec3(0.0)) t0 = vec3(0.0, 0.0, 1.0);
     vec3 r0 = seed_normal(t0);
-    // Job flags bit 1: the job gives the previous normal (bit 0: there is one); else the slot's last frame's.
-    vec4 previous = (job.flags & 2u) == 0u           ? slot_state[slot].first_normal
-                    : (job.flags & 1u) != 0u ? vec4(job.previous_normal.xyz, 1.0)
-                                             : vec4(0.0);
+    vec4 previous = (job.flags & kJobGivesPrevious) == 0u ? slot_state[slot].first_normal
+                    : (job.flags & kJobHasPrevious) != 0u ? vec4(job.previous_normal.xyz, 1.0)
+                                                          : vec4(0.0);
     if (previous.w != 0.0) {
         float along = dot(previous.xyz, t0);
         if (abs(along) <= 1e-6 && abs(dot(previous.xyz, previous.xyz) - 1.0) <= 4e-7) {
@@ -214,10 +213,10 @@ void main() {
     bool tilt = false;
     float r_first = node_radius(0u);
     for (uint j = 1u; j < N; ++j) tilt = tilt || node_radius(j) != r_first;
-    uint flags = (CLOSED ? 1u : 0u) | (caps ? 2u : 0u) | (tilt ? 4u : 0u) | (drawn == 2u ? 8u : 0u) |
-                 (drawn == 1u ? 16u : 0u);
-    vec3 offset = vec3(dvec3(H.origin[0], H.origin[1], H.origin[2]) - u_eye);
-    draws[w] = Draw(offset, 7u * RING_FIRST, n, drawn, flags, totals.x);
+    uint flags = (CLOSED ? kDrawClosed : 0u) | (caps ? kDrawCaps : 0u) | (tilt ? kDrawTilt : 0u) |
+                 (drawn == 2u ? kDrawStrip : drawn == 1u ? kDrawLine : 0u);
+    vec3 offset = vec3(dvec3(H.origin_m[0], H.origin_m[1], H.origin_m[2]) - u_eye);
+    draws[w] = GpuDraw(offset, 7u * RING_FIRST, n, drawn, flags, totals.x);
     uint band = 0u;
     for (uint kind = 0u; kind < 6u; ++kind) {
         uint c = chunk_count_of(kind, n, drawn, caps);

@@ -1,7 +1,7 @@
 // Packed ring records (wire::render::PackedRing, 7 words): centre xyz, radius, u (floats), frame quaternion in
 // smallest-three form (2-bit index of the largest component, three 20-bit components).
 layout(std430, binding = 1) readonly buffer Rings { uint ring_words[]; };
-// The retained path's wires that move (DrawData.flags & 32): their rings in the frame's stream region.
+// The retained path's wires that move (kDrawStreamedRings): their rings in the frame's stream region.
 layout(std430, binding = 4) readonly buffer StreamRings { uint stream_words[]; };
 // cos and sin of 2 pi j / n for n = 3, 4, ... (n + 1 entries each, the last repeating j = 0), computed as
 // wire::write_tube's side table (double, then float): the two paths place rim vertices identically.
@@ -13,17 +13,17 @@ const uint kCapVertexBase = 1073741824u;  // 1 << 30: vertex ids of the two caps
 
 struct Ring { vec3 centre_m; float radius_m; float u; vec3 normal; vec3 binormal; vec3 tangent; };
 
-uint ring_base(DrawData d, uint i) { return d.ring_first + i * 7u; }
-uint ring_word(DrawData d, uint w) { return (d.flags & 32u) != 0u ? stream_words[w] : ring_words[w]; }
-vec3 ring_centre(DrawData d, uint i) {
+uint ring_base(GpuDraw d, uint i) { return d.ring_first + i * 7u; }
+uint ring_word(GpuDraw d, uint w) { return (d.flags & kDrawStreamedRings) != 0u ? stream_words[w] : ring_words[w]; }
+vec3 ring_centre(GpuDraw d, uint i) {
   uint b = ring_base(d, i);
   return vec3(uintBitsToFloat(ring_word(d, b)), uintBitsToFloat(ring_word(d, b + 1u)), uintBitsToFloat(ring_word(d, b + 2u)));
 }
-float ring_radius(DrawData d, uint i) { return uintBitsToFloat(ring_word(d, ring_base(d, i) + 3u)); }
+float ring_radius(GpuDraw d, uint i) { return uintBitsToFloat(ring_word(d, ring_base(d, i) + 3u)); }
 
 float fixed20(uint k) { return (float(k) / 1048575.0 * 2.0 - 1.0) * 0.70710678; }
 
-Ring load_ring(DrawData d, uint i) {
+Ring load_ring(GpuDraw d, uint i) {
   uint b = ring_base(d, i);
   Ring r;
   r.centre_m = ring_centre(d, i);
@@ -44,10 +44,10 @@ Ring load_ring(DrawData d, uint i) {
 }
 
 // wire::write_tube's slope_at: central difference of radius over chord length, one-sided at open ends.
-float slope_at(DrawData d, uint i, Ring ri) {
+float slope_at(GpuDraw d, uint i, Ring ri) {
   uint n = d.ring_count;
-  if ((d.flags & kTilt) == 0u || n < 2u) return 0.0;
-  bool closed = (d.flags & kClosed) != 0u;
+  if ((d.flags & kDrawTilt) == 0u || n < 2u) return 0.0;
+  bool closed = (d.flags & kDrawClosed) != 0u;
   uint lo = i > 0u ? i - 1u : (closed ? n - 1u : i);
   uint hi = i + 1u < n ? i + 1u : (closed ? 0u : i);
   float dr = ring_radius(d, hi) - ring_radius(d, lo);
@@ -71,7 +71,7 @@ uint div_row(uint vid, uint m) {
 // centre, 1 + j rim vertex j).
 void main() {
   uvec2 chunk = chunks[record_index()];
-  DrawData d = draws[chunk.x];
+  GpuDraw d = draws[chunk.x];
   uint n = d.sides;
   uint vid = uint(gl_VertexID);
   if (strip_mode(d) != 0u) {  // strip: vertex 2 row + (0: -side, 1: +side); a closed wire's last row repeats ring 0

@@ -1,14 +1,9 @@
 // invariant: the cpu-mesh and ring programs compute gl_Position from the same values the same way; without it GL
 // does not promise the same positions from two programs (their shared edges and depth ties could differ).
 invariant gl_Position;
-struct DrawData {
-  vec3 offset_m; uint ring_first;
-  uint ring_count; uint sides; uint flags; float u_close;
-};
-layout(std430, binding = 0) readonly buffer Draws { DrawData draws[]; };
-const uint kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;
+layout(std430, binding = 0) readonly buffer Draws { GpuDraw draws[]; };
 // 2: camera-facing strip, 1: phone-wire line, 0: tube.
-uint strip_mode(DrawData d) { return (d.flags & kStrip) != 0u ? 2u : (d.flags & kLine) != 0u ? 1u : 0u; }
+uint strip_mode(GpuDraw d) { return (d.flags & kDrawStrip) != 0u ? 2u : (d.flags & kDrawLine) != 0u ? 1u : 0u; }
 uniform mat4 u_clip_from_rel;   // projection * camera rotation: positions are camera-relative
 uniform vec2 u_viewport_px;     // viewport size (phone-wire lines are sized in pixels)
 uniform bool u_push_back;       // shadow casters: strips and lines at the tube's far side from the eye (the light)
@@ -16,7 +11,7 @@ uniform float u_focal_px;       // (viewport height / 2) * projection[1][1]: pix
 out vec3 v_normal;
 out vec2 v_uv;
 out vec3 v_rel_m;               // fragment position minus camera position
-// Strips and phone-wire lines (DrawData.sides 2 and 1; 0 for tubes): the ring frame and the strip coordinate,
+// Strips and phone-wire lines (GpuDraw.sides 2 and 1; 0 for tubes): the ring frame and the strip coordinate,
 // from which the fragment shader rebuilds the tube's normal.
 flat out uint v_mode;
 out vec3 v_tangent;
@@ -35,7 +30,7 @@ void tube_outputs() {
 // tube's silhouette seen from the eye. A phone-wire vertex (sides 1): the centre moved in screen space so the
 // line is one pixel across along the screen axis that crosses it most (each pixel column, or row, of the wire
 // gets one pixel), its opacity the true width over that drawn width.
-void strip_vertex(DrawData d, uint mode, vec3 centre, vec3 r, vec3 s, vec3 t, float radius, float u, float side) {
+void strip_vertex(GpuDraw d, uint mode, vec3 centre, vec3 r, vec3 s, vec3 t, float radius, float u, float side) {
   vec3 rel = d.offset_m + centre;
   vec3 across = cross(t, -rel);
   float len = length(across);

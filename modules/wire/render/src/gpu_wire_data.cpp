@@ -29,7 +29,7 @@ GpuCurveHeader packed_header(const PackedNodes& p, uint32_t segment_first, uint3
     h.flags = (p.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
               (p.per_node_kb ? kHeaderPerNode : 0u) | (p.stretch ? kHeaderStretch : 0u) |
               (motion.fit ? kHeaderFitMotion : 0u) | (material << kHeaderMaterialShift);
-    h.alpha = p.alpha, h.tension = p.tension, h.bias = p.bias, h.continuity = p.continuity;
+    h.kb = {p.alpha, p.tension, p.bias, p.continuity};
     h.extra_first = extra_first;
     h.slot = slot;
     h.origin_m[0] = static_cast<float>(p.origin_m.x), h.origin_m[1] = static_cast<float>(p.origin_m.y),

@@ -60,8 +60,9 @@ Status WireRenderer::State::prepare_mesh(const DrawList& list, const glm::dvec3&
     for (std::size_t k = 0; k < n; ++k) {
         const DrawItem& item = list.items[order[k]];
         const glm::vec3 offset(item.origin_m - eye);  // difference in double, then float
-        detail::GpuDraw draw{{offset.x, offset.y, offset.z}, 0, 0, 0, 0, 0.0f};
-        draw.flags = item.sides == 2 ? detail::kStrip : item.sides == 1 ? detail::kLine : 0u;
+        detail::GpuDraw draw{};
+        draw.offset_m = {offset.x, offset.y, offset.z};
+        draw.flags = item.sides == 2 ? detail::kDrawStrip : item.sides == 1 ? detail::kDrawLine : 0u;
         const auto vertex_count = static_cast<uint32_t>(item.vertices.size());
         const std::size_t index_count = item.indices.size();
         std::memcpy(base + f.geometry_offset + geometry_cursor, item.vertices.data(),

@@ -125,7 +125,7 @@ Status NodePath::grow_slots(std::size_t slots) {
         state = std::move(*made);
     }
     const std::size_t old_refs = motion_ref_bytes_;
-    if (Status st = ensure(motion_refs_, motion_ref_bytes_, want * kMotionRefBytes, "wire nodes: motion references", true);
+    if (Status st = ensure(motion_refs_, motion_ref_bytes_, want * sizeof(MotionRef), "wire nodes: motion references", true);
         !st) {
         return st;
     }
@@ -173,7 +173,7 @@ std::optional<uint32_t> NodePath::acquire_slot() {
         free_slots_.pop_back();
     }
     clear_slot_state(index, kSlotStateBytes);
-    clear_range(motion_refs_, index * kMotionRefBytes, 32);  // no reference: nothing to fit against
+    clear_range(motion_refs_, index * sizeof(MotionRef), 32);  // no reference: nothing to fit against
     return index;
 }
 
@@ -310,7 +310,7 @@ Status NodePath::read_rings(std::vector<DrawnRings>& out) const {
                                 static_cast<GLsizeiptr>(packed.size() * sizeof(PackedRing)), packed.data());
         r.closed = closed;
         r.origin_m = glm::dvec3(header.origin_m[0], header.origin_m[1], header.origin_m[2]);
-        r.length_m = job.totals[1];
+        r.length_m = job.totals.y;
         const std::size_t n = packed.size();
         r.rings.resize(n), r.frames.resize(n), r.centre_m.resize(n), r.u.resize(n + (closed ? 1 : 0));
         r.arc_length_m.clear();
@@ -323,7 +323,7 @@ Status NodePath::read_rings(std::vector<DrawnRings>& out) const {
             r.centre_m[i] = glm::dvec3(centre);
             r.u[i] = p.u;
         }
-        if (closed) r.u[n] = job.totals[0];
+        if (closed) r.u[n] = job.totals.x;
     }
     return Status::success();
 }

@@ -128,8 +128,9 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                     {nullptr, extras_before, up.extras.size() - extras_before, extra_total});
                 extra_total += up.extras.size() - extras_before;
             }
-            // The wire's most sides (the LOD's max_sides for it; its Style's): header bits 8-15.
-            up.headers.back().flags |= std::min<uint32_t>(std::max<uint32_t>(item.sides, 3u), 255u) << 8;
+            // The wire's most sides (the LOD's max_sides for it; its Style's).
+            up.headers.back().flags |= std::min(std::max<uint32_t>(item.sides, 3u), kHeaderSidesMask)
+                                       << kHeaderSidesShift;
             if (segments != slot.segments) {
                 free_segments(slot.segment_first, slot.segments);
                 uint32_t first = 0;

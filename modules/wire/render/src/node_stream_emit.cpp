@@ -142,9 +142,10 @@ std::size_t NodePath::emit_stream(std::size_t materials, std::size_t& segments_v
                 h.segment_first = w.segment_first;
                 h.flags = (style.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) |
                           (style.caps ? kHeaderCaps : 0u) | (fit ? kHeaderFitMotion : 0u) |
-                          (std::min<uint32_t>(sides, 255u) << 8) | (style.material << kHeaderMaterialShift);
-                h.alpha = static_cast<float>(style.alpha), h.tension = static_cast<float>(style.tension);
-                h.bias = static_cast<float>(style.bias), h.continuity = static_cast<float>(style.continuity);
+                          (std::min(sides, kHeaderSidesMask) << kHeaderSidesShift) |
+                          (style.material << kHeaderMaterialShift);
+                h.kb = {static_cast<float>(style.alpha), static_cast<float>(style.tension),
+                        static_cast<float>(style.bias), static_cast<float>(style.continuity)};
                 h.slot = w.slot;
                 std::memcpy(h.origin_m, w.origin, sizeof h.origin_m);
                 std::memcpy(headers + c, &h, sizeof h);  // mapped memory: written once, never read

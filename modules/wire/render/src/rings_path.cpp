@@ -163,8 +163,9 @@ Status WireRenderer::State::prepare_rings(const DrawList& list, const glm::dvec3
     for (std::size_t k = 0; k < n; ++k) {
         const DrawItem& item = list.items[order[k]];
         const glm::vec3 offset(item.origin_m - eye);  // difference in double, then float
-        detail::GpuDraw draw{{offset.x, offset.y, offset.z}, 0, 0, 0, 0, 0.0f};
-        const uint32_t strip_flags = item.sides == 2 ? detail::kStrip : item.sides == 1 ? detail::kLine : 0u;
+        detail::GpuDraw draw{};
+        draw.offset_m = {offset.x, offset.y, offset.z};
+        const uint32_t strip_flags = item.sides == 2 ? detail::kDrawStrip : item.sides == 1 ? detail::kDrawLine : 0u;
         const auto ring_count = static_cast<uint32_t>(item.rings.size());
         const bool stream_rings = !retained || streamed[k];
         if (stream_rings) {  // into this frame's region (binding 4); the retained path's moving wires too
@@ -185,9 +186,9 @@ Status WireRenderer::State::prepare_rings(const DrawList& list, const glm::dvec3
                                  ? *item.radius_varies
                                  : std::any_of(item.rings.begin(), item.rings.end(),
                                                [r0](const Ring& r) { return r.radius_m != r0; });
-        draw.flags = (item.closed ? detail::kClosed : 0u) | (item.caps ? detail::kCaps : 0u) |
-                     (varying ? detail::kTilt : 0u) |
-                     (stream_rings && retained ? detail::kStreamedRings : 0u) | strip_flags;
+        draw.flags = (item.closed ? detail::kDrawClosed : 0u) | (item.caps ? detail::kDrawCaps : 0u) |
+                     (varying ? detail::kDrawTilt : 0u) |
+                     (stream_rings && retained ? detail::kDrawStreamedRings : 0u) | strip_flags;
         draw.u_close = item.u_close;
         stats.vertices += expanded_vertices(item);
         stats.triangles += expanded_triangles(item);
@@ -203,7 +204,7 @@ Status WireRenderer::State::prepare_rings(const DrawList& list, const glm::dvec3
 
 void WireRenderer::State::bind_rings(const ListFrame& f) {
     // Binding 1: the rings a draw record addresses by default (retained storage, or the frame's region);
-    // binding 4: the frame's region, for retained-path wires streamed this frame (kStreamedRings).
+    // binding 4: the frame's region, for retained-path wires streamed this frame (kDrawStreamedRings).
     const GLuint buffer = f.region.buffer;
     const auto geometry_at = static_cast<GLintptr>(f.region.offset_bytes + f.geometry_offset);
     const auto geometry_size = static_cast<GLsizeiptr>(std::max<std::size_t>(f.geometry_bytes, 4));

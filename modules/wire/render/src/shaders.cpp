@@ -25,10 +25,19 @@ std::string glsl_program(std::initializer_list<std::string_view> pieces) {
     return s;
 }
 
+namespace {
+
+/// The shared records (gpu_records.h) read as GLSL: its two macros, then the text.
+constexpr std::string_view kRecordMacros = "#define WIRE_CONST const\n#define WIRE_ZERO\n";
+
+}  // namespace
+
 std::string vertex_source(bool cpu_mesh, bool draw_parameters) {
+    // The record index piece first: the draw-parameters one holds an #extension, which must precede declarations.
     return glsl_program(
         {draw_parameters && !cpu_mesh ? glsl::record_draw_parameters_vert : glsl::record_attribute_vert,
-         glsl::tube_common_vert, cpu_mesh ? glsl::mesh_main_vert : glsl::rings_main_vert});
+         kRecordMacros, glsl::gpu_records_h, glsl::tube_common_vert,
+         cpu_mesh ? glsl::mesh_main_vert : glsl::rings_main_vert});
 }
 
 std::string fragment_source(FragmentOutput output, std::string_view shading, std::string_view gbuffer) {
@@ -61,13 +70,13 @@ std::string binding_defines() {
 
 std::string curve_program_source() {
     const std::string defines = binding_defines();
-    return glsl_program({defines, glsl::wire_header_comp, glsl::curves_comp, glsl::curves_motion_comp,
+    return glsl_program({defines, kRecordMacros, glsl::gpu_records_h, glsl::curves_comp, glsl::curves_motion_comp,
                          glsl::curves_main_comp});
 }
 
 std::string ring_program_source() {
     const std::string defines = binding_defines();
-    return glsl_program({defines, glsl::wire_header_comp, glsl::rings_comp, glsl::rings_segment_comp,
+    return glsl_program({defines, kRecordMacros, glsl::gpu_records_h, glsl::rings_comp, glsl::rings_segment_comp,
                          glsl::rings_frames_comp, glsl::rings_lod_comp, glsl::rings_main_comp});
 }
 

@@ -2,26 +2,14 @@
 // programs, one vertex shader per upload path, the fragment shaders.
 #pragma once
 
+#include "gpu_records.hpp"
+
 #include <cstdint>
 #include <initializer_list>
 #include <string>
 #include <string_view>
 
 namespace wire::render::detail {
-
-/// Per-draw record in the SSBO at binding 0 (std430, 32 bytes); must match DrawData in the GLSL.
-struct GpuDraw {
-    float offset_m[3];    ///< wire origin minus camera position (computed in double)
-    uint32_t ring_first;  ///< gpu-rings: first 32-bit word of the wire's PackedRings in the ring SSBO (binding 1)
-    uint32_t ring_count;
-    uint32_t sides;
-    uint32_t flags;  ///< kClosed | kCaps | kTilt | kStrip | kLine | kStreamedRings
-    float u_close;
-};
-static_assert(sizeof(GpuDraw) == 32);
-inline constexpr uint32_t kClosed = 1u, kCaps = 2u, kTilt = 4u, kStrip = 8u, kLine = 16u;  // kStrip: sides 2, kLine: sides 1
-/// Retained path: this wire's rings are in the frame's region (SSBO binding 4), not in the retained storage.
-inline constexpr uint32_t kStreamedRings = 32u;
 
 /// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex) and 3 the vertex's draw index (uint,
 /// streamed beside the vertices). Otherwise the ring expansion from gl_VertexID of an instanced indexed draw over
@@ -40,9 +28,9 @@ std::string fragment_source(FragmentOutput output, std::string_view shading, std
 /// One program's GLSL: `#version 450 core`, then each piece after `#line 1 k` (k = 1, 2, ...), so a driver's
 /// message names piece k and its line ("k:line" on Mesa, "k(line)" on NVIDIA).
 std::string glsl_program(std::initializer_list<std::string_view> pieces);
-/// The curve program: the binding macros (kBindingMacros), wire_header.comp, curves*.comp.
+/// The curve program: the binding macros (kBindingMacros), the shared records (gpu_records.h), curves*.comp.
 std::string curve_program_source();
-/// The ring program: the binding macros, wire_header.comp, rings*.comp.
+/// The ring program: the binding macros, the shared records, rings*.comp.
 std::string ring_program_source();
 
 }  // namespace wire::render::detail

@@ -1,7 +1,9 @@
-// The records the CPU and the GPU programs share, field by field: every offset and the array stride of each
-// std430 record as the driver laid it out (glGetProgramResourceiv, GL_OFFSET and GL_TOP_LEVEL_ARRAY_STRIDE on
-// the linked programs) against the C++ mirror's offsetof and sizeof. A field renamed, reordered or retyped on one
-// side fails here by name, not as a wrong picture on some driver.
+// The records the CPU and the GPU programs share (shaders/gpu_records.h, one text read as C++ and as GLSL), field
+// by field: every offset and the array stride of each std430 record as the driver laid it out
+// (glGetProgramResourceiv, GL_OFFSET and GL_TOP_LEVEL_ARRAY_STRIDE on the linked programs) against the C++
+// compiler's offsetof and sizeof. The two languages align differently (a vec3, a vec4 in C++ by alignas): a field
+// placed where they disagree, or a program that declares its own copy of a record, fails here by name, not as a
+// wrong picture on some driver.
 #include <gtest/gtest.h>
 
 #include <epoxy/gl.h>
@@ -71,10 +73,10 @@ TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
     EXPECT_FIELD(p, "headers[0].node_count", GpuCurveHeader, node_count);
     EXPECT_FIELD(p, "headers[0].segment_first", GpuCurveHeader, segment_first);
     EXPECT_FIELD(p, "headers[0].flags", GpuCurveHeader, flags);
-    EXPECT_FIELD(p, "headers[0].kb", GpuCurveHeader, alpha);
+    EXPECT_FIELD(p, "headers[0].kb", GpuCurveHeader, kb);
     EXPECT_FIELD(p, "headers[0].extra_first", GpuCurveHeader, extra_first);
     EXPECT_FIELD(p, "headers[0].slot", GpuCurveHeader, slot);
-    EXPECT_FIELD(p, "headers[0].origin[0]", GpuCurveHeader, origin_m);
+    EXPECT_FIELD(p, "headers[0].origin_m[0]", GpuCurveHeader, origin_m);
     EXPECT_FIELD(p, "headers[0].motion[0]", GpuCurveHeader, motion);
     // The draw record the ring pass writes and the vertex shader reads (GpuDraw).
     EXPECT_EQ(stride(p, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));
@@ -92,10 +94,13 @@ TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
     auto curves = gfx::make_program({.label = "layout: curves", .compute = curve_program_source()});
     ASSERT_TRUE(curves.ok()) << curves.error().message;
     EXPECT_EQ(stride(*curves, "headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
-    EXPECT_FIELD(*curves, "headers[0].origin[0]", GpuCurveHeader, origin_m);
+    EXPECT_FIELD(*curves, "headers[0].origin_m[0]", GpuCurveHeader, origin_m);
     EXPECT_FIELD(*curves, "headers[0].motion[0]", GpuCurveHeader, motion);
     EXPECT_EQ(stride(*curves, "slot_headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
-    EXPECT_EQ(stride(*curves, "refs[0].origin"), static_cast<GLint>(kMotionRefBytes));
+    EXPECT_EQ(stride(*curves, "refs[0].origin"), static_cast<GLint>(sizeof(MotionRef)));
+    EXPECT_FIELD(*curves, "refs[0].origin", MotionRef, origin);
+    EXPECT_FIELD(*curves, "refs[0].counts", MotionRef, counts);
+    EXPECT_FIELD(*curves, "refs[0].p[0]", MotionRef, p);
     for (const bool draw_parameters : {true, false}) {
         const std::string vertex = vertex_source(false, draw_parameters);
         const std::string fragment = fragment_source(FragmentOutput::color, "", "");

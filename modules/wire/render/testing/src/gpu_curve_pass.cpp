@@ -72,7 +72,7 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
     scratch_ = std::move(*scratch), extras_ = std::move(*extra_buffer);
     if (motion_ref_wires_ != wires.size() ||
         !motion_refs_) {  // the wires' references, kept for the next build
-        auto refs = engine::gfx::make_buffer({.size_bytes = wires.size() * detail::kMotionRefBytes,
+        auto refs = engine::gfx::make_buffer({.size_bytes = wires.size() * sizeof(detail::MotionRef),
                                               .label = "wire gpu curve motion references"});
         if (!refs) return Status::error(refs.error().message);
         motion_refs_ = std::move(*refs);

@@ -51,9 +51,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
         count_total += segs;
         j.flags = jobs[w].carry_last ? 0u : 2u | (jobs[w].has_previous_normal ? 1u : 0u);
         carry_last = carry_last || jobs[w].carry_last;
-        j.previous_normal[0] = jobs[w].previous_normal.x;
-        j.previous_normal[1] = jobs[w].previous_normal.y;
-        j.previous_normal[2] = jobs[w].previous_normal.z;
+        j.previous_normal = {jobs[w].previous_normal.x, jobs[w].previous_normal.y, jobs[w].previous_normal.z, 0.0f};
         if (lod != nullptr) {
             rings += (closed ? 0 : 1) + segs * max_rings;
             continue;
@@ -85,7 +83,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
             // The first normals carry over to the same wires (the LOD's state restarts with the new layout).
             glGetNamedBufferSubData(state_.id(), 0, static_cast<GLsizeiptr>(state.size() * sizeof(SlotState)),
                                     state.data());
-            for (SlotState& st : state) st.lod[0] = st.lod[1] = st.lod[2] = st.lod[3] = 0;
+            for (SlotState& st : state) st.lod = {};
         }
         auto state_buffer =
             engine::gfx::make_buffer(std::span<const SlotState>(state), "wire gpu slot state");
@@ -174,16 +172,16 @@ void GpuRingPass::read(std::vector<GpuRingResult>& out) const {
         const bool fits = j.ring_count != 0 && std::size_t{j.ring_first} + j.ring_count <= used;
         if (fits) r.rings.assign(rings.begin() + j.ring_first, rings.begin() + j.ring_first + j.ring_count);
         r.counts.assign(counts.begin() + count_first_[w], counts.begin() + count_first_[w] + segments_[w]);
-        r.first_normal = glm::vec3(j.first_normal[0], j.first_normal[1], j.first_normal[2]);
+        r.first_normal = glm::vec3(j.first_normal.x, j.first_normal.y, j.first_normal.z);
         r.sides = j.sides;
-        r.u_close = j.totals[0];
-        r.length_m = j.totals[1];
-        r.holonomy_rad = j.totals[2];
-        r.radius_px = j.totals[3];
+        r.u_close = j.totals.x;
+        r.length_m = j.totals.y;
+        r.holonomy_rad = j.totals.z;
+        r.radius_px = j.totals.w;
         if (lod_) {
-            r.sides = state[w].lod[0];
-            r.drawn_sides = state[w].lod[1];
-            r.visible = state[w].lod[3] != 0;
+            r.sides = state[w].lod.x;
+            r.drawn_sides = state[w].lod.y;
+            r.visible = state[w].lod.w != 0;
             r.overflow = r.visible && !fits;
         } else {
             r.overflow = !fits;
