@@ -1,5 +1,6 @@
 // The curve stage: validated nodes -> the curve drawn (pop-free blended where nodes appear or vanish), its sphere;
 // on the nodes path the nodes packed for the GPU instead (the GPU builds the curve).
+#include "curve_state.hpp"
 #include "stages.hpp"
 
 namespace wire::systems {
@@ -69,39 +70,15 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         mesh_one(mesh_job);
         job.fused |= 4;
     };
-    // One wire's update in two steps around its build, so that up to four wires building their exact curves share
-    // build_curves (their tridiagonal solves, a serial chain of divisions each, run side by side).
-    struct Step {
-        SplineSettings spline;           // the wire's settings now
-        SplineSettings released_spline;  // what a released curve was built with
-        bool exact = false;              // the exact curve is built (no pop-free blending)
-    };
-    const auto prepare = [&](CurveJob& job, Step& step) {
-        WireCurve& c = *job.curve;
-        step.spline = spline_of(*job.style);
-        step.released_spline = c.spline;
-        const SplineSettings& spline = step.spline;
-        if (c.builds == 0 || spline != c.spline || c.pop_free_on != pop_free || c.blend_s != job.style->blend_s) {
-            c.pop_free = PopFreeCurve(PopFreeSettings{.spline = spline, .enabled = pop_free, .blend_s = job.style->blend_s});
-            c.spline = spline;
-            c.pop_free_on = pop_free;
-            c.blend_s = job.style->blend_s;
-        }
-        const WireNodes& nodes = *job.nodes;
-        const WireNodes& prev = c.previous_nodes;
-        const bool same_ids = c.generation > 0 && !c.blending && nodes.ids == prev.ids &&
-                              (!nodes.ids.empty() || nodes.size() == prev.size());
-        // The first valid state has nothing to blend from: the pop-free blend would show its exact curve too (and is
-        // primed from previous_nodes if the next state changes ids, as after any fast-path frame).
-        const bool first = c.generation == 0;
-        // No node appeared or vanished and nothing blends: the exact curve is what the pop-free blend would show.
-        step.exact = !pop_free || same_ids || first;
+    // One wire's update in two steps around its build (prepare, finish), so that up to four wires building their
+    // exact curves share build_curves (their tridiagonal solves, a serial chain of divisions each, side by side).
+    const auto prepare = [&](CurveJob& job, CurveStep& step) {
+        step = begin_update(*job.curve, *job.nodes, spline_of(*job.style), job.style->blend_s, pop_free);
     };
     // After the build (exact: job.status is build_curve's, its curve in `scratch`, a per-thread buffer swapped
     // with the wire's curve, not one per wire).
-    const auto finish = [&](CurveJob& job, const Step& step, Curve& scratch) {
+    const auto finish = [&](CurveJob& job, const CurveStep& step, Curve& scratch) {
         WireCurve& c = *job.curve;
-        const SplineSettings& spline = step.spline;
         const WireNodes& nodes = *job.nodes;
         const WireNodes& prev = c.previous_nodes;
         bool stays_released = false;
@@ -120,46 +97,19 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                     std::swap(c.curve, scratch);
                 }
             }
-            if (!c.pop_free_stale) {
-                // Re-priming rebuilds the pop-free state from previous_nodes: release it until then.
-                c.pop_free = PopFreeCurve(
-                    PopFreeSettings{.spline = spline, .enabled = pop_free, .blend_s = job.style->blend_s});
-                c.pop_free_stale = true;
-            }
+            stale_blend(c, step);
         } else {
-            if (c.pop_free_stale) {
-                // Re-prime the pop-free state with the last valid nodes (what is on screen now), then step.
-                c.pop_free.reset();
-                (void)c.pop_free.update(prev, scratch);
-                c.pop_free_stale = false;
-            }
-            job.status = c.pop_free.update(nodes, c.curve);
+            job.status = step_blend(c, nodes, scratch);
         }
-        ++c.builds;
         if (job.status.ok()) {
-            ++c.generation;
             // The LOD's O(1) cull test; its LodBounds are the LOD stage's (WireCurve::lod_bounds).
-            c.bounds = sphere.radius_m >= 0.0 ? sphere : curve_bounding_sphere(c.curve);
-            c.bounds_generation = c.generation;
+            commit(c, nodes, sphere.radius_m >= 0.0 ? sphere : curve_bounding_sphere(c.curve), stays_released);
             job.changed = true;
-            copy_nodes(c.previous_nodes, nodes);
-            c.released = stays_released;
             job.kept_released = stays_released;
         } else {
-            // The pop-free blend path may have put its last state back into `curve` (or restore_curve below rebuilds
-            // it): `bounds` is not known to be its sphere.
-            c.bounds_generation = 0;
+            job.restored = keep_last_curve(c, step);
         }
-        if (!job.status.ok() && c.released) {
-            // Invalid nodes: the wire keeps its last valid curve, which was released. The pop-free blend path has
-            // already put it back (it shows its last state on failure); the fast path leaves it empty.
-            if (!c.curve.segments.empty()) {
-                c.released = false;
-            } else if (restore_curve(c, step.released_spline)) {
-                job.restored = true;
-            }
-        }
-        c.blending = job.status.ok() && !c.pop_free_stale && c.pop_free.blending();
+        end_update(c, job.status.ok());
     };
     if (ctx.path == UploadPath::gpu_nodes) {
         // The nodes path: the GPU builds the curve from the nodes. Here only build_curve's checks, the sphere the
@@ -182,65 +132,47 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 prefetch_lines<true>(ahead.packed.nodes.data(), ahead.packed.nodes.size() * sizeof(glm::vec4));
             }
             CurveJob& job = jobs[i];
-            Step step;
+            CurveStep step;
             prepare(job, step);
             WireCurve& c = *job.curve;
             const WireNodes& nodes = *job.nodes;
             const WireNodes& prev = c.previous_nodes;
             BoundingSphere sphere{};
-            if (step.exact && !gpu_builds(step.spline.kind)) {
+            if (step.exact && !gpu_builds(step.pop_free.spline.kind)) {
                 // A kind the GPU does not build: the CPU builds the curve and the renderer gets its segments.
                 thread_local Curve built;  // swapped in on success: a failure keeps the last valid curve
-                job.status = build_curve(nodes, step.spline, built);
+                job.status = build_curve(nodes, step.pop_free.spline, built);
                 if (job.status.ok() && nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
                 if (job.status.ok()) {
                     std::swap(c.curve, built);
                     sphere = curve_bounding_sphere(c.curve);
                 }
-                if (!c.pop_free_stale) {
-                    c.pop_free = PopFreeCurve(
-                        PopFreeSettings{.spline = step.spline, .enabled = pop_free, .blend_s = job.style->blend_s});
-                    c.pop_free_stale = true;
-                }
+                stale_blend(c, step);
             } else if (step.exact) {
                 // build_curve's checks and the GPU's packing in one pass (c.packed is kept on failure).
                 if (nodes.ids != prev.ids) job.status = check_unique_ids(nodes);
-                if (job.status.ok()) job.status = pack_nodes(nodes, step.spline, c.packed);
+                if (job.status.ok()) job.status = pack_nodes(nodes, step.pop_free.spline, c.packed);
                 if (job.status.ok()) {
                     release(c.curve.segments);  // not kept: the GPU builds it
                     sphere = packed_bounding_sphere(c.packed);
                 }
-                if (!c.pop_free_stale) {
-                    c.pop_free = PopFreeCurve(
-                        PopFreeSettings{.spline = step.spline, .enabled = pop_free, .blend_s = job.style->blend_s});
-                    c.pop_free_stale = true;
-                }
+                stale_blend(c, step);
             } else {
                 thread_local Curve scratch;
-                if (c.pop_free_stale) {
-                    c.pop_free.reset();
-                    (void)c.pop_free.update(prev, scratch);
-                    c.pop_free_stale = false;
-                }
-                job.status = c.pop_free.update(nodes, c.curve);
+                job.status = step_blend(c, nodes, scratch);
                 if (job.status.ok()) sphere = curve_bounding_sphere(c.curve);
             }
-            ++c.builds;
             if (job.status.ok()) {
-                ++c.generation;
-                c.bounds = sphere;
-                c.bounds_generation = c.generation;
+                commit(c, nodes, sphere, false);
                 job.changed = true;
-                copy_nodes(c.previous_nodes, nodes);
-                c.released = false;
             }
-            c.blending = job.status.ok() && !c.pop_free_stale && c.pop_free.blending();
+            end_update(c, job.status.ok());
         });
     } else parallel_over((jobs.size() + 3) / 4, [&](std::size_t group) {
         thread_local Curve scratch[4];
         const std::size_t first = 4 * group, count = std::min<std::size_t>(4, jobs.size() - first);
         CurveJob* const job = &jobs[first];
-        Step step[4];
+        CurveStep step[4];
         // The next group's components (read first thing there, out of the cache since the last frame): their
         // lines come in while this group builds. WireCurve's per-frame fields lie from lod_bounds.data (what the
         // LOD stage reads of a moving wire) to the end of previous_nodes.
@@ -261,7 +193,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
             // tangents are built, not one by one as the records are written (values unchanged).
             prefetch_lines<true>(scratch[k].segments.data(),
                                  std::min(scratch[k].segments.capacity(), job[k].nodes->size()) * sizeof(CubicBezier));
-            builds[exact] = CurveBuildJob{job[k].nodes, &step[k].spline, &scratch[k], {}};
+            builds[exact] = CurveBuildJob{job[k].nodes, &step[k].pop_free.spline, &scratch[k], {}};
             built[exact++] = k;
         }
         build_curves(std::span(builds, exact));

@@ -1,11 +1,34 @@
 // The wire systems: curve -> lod -> rings -> mesh -> draw list, each over a dense array of the wires that need
-// work, in parallel with oneTBB; every wire writes only its own components. The stages are in curve_system.cpp,
-// lod_rings_mesh.cpp and draw_list_system.cpp; here their installation and the read-outs (rings, memory, error).
+// work, in parallel with oneTBB; every wire writes only its own components. The stages are in curve_system.cpp
+// (the curve's state machine: curve_state.cpp), lod_rings_mesh.cpp (one wire's work: one_wire.cpp) and
+// draw_list_system.cpp; here their installation and the read-outs (rings, memory, error).
 #include "stages.hpp"
 
 namespace wire::systems {
 
 using namespace detail;
+
+namespace {
+
+template <class T>
+std::size_t bytes_of(const std::vector<T>& v) { return v.capacity() * sizeof(T); }
+
+std::size_t bytes_of(const Curve& c) {
+    return bytes_of(c.segments) + bytes_of(c.source_node) + bytes_of(c.radius_m) + bytes_of(c.stretch);
+}
+
+std::size_t bytes_of(const WireNodes& n) {
+    std::size_t bytes = bytes_of(n.positions);
+    for_each_node_array([&](const char*, auto member) { bytes += bytes_of(n.*member); });
+    return bytes;
+}
+
+std::size_t bytes_of(const RingSet& r) {
+    return bytes_of(r.params) + bytes_of(r.rings) + bytes_of(r.frames) + bytes_of(r.centre_m) +
+           bytes_of(r.arc_length_m) + bytes_of(r.u) + bytes_of(r.tangent_scratch);
+}
+
+}  // namespace
 
 void install(engine::ecs::Schedule& schedule, WireContext& context) {
     WireContext* ctx = &context;
