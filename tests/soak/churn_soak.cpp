@@ -492,7 +492,7 @@ void Soak::check_errors() {
 
 Sample Soak::sample(const wire::render::DrawStats& fs) {
     const GlObjects gl = count_gl_objects();
-    // The nodes path compiles its two compute programs on its first frame.
+    // The nodes path compiles its compute programs on its first frame.
     const int programs = baseline_.programs + static_cast<int>(renderer_->info().node_path_programs);
     if (gl.textures != baseline_.textures || gl.vertex_arrays != baseline_.vertex_arrays ||
         gl.programs != programs || gl.shaders != baseline_.shaders ||

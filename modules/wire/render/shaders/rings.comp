@@ -1,4 +1,4 @@
-// The ring program: its storage blocks, uniforms and the wire being walked.
+// The ring pass's per-wire programs (LOD, rings): their shared storage blocks, uniforms and the wire being walked.
 // One invocation per wire. The CPU reference for every function named after one: modules/wire/src/rings.cpp
 // (build_rings, radius, u) and modules/wire/src/frames.cpp (compute_frames, mirrors, Transporter).
 layout(local_size_x = 64) in;
@@ -7,47 +7,41 @@ layout(std430, binding = RING_SEGMENTS) readonly buffer Segments { vec4 segments
 layout(std430, binding = RING_JOBS) buffer Jobs { Job jobs[]; };
 // Rings per segment (at GpuCurveHeader.segment_first): the caller's, or (u_lod) the LOD's, over the previous frame's.
 layout(std430, binding = RING_COUNTS) buffer Counts { uint counts[]; };
-layout(std430, binding = RING_RINGS) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
 layout(std430, binding = RING_SLOTS) buffer Slots { SlotState slot_state[]; };
-// Rings allocated, wires that did not fit, rings allocated from the reserve (u_ring_reserve records after
-// u_ring_capacity: one ring a segment for every listed wire, so a wire that does not fit is drawn coarse, not
-// missing, until the ring buffer has grown), triangles the draw expands (u_draw: wire::tube_counts' and
-// strip_counts').
-layout(std430, binding = RING_COUNTER) buffer Counter {
-    uint ring_counter; uint overflow; uint reserve_counter; uint triangles;
-};
 // The slot of each dispatched wire: the first u_unchanged were listed by the CPU (their nodes did not change), the
 // others by this frame's curve passes (their nodes changed: CURVE_SLOT_LIST).
 layout(std430, binding = RING_VISIBLE) readonly buffer Visible { uint visible[]; };
-// u_draw: the single draw's records (GpuDraw, the chunk records and the indirect commands).
-layout(std430, binding = RING_DRAWS) writeonly buffer Draws { GpuDraw draws[]; };
-layout(std430, binding = RING_CHUNKS) writeonly buffer Chunks { uvec2 chunks[]; };
-layout(std430, binding = RING_BUCKETS) buffer Buckets { uint buckets[]; };  // u_buckets chunk counts, then as many cursors
-layout(std430, binding = RING_COMMANDS) writeonly buffer Commands { uint commands[]; };  // 5 words each, one per bucket
-layout(std430, binding = RING_TEMPLATES) readonly buffer Templates { uvec2 templates[]; };  // (count, first index) per side slot and kind
 uniform uint u_wires;
-uniform uint u_unchanged;
-uniform uint u_ring_capacity;
-uniform uint u_ring_reserve;
-uniform uint u_stage;  // 0: LOD (or the caller's counts) and rings; 1: LOD only; 2: the commands; 3: rings only
-uniform bool u_draw;
-uniform uint u_buckets, u_side_slots;
-// The LOD (wire/lod.hpp, per-segment evaluation at node resolution): the view and the settings' values.
-uniform bool u_lod;
-uniform mat3 u_view_rot;  // world -> view rotation (GL view space: looking down -z)
-uniform dvec3 u_eye;
-uniform float u_focal, u_tan_x, u_tan_y, u_near, u_far, u_eps, u_band, u_strip_px, u_line_px;
-uniform uint u_max_rings, u_max_sides;  // u_max_sides <= kMaxSides
-uniform bool u_coarse;
-uniform bool u_merge;  // spans below node resolution (LodSettings::keep_node_resolution off)
-// 1 - cos(pi / n) at [n >> 2][n & 3], n <= 256: vec4s, so a compiler that gives each element of a uniform array a
-// vec4 slot needs 260 components, not 1028 (of the 1024 GL_MAX_COMPUTE_UNIFORM_COMPONENTS guarantees).
-uniform vec4 u_sagitta4[65];
+uniform bool u_draw;  // the single draw's records: chunk counts (LOD), the draw and chunk records (rings)
+uniform dvec3 u_eye;  // the view's eye: the LOD's view, the draw record's offset
 
 const float kPi = 3.14159265358979;
-const float kSplitCos = 0.70710678;  // a step turning more than 45 degrees is split
-const uint kMaxDepth = 10u;          // FrameSettings::max_subdivision_depth's default
 
 GpuCurveHeader H;
-uint N, SEGS, RING_FIRST;
+uint N, SEGS;
 bool CLOSED;
+bool FEWEST = false;  // the wire's rings came from the reserve: one a segment (the LOD's counts are kept)
+uint count_of(uint k) {
+    if (FEWEST) return 1u;
+    uint c = counts[H.segment_first + k];
+    return k == 0u ? max(c, 1u) : c;
+}
+
+// The chunk records a wire draws (upload_plan.hpp's chunk_counts): a cap chunk on a capped open tube, bands by
+// 16, then the remainder's binary digits.
+uint chunk_count_of(uint kind, uint rings, uint drawn, bool caps) {
+    uint bands = rings == 0u ? 0u : rings - 1u + (CLOSED ? 1u : 0u);
+    bool geometry = drawn <= 2u ? bands > 0u : (bands > 0u || (!CLOSED && caps));
+    if (!geometry || rings == 0u) return 0u;
+    if (kind == 0u) return drawn > 2u && !CLOSED && caps ? 1u : 0u;
+    if (kind == 1u) return bands / 16u;
+    return (bands & (16u >> (kind - 1u))) != 0u ? 1u : 0u;
+}
+uint bucket_of(uint material, uint drawn, uint kind) { return (material * u_side_slots + drawn) * 6u + kind; }
+
+void load_wire(uint slot) {
+    H = headers[slot];
+    N = H.node_count;
+    CLOSED = (H.flags & kHeaderClosed) != 0u;
+    SEGS = CLOSED ? N : N - 1u;
+}

@@ -1,4 +1,6 @@
 // ---- frames (frames.cpp) ----
+const float kSplitCos = 0.70710678;  // a step turning more than 45 degrees is split
+const uint kMaxDepth = 10u;          // FrameSettings::max_subdivision_depth's default
 vec3 seed_normal(vec3 t) {
     vec3 a = abs(t);
     vec3 e = a.x <= a.y && a.x <= a.z ? vec3(1.0, 0.0, 0.0) : (a.y <= a.z ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0));
@@ -99,6 +101,7 @@ vec3 carry(uint sa, float ta, vec3 at, vec3 r, uint sb, float tb, vec3 bt, bool 
 }
 
 // ---- PackedRing (packed_ring.cpp) ----
+layout(std430, binding = RING_RINGS) writeonly buffer Rings { uint ring_words[]; };  // PackedRing: 7 words
 uint encode20(float v) { return uint(clamp((v * (0.5 / 0.70710678118654752) + 0.5) * 1048575.0, 0.0, 1048575.0) + 0.5); }
 uvec2 pack_frame(vec3 r, vec3 s) {
     vec3 t = cross(r, s);
@@ -136,4 +139,68 @@ void put_ring(uint index, vec3 centre, float radius, float u, vec3 r, vec3 s) {
     uvec2 f = pack_frame(r, s);
     ring_words[b + 5u] = f.x;
     ring_words[b + 6u] = f.y;
+}
+
+// ---- the walk ----
+uint RING_FIRST;  // the wire's first ring in the ring buffer
+// Walks the rings in order: place_rings' parameters, build_rings' intervals, compute_frames' carry. With
+// `write`, rotates ring i's frame by -holonomy * s_i / total (closed loops) and writes it. Returns (u at the
+// close, length, holonomy, rings); r0 is ring 0's normal.
+vec4 walk(vec3 r0, bool write, float holonomy, double total) {
+    Coeffs a = load(0u);
+    uint sa = 0u;
+    float ta = 0.0;
+    vec3 at = unit_tangent(a.c, 0.0);
+    if (at == vec3(0.0)) at = vec3(0.0, 0.0, 1.0);
+    vec3 r = r0;
+    double s = 0.0, u = 0.0;
+    uint index = 0u;
+    if (write) put_ring(RING_FIRST, a.c.b0, radius_at(a, 0.0), 0.0, r, cross(at, r));
+    uint k = 0u, j = 1u;  // the next ring: j-th of segment k
+    for (;;) {
+        // Next ring's parameter: (k, j / count), segments without rings skipped; an open wire's last at t = 1.
+        while (k < SEGS && j >= count_of(k)) { ++k; j = 0u; }
+        bool last_open = k == SEGS && !CLOSED;
+        if (k == SEGS && !last_open) break;
+        uint sb = last_open ? SEGS - 1u : k;
+        float tb = last_open ? 1.0 : float(j) / float(count_of(k));
+        Coeffs b = a;
+        if (sb != sa) b = load(sb);
+        // The interval's length and u: the rest of a's segment, the segments crossed, b's part of its own.
+        vec2 iv = integrate(a, ta, sb == sa ? tb : 1.0);
+        for (uint m = sa + 1u; m < sb; ++m) iv += integrate(load(m), 0.0, 1.0);
+        if (sb != sa && tb > 0.0) iv += integrate(b, 0.0, tb);
+        s += double(iv.x);
+        u += double(iv.y);
+        vec3 bt = unit_tangent(b.c, tb);
+        if (bt == vec3(0.0)) bt = at;
+        r = carry(sa, ta, at, r, sb, tb, bt, false);
+        ++index;
+        if (write) {
+            vec3 rr = r, ss = cross(bt, r);
+            if (holonomy != 0.0 && total > 0.0) {
+                float angle = float(-double(holonomy) * s / total);
+                float ca = cos(angle), sn = sin(angle);
+                rr = ca * r + sn * ss;
+                ss = ca * ss - sn * r;
+            }
+            put_ring(RING_FIRST + index, b.c.b0 + offset_at(b.c, tb), radius_at(b, tb), float(u), rr, ss);
+        }
+        a = b; sa = sb; ta = tb; at = bt;
+        if (last_open) break;
+        ++j;
+    }
+    float hol = 0.0;
+    if (CLOSED) {
+        // Back to ring 0 (t = 1 of the last segment): the loop's length and u, and its twist.
+        vec2 iv = integrate(a, ta, 1.0);
+        for (uint m = sa + 1u; m < SEGS; ++m) iv += integrate(load(m), 0.0, 1.0);
+        s += double(iv.x);
+        u += double(iv.y);
+        Seg c0 = load_seg(0u);
+        vec3 t0 = unit_tangent(c0, 0.0);
+        vec3 r_end = carry(sa, ta, at, r, 0u, 0.0, t0, true);
+        hol = atan(dot(cross(r0, r_end), t0), dot(r0, r_end));
+    }
+    return vec4(float(u), float(s), hol, float(index + 1u));
 }

@@ -1,4 +1,14 @@
 // ---- the LOD (modules/wire/src/lod/update.cpp's per-segment pass, view.hpp's hull depth and plane test) ----
+// The view (with u_eye) and the settings' values.
+uniform mat3 u_view_rot;  // world -> view rotation (GL view space: looking down -z)
+uniform float u_focal, u_tan_x, u_tan_y, u_near, u_far, u_eps, u_band, u_strip_px, u_line_px;
+uniform uint u_max_rings, u_max_sides;  // u_max_sides <= kMaxSides
+uniform bool u_coarse;
+uniform bool u_merge;  // spans below node resolution (LodSettings::keep_node_resolution off)
+// 1 - cos(pi / n) at [n >> 2][n & 3], n <= 256: vec4s, so a compiler that gives each element of a uniform array a
+// vec4 slot needs 260 components, not 1028 (of the 1024 GL_MAX_COMPUTE_UNIFORM_COMPONENTS guarantees).
+uniform vec4 u_sagitta4[65];
+
 uint hysteresis_count(uint old_count, uint raw, float band) {
     if (old_count == 0u || raw >= old_count || band < 0.0) return raw;
     if (float(old_count) <= float(raw) * (1.0 + band) + 1.0) return old_count;

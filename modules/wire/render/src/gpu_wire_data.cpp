@@ -1,5 +1,5 @@
 // The CPU side of the GPU wire passes (gpu_wire_data.hpp): a wire's upload (header, curve nodes, extras) and
-// the ring program's LOD uniforms.
+// the ring LOD program's uniforms.
 #include "gpu_wire_data.hpp"
 
 #include "wire/packed_nodes.hpp"

@@ -25,11 +25,11 @@ namespace wire::render::detail {
 /// The most radial sides the GPU LOD gives (LodSettings::max_sides above it is taken as this).
 inline constexpr uint32_t kMaxSides = 256;
 
-/// The shader storage binding points of the curve and ring programs, dense from 0: GL guarantees 8 bindings and 8
-/// blocks a stage, NVIDIA 16 (a binding past that fails to link there, never on llvmpipe). The GLSL names them by
-/// macros of the same names in capitals (kRingJobs: RING_JOBS), defined by curve_program_source() and
-/// ring_program_source() (shaders.hpp), so both sides read
-/// one number.
+/// The shader storage binding points of the curve program and of the ring pass's programs, dense from 0 (the ring
+/// pass's between its three programs, each declaring the blocks it reads): GL guarantees 8 bindings and 8 blocks a
+/// stage, NVIDIA 16 (a binding past that fails to link there, never on llvmpipe). The GLSL names them by macros of
+/// the same names in capitals (kRingJobs: RING_JOBS), defined by every program's source (shaders.hpp), so both
+/// sides read one number.
 enum CurveBinding : uint32_t {
     kCurveHeaders, kCurveNodes, kCurveSegments, kCurveScratch, kCurveExtras, kCurveSlotHeaders, kCurveMotionRefs,
     kCurveSlotList, kCurveBindings
@@ -81,7 +81,8 @@ void append_packed(const PackedNodes& packed, uint32_t segment_first, uint32_t s
 Status append_wire(const WireNodes& nodes, const SplineSettings& spline, uint32_t segment_first, uint32_t slot,
                    uint32_t material, bool caps, const WireMotion& motion, WireUpload& out, uint32_t& segments);
 
-/// The ring program's LOD uniforms for a view and settings (LodSettings' defaults applied as update_lod does).
+/// The ring LOD program's uniforms for a view and settings (LodSettings' defaults applied as update_lod does), on
+/// `program`, the program in use.
 void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, const LodSettings& settings);
 
 /// Appends a curve given as segments (a wire in a pop-free blend): 4 vec4 a segment in `nodes` (b0 from the

@@ -54,12 +54,24 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
     auto path = std::make_unique<NodePath>();
     auto curve = gfx::make_program({.label = "wire nodes: curves", .compute = curve_program_source()});
     if (!curve) return curve.error();
-    auto rings = gfx::make_program({.label = "wire nodes: rings", .compute = ring_program_source()});
-    if (!rings) return rings.error();
     path->curve_program_ = std::move(*curve);
-    path->ring_program_ = std::move(*rings);
     if (Status st = check_storage_limits(path->curve_program_, "wire nodes: curves", kCurveBindings); !st) return st;
-    if (Status st = check_storage_limits(path->ring_program_, "wire nodes: rings", kRingBindings); !st) return st;
+    // The ring pass: one program per stage, each checked as it is made (the first that fails is the one named).
+    const struct {
+        const char* label;
+        std::string source;
+        gfx::Program& program;
+    } ring_programs[] = {
+        {"wire nodes: ring LOD", ring_lod_program_source(), path->ring_lod_program_},
+        {"wire nodes: ring commands", ring_commands_program_source(), path->ring_commands_program_},
+        {"wire nodes: rings", ring_build_program_source(), path->ring_build_program_},
+    };
+    for (const auto& [label, source, program] : ring_programs) {
+        auto made = gfx::make_program({.label = label, .compute = source});
+        if (!made) return made.error();
+        program = std::move(*made);
+        if (Status st = check_storage_limits(program, label, kRingBindings); !st) return st;
+    }
     path->set_lod({});
     path->retain_frames_ = retain_frames ? retain_frames : 180;
     auto readback = gfx::make_buffer({.size_bytes = kReadbackSlots * kCounterBytes,
@@ -91,6 +103,13 @@ std::size_t NodePath::gl_buffers() const {
         n += b->id() != 0 ? 1 : 0;
     }
     for (const gfx::Buffer& b : view_states_) n += b.id() != 0 ? 1 : 0;
+    return n;
+}
+
+std::size_t NodePath::gl_programs() const {
+    std::size_t n = 0;
+    for (const gfx::Program* p : {&curve_program_, &ring_lod_program_, &ring_commands_program_, &ring_build_program_})
+        n += p->id() != 0 ? 1 : 0;
     return n;
 }
 

@@ -87,6 +87,8 @@ public:
     [[nodiscard]] std::size_t resident_wires() const { return slots_.size(); }
     /// GL buffers it holds now (its persistent and per-frame buffers; a grown one replaces the old).
     [[nodiscard]] std::size_t gl_buffers() const;
+    /// GL programs it holds (the curve program and the ring pass's three).
+    [[nodiscard]] std::size_t gl_programs() const;
     /// Chunk records the frame may draw (the instanced chunk-index attribute must cover them).
     [[nodiscard]] std::size_t chunk_capacity() const { return chunk_bytes_ / 8; }
 
@@ -139,7 +141,9 @@ private:
     /// in `stats` (a material out of range, an id listed twice: its status says which).
     Gathered gather(const DrawList& list, std::size_t materials, WireUpload& up, DrawStats& stats);
 
-    engine::gfx::Program curve_program_, ring_program_;
+    engine::gfx::Program curve_program_;
+    /// The ring pass's stages, dispatched in this order (shaders.hpp): LOD, indirect commands, rings and records.
+    engine::gfx::Program ring_lod_program_, ring_commands_program_, ring_build_program_;
     LodSettings lod_{};
     uint32_t retain_frames_ = 180, max_sides_ = 32;
     uint64_t frame_ = 0;

@@ -1,6 +1,6 @@
 // The nodes path's frame on the GPU (node_path.hpp): the region (headers, nodes, the listed slots), the
-// per-frame buffers, the curve passes of the changed wires (the list's, then the stream's) and the ring
-// program's stages (LOD, commands, rings with their draw and chunk records).
+// per-frame buffers, the curve passes of the changed wires (the list's, then the stream's) and the ring pass's
+// three programs (LOD, commands, rings with their draw and chunk records).
 #include "node_path.hpp"
 
 #include "gpu_wire_data.hpp"
@@ -214,7 +214,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     // buffers the last draw read (the previous view of this frame, or the last frame): the barrier orders
     // those reads first.
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-    ring_program_.use();
+    // One binding point per buffer (RingBinding), shared by the three programs: each reads the ones it declares.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingHeaders, slot_headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSegments, segments_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingJobs, jobs_.id());
@@ -230,26 +230,45 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingBuckets, buckets_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCommands, commands_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingTemplates, templates_.id());
-    const auto at = [&](const char* name) { return ring_program_.uniform_location(name); };
-    set_lod_uniforms(ring_program_, view, lod_);
-    glUniform1i(at("u_lod"), 1);
-    glUniform1i(at("u_draw"), 1);
-    glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
-    glUniform1ui(at("u_unchanged"), static_cast<GLuint>(unchanged_));
-    glUniform1ui(at("u_ring_capacity"),
-                 static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
-    glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, 0xffffffffu)));
-    glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
-    glUniform1ui(at("u_side_slots"), side_slots_);
     const auto groups = static_cast<GLuint>((visible_ + 63) / 64);
-    glUniform1ui(at("u_stage"), 1u);
-    glDispatchCompute(groups, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUniform1ui(at("u_stage"), 2u);
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUniform1ui(at("u_stage"), 3u);
-    glDispatchCompute(groups, 1, 1);
+    // (2) The LOD: counts, sides, ring ranges, chunk counts per bucket.
+    {
+        ring_lod_program_.use();
+        const auto at = [&](const char* name) { return ring_lod_program_.uniform_location(name); };
+        set_lod_uniforms(ring_lod_program_, view, lod_);
+        glUniform1i(at("u_lod"), 1);
+        glUniform1i(at("u_keep_job_flags"), 0);
+        glUniform1i(at("u_draw"), 1);
+        glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
+        glUniform1ui(at("u_unchanged"), static_cast<GLuint>(unchanged_));
+        glUniform1ui(at("u_ring_capacity"),
+                     static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
+        glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, 0xffffffffu)));
+        glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
+        glUniform1ui(at("u_side_slots"), side_slots_);
+        glDispatchCompute(groups, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    // (3) The indirect commands and each bucket's first chunk.
+    {
+        ring_commands_program_.use();
+        const auto at = [&](const char* name) { return ring_commands_program_.uniform_location(name); };
+        glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
+        glUniform1ui(at("u_side_slots"), side_slots_);
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    // (4) The rings, the draw and chunk records.
+    {
+        ring_build_program_.use();
+        const auto at = [&](const char* name) { return ring_build_program_.uniform_location(name); };
+        glUniform3d(at("u_eye"), view.eye_m.x, view.eye_m.y, view.eye_m.z);
+        glUniform1i(at("u_draw"), 1);
+        glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
+        glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
+        glUniform1ui(at("u_side_slots"), side_slots_);
+        glDispatchCompute(groups, 1, 1);
+    }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     // The counter, read kReadbackSlots frames later (the ring buffer's size).
     glCopyNamedBufferSubData(counter_.id(), readback_.id(), 0,

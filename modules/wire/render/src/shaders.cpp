@@ -74,10 +74,21 @@ std::string curve_program_source() {
                          glsl::curves_main_comp});
 }
 
-std::string ring_program_source() {
+std::string ring_lod_program_source() {
     const std::string defines = binding_defines();
-    return glsl_program({defines, kRecordMacros, glsl::gpu_records_h, glsl::rings_comp, glsl::rings_segment_comp,
-                         glsl::rings_frames_comp, glsl::rings_lod_comp, glsl::rings_main_comp});
+    return glsl_program({defines, kRecordMacros, glsl::gpu_records_h, glsl::rings_buckets_comp, glsl::rings_comp,
+                         glsl::rings_segment_comp, glsl::rings_lod_comp, glsl::rings_lod_main_comp});
+}
+
+std::string ring_commands_program_source() {
+    const std::string defines = binding_defines();
+    return glsl_program({defines, glsl::rings_buckets_comp, glsl::rings_commands_main_comp});
+}
+
+std::string ring_build_program_source() {
+    const std::string defines = binding_defines();
+    return glsl_program({defines, kRecordMacros, glsl::gpu_records_h, glsl::rings_buckets_comp, glsl::rings_comp,
+                         glsl::rings_segment_comp, glsl::rings_frames_comp, glsl::rings_build_main_comp});
 }
 
 }  // namespace wire::render::detail

@@ -1,5 +1,5 @@
-// The wire programs' GLSL (internal; the text is in modules/wire/render/shaders): the curve and ring compute
-// programs, one vertex shader per upload path, the fragment shaders.
+// The wire programs' GLSL (internal; the text is in modules/wire/render/shaders): the curve program and the
+// ring pass's three compute programs, one vertex shader per upload path, the fragment shaders.
 #pragma once
 
 #include "gpu_records.hpp"
@@ -30,7 +30,16 @@ std::string fragment_source(FragmentOutput output, std::string_view shading, std
 std::string glsl_program(std::initializer_list<std::string_view> pieces);
 /// The curve program: the binding macros (kBindingMacros), the shared records (gpu_records.h), curves*.comp.
 std::string curve_program_source();
-/// The ring program: the binding macros, the shared records, rings*.comp.
-std::string ring_program_source();
+/// The ring pass's three programs, dispatched in this order (each from the binding macros and the pieces its stage
+/// reads). The LOD program (one invocation per wire): the slot's first normal turned by the wire's motion, the
+/// rings per segment (the LOD's or the caller's), a range of the ring buffer, the chunk counts per bucket. The
+/// shared records, rings_buckets.comp, rings.comp, rings_segment.comp, rings_lod.comp, rings_lod_main.comp.
+std::string ring_lod_program_source();
+/// The commands program (one invocation): the indirect commands and each bucket's first chunk.
+/// rings_buckets.comp, rings_commands_main.comp.
+std::string ring_commands_program_source();
+/// The rings program (one invocation per wire): the rings with their frames and u, the draw and chunk records.
+/// The shared records, rings_buckets.comp, rings.comp, rings_segment.comp, rings_frames.comp, rings_build_main.comp.
+std::string ring_build_program_source();
 
 }  // namespace wire::render::detail

@@ -168,7 +168,7 @@ RendererInfo WireRenderer::info() const {
     i.allocated_ring_buffers = s.ring_storage.allocated_buffers();
     if (s.nodes) {
         i.node_path_buffers = s.nodes->gl_buffers();
-        i.node_path_programs = 2;
+        i.node_path_programs = s.nodes->gl_programs();
         i.node_path_wires = s.nodes->resident_wires();
     }
     return i;

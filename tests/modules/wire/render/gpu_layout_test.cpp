@@ -51,43 +51,52 @@ protected:
     EXPECT_EQ(offset(program, glsl), static_cast<GLint>(offsetof(type, member))) << (glsl)
 
 TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
-    auto made = gfx::make_program({.label = "layout: rings", .compute = ring_program_source()});
-    ASSERT_TRUE(made.ok()) << made.error().message;
-    const gfx::Program& p = *made;
-    // Job (the ring pass's per-wire record; read back by the nodes path and GpuRingPass).
-    EXPECT_EQ(stride(p, "jobs[0].ring_first"), static_cast<GLint>(sizeof(Job)));
-    EXPECT_FIELD(p, "jobs[0].ring_first", Job, ring_first);
-    EXPECT_FIELD(p, "jobs[0].ring_count", Job, ring_count);
-    EXPECT_FIELD(p, "jobs[0].flags", Job, flags);
-    EXPECT_FIELD(p, "jobs[0].sides", Job, sides);
-    EXPECT_FIELD(p, "jobs[0].previous_normal", Job, previous_normal);
-    EXPECT_FIELD(p, "jobs[0].first_normal", Job, first_normal);
-    EXPECT_FIELD(p, "jobs[0].totals", Job, totals);
-    // SlotState (kept per slot between frames; cleared by the CPU).
-    EXPECT_EQ(stride(p, "slot_state[0].lod"), static_cast<GLint>(sizeof(SlotState)));
-    EXPECT_FIELD(p, "slot_state[0].lod", SlotState, lod);
-    EXPECT_FIELD(p, "slot_state[0].first_normal", SlotState, first_normal);
-    // The wire header (GpuCurveHeader), as the ring pass reads it per slot.
-    EXPECT_EQ(stride(p, "headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
-    EXPECT_FIELD(p, "headers[0].node_first", GpuCurveHeader, node_first);
-    EXPECT_FIELD(p, "headers[0].node_count", GpuCurveHeader, node_count);
-    EXPECT_FIELD(p, "headers[0].segment_first", GpuCurveHeader, segment_first);
-    EXPECT_FIELD(p, "headers[0].flags", GpuCurveHeader, flags);
-    EXPECT_FIELD(p, "headers[0].kb", GpuCurveHeader, kb);
-    EXPECT_FIELD(p, "headers[0].extra_first", GpuCurveHeader, extra_first);
-    EXPECT_FIELD(p, "headers[0].slot", GpuCurveHeader, slot);
-    EXPECT_FIELD(p, "headers[0].origin_m[0]", GpuCurveHeader, origin_m);
-    EXPECT_FIELD(p, "headers[0].motion[0]", GpuCurveHeader, motion);
-    // The draw record the ring pass writes and the vertex shader reads (GpuDraw).
-    EXPECT_EQ(stride(p, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));
-    EXPECT_FIELD(p, "draws[0].offset_m", GpuDraw, offset_m);
-    EXPECT_FIELD(p, "draws[0].ring_first", GpuDraw, ring_first);
-    EXPECT_FIELD(p, "draws[0].ring_count", GpuDraw, ring_count);
-    EXPECT_FIELD(p, "draws[0].sides", GpuDraw, sides);
-    EXPECT_FIELD(p, "draws[0].flags", GpuDraw, flags);
-    EXPECT_FIELD(p, "draws[0].u_close", GpuDraw, u_close);
-    // The indirect commands: 5 words each (DrawElementsIndirectCommand), written as a word array.
-    EXPECT_EQ(property(p, "commands[0]", GL_ARRAY_STRIDE), 4);
+    auto lod = gfx::make_program({.label = "layout: ring LOD", .compute = ring_lod_program_source()});
+    ASSERT_TRUE(lod.ok()) << lod.error().message;
+    auto commands = gfx::make_program({.label = "layout: ring commands", .compute = ring_commands_program_source()});
+    ASSERT_TRUE(commands.ok()) << commands.error().message;
+    auto rings = gfx::make_program({.label = "layout: rings", .compute = ring_build_program_source()});
+    ASSERT_TRUE(rings.ok()) << rings.error().message;
+    // The records both per-wire programs (LOD, rings) declare, on each.
+    for (const gfx::Program* program : {&*lod, &*rings}) {
+        const gfx::Program& p = *program;
+        SCOPED_TRACE(program == &*lod ? "ring LOD program" : "rings program");
+        // Job (the ring pass's per-wire record; read back by the nodes path and GpuRingPass).
+        EXPECT_EQ(stride(p, "jobs[0].ring_first"), static_cast<GLint>(sizeof(Job)));
+        EXPECT_FIELD(p, "jobs[0].ring_first", Job, ring_first);
+        EXPECT_FIELD(p, "jobs[0].ring_count", Job, ring_count);
+        EXPECT_FIELD(p, "jobs[0].flags", Job, flags);
+        EXPECT_FIELD(p, "jobs[0].sides", Job, sides);
+        EXPECT_FIELD(p, "jobs[0].previous_normal", Job, previous_normal);
+        EXPECT_FIELD(p, "jobs[0].first_normal", Job, first_normal);
+        EXPECT_FIELD(p, "jobs[0].totals", Job, totals);
+        // SlotState (kept per slot between frames; cleared by the CPU).
+        EXPECT_EQ(stride(p, "slot_state[0].lod"), static_cast<GLint>(sizeof(SlotState)));
+        EXPECT_FIELD(p, "slot_state[0].lod", SlotState, lod);
+        EXPECT_FIELD(p, "slot_state[0].first_normal", SlotState, first_normal);
+        // The wire header (GpuCurveHeader), as the ring pass reads it per slot.
+        EXPECT_EQ(stride(p, "headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
+        EXPECT_FIELD(p, "headers[0].node_first", GpuCurveHeader, node_first);
+        EXPECT_FIELD(p, "headers[0].node_count", GpuCurveHeader, node_count);
+        EXPECT_FIELD(p, "headers[0].segment_first", GpuCurveHeader, segment_first);
+        EXPECT_FIELD(p, "headers[0].flags", GpuCurveHeader, flags);
+        EXPECT_FIELD(p, "headers[0].kb", GpuCurveHeader, kb);
+        EXPECT_FIELD(p, "headers[0].extra_first", GpuCurveHeader, extra_first);
+        EXPECT_FIELD(p, "headers[0].slot", GpuCurveHeader, slot);
+        EXPECT_FIELD(p, "headers[0].origin_m[0]", GpuCurveHeader, origin_m);
+        EXPECT_FIELD(p, "headers[0].motion[0]", GpuCurveHeader, motion);
+    }
+    // The draw record the rings program writes and the vertex shader reads (GpuDraw).
+    EXPECT_EQ(stride(*rings, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));
+    EXPECT_FIELD(*rings, "draws[0].offset_m", GpuDraw, offset_m);
+    EXPECT_FIELD(*rings, "draws[0].ring_first", GpuDraw, ring_first);
+    EXPECT_FIELD(*rings, "draws[0].ring_count", GpuDraw, ring_count);
+    EXPECT_FIELD(*rings, "draws[0].sides", GpuDraw, sides);
+    EXPECT_FIELD(*rings, "draws[0].flags", GpuDraw, flags);
+    EXPECT_FIELD(*rings, "draws[0].u_close", GpuDraw, u_close);
+    // The indirect commands the commands program writes: 5 words each (DrawElementsIndirectCommand), as a word
+    // array.
+    EXPECT_EQ(property(*commands, "commands[0]", GL_ARRAY_STRIDE), 4);
 }
 
 TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
@@ -119,7 +128,7 @@ TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
 
 // The helper itself: a name the program does not have reads -1, so a renamed field cannot pass silently.
 TEST_F(GpuLayout, AnUnknownFieldReadsAsMissing) {
-    auto made = gfx::make_program({.label = "layout: rings", .compute = ring_program_source()});
+    auto made = gfx::make_program({.label = "layout: rings", .compute = ring_build_program_source()});
     ASSERT_TRUE(made.ok()) << made.error().message;
     EXPECT_EQ(offset(*made, "jobs[0].no_such_field"), -1);
     EXPECT_GE(offset(*made, "jobs[0].totals"), 0);

@@ -47,15 +47,19 @@ Blocks storage_blocks(const std::string& source) {
 TEST(ShaderResources, StorageBlocksFitEveryDesktopDriver) {
     struct Program {
         std::string name, source;
-        std::size_t expected_bindings;  // 0: not a table of ours
+        std::size_t expected_bindings;  // 0: not a table of ours, or the ring pass's (checked together below)
+        bool ring_pass;                 // one of the ring pass's programs: their bindings together are RingBinding's
     };
     const std::vector<Program> programs = {
-        {"curves", curve_program_source(), kCurveBindings},
-        {"rings", ring_program_source(), kRingBindings},
-        {"cpu-mesh vertex", vertex_source(true, true), 0},
-        {"gpu-rings vertex", vertex_source(false, true), 0},
-        {"gpu-rings vertex (attribute)", vertex_source(false, false), 0},
+        {"curves", curve_program_source(), kCurveBindings, false},
+        {"ring LOD", ring_lod_program_source(), 0, true},
+        {"ring commands", ring_commands_program_source(), 0, true},
+        {"rings", ring_build_program_source(), 0, true},
+        {"cpu-mesh vertex", vertex_source(true, true), 0, false},
+        {"gpu-rings vertex", vertex_source(false, true), 0, false},
+        {"gpu-rings vertex (attribute)", vertex_source(false, false), 0, false},
     };
+    std::set<int> ring_pass;
     for (const Program& p : programs) {
         const Blocks b = storage_blocks(p.source);
         EXPECT_TRUE(b.unresolved.empty()) << p.name << ": a binding names no #define: " << b.unresolved.front();
@@ -69,8 +73,14 @@ TEST(ShaderResources, StorageBlocksFitEveryDesktopDriver) {
             EXPECT_EQ(unique.size(), p.expected_bindings) << p.name;
             EXPECT_EQ(*unique.rbegin(), static_cast<int>(p.expected_bindings) - 1) << p.name;
         }
+        if (p.ring_pass) ring_pass.insert(unique.begin(), unique.end());
         std::printf("%s: %zu storage blocks, highest binding %d\n", p.name.c_str(), b.bindings.size(), *unique.rbegin());
     }
+    // The ring pass's programs between them: dense, exactly the enum's bindings 0 .. count - 1, each used by one
+    // of them at least.
+    ASSERT_FALSE(ring_pass.empty());
+    EXPECT_EQ(ring_pass.size(), static_cast<std::size_t>(kRingBindings));
+    EXPECT_EQ(*ring_pass.rbegin(), static_cast<int>(kRingBindings) - 1);
 }
 
 // The default uniform block of the compute programs within GL_MAX_COMPUTE_UNIFORM_COMPONENTS' minimum (1024),
@@ -81,7 +91,9 @@ TEST(ShaderResources, DefaultUniformBlocksFitTheMinimumWithVec4Slots) {
                                               {"vec3", 1}, {"vec4", 1}, {"uvec4", 1}, {"mat3", 3}, {"mat4", 4},
                                               {"dvec3", 2}, {"double", 1}};
     for (const auto& [name, source] : {std::pair{"curves", curve_program_source()},
-                                       std::pair{"rings", ring_program_source()}}) {
+                                       std::pair{"ring LOD", ring_lod_program_source()},
+                                       std::pair{"ring commands", ring_commands_program_source()},
+                                       std::pair{"rings", ring_build_program_source()}}) {
         const std::regex uniform(R"((?:^|\n)[ \t]*uniform\s+(\w+)\s+([^;]+);)");  // declarations, not comments
         int components = 0, declared = 0;
         for (auto it = std::sregex_iterator(source.begin(), source.end(), uniform); it != std::sregex_iterator(); ++it) {

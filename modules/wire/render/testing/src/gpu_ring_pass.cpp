@@ -1,4 +1,4 @@
-// The ring program driven alone (see gpu_ring_pass.hpp).
+// The ring pass's LOD and rings programs driven alone (see gpu_ring_pass.hpp).
 #include "wire/render/testing/gpu_ring_pass.hpp"
 
 #include "shaders.hpp"
@@ -18,11 +18,15 @@ using detail::SlotState;
 }  // namespace
 
 engine::Expected<GpuRingPass> GpuRingPass::create() {
-    engine::Expected<engine::gfx::Program> program =
-        engine::gfx::make_program({.label = "wire gpu rings", .compute = detail::ring_program_source()});
-    if (!program) return program.error();
+    engine::Expected<engine::gfx::Program> lod =
+        engine::gfx::make_program({.label = "wire gpu ring LOD", .compute = detail::ring_lod_program_source()});
+    if (!lod) return lod.error();
+    engine::Expected<engine::gfx::Program> rings =
+        engine::gfx::make_program({.label = "wire gpu rings", .compute = detail::ring_build_program_source()});
+    if (!rings) return rings.error();
     GpuRingPass pass;
-    pass.program_ = std::move(*program);
+    pass.lod_program_ = std::move(*lod);
+    pass.ring_program_ = std::move(*rings);
     return pass;
 }
 
@@ -126,10 +130,12 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingSlots, state_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingCounter, counter_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kRingVisible, visible_.id());
-    program_.use();
-    const auto at = [&](const char* name) { return program_.uniform_location(name); };
+    const auto groups = static_cast<GLuint>((jobs.size() + 63) / 64);
+    // The LOD program: the counts (the LOD's or the caller's) and ring ranges, the caller's job flags kept.
+    lod_program_.use();
+    const auto at = [&](const char* name) { return lod_program_.uniform_location(name); };
     glUniform1ui(at("u_wires"), static_cast<GLuint>(jobs.size()));
-    glUniform1ui(at("u_stage"), 0u);
+    glUniform1i(at("u_keep_job_flags"), 1);
     // Every wire is "changed" (its header's motion turns its kept first normal) when a job carries the last
     // one.
     glUniform1ui(at("u_unchanged"), carry_last ? 0u : static_cast<GLuint>(jobs.size()));
@@ -138,8 +144,14 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
                  static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
     glUniform1ui(at("u_ring_reserve"), 0u);  // a wire that does not fit is reported (GpuRingResult::overflow)
     glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);
-    if (lod != nullptr) detail::set_lod_uniforms(program_, lod->view, lod->settings);
-    glDispatchCompute(static_cast<GLuint>((jobs.size() + 63) / 64), 1, 1);
+    if (lod != nullptr) detail::set_lod_uniforms(lod_program_, lod->view, lod->settings);
+    glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    // The rings program: the rings in the ranges the jobs hold.
+    ring_program_.use();
+    glUniform1ui(ring_program_.uniform_location("u_wires"), static_cast<GLuint>(jobs.size()));
+    glUniform1i(ring_program_.uniform_location("u_draw"), 0);
+    glDispatchCompute(groups, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);
     return Status::success();

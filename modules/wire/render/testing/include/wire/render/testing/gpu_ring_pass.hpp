@@ -1,6 +1,6 @@
-// Test harness (wire::render_testing, never installed): the nodes path's ring program driven alone. From the
-// segments a GpuCurvePass built,
-// one compute dispatch writes every wire's ring records (wire::PackedRing, the 28-byte form the gpu-rings vertex
+// Test harness (wire::render_testing, never installed): the nodes path's ring pass driven alone, its LOD and rings
+// programs (shaders.hpp). From the segments a GpuCurvePass built, two compute dispatches (the counts and ring
+// ranges, then the rings) write every wire's ring records (wire::PackedRing, the 28-byte form the gpu-rings vertex
 // shader reads), one invocation per wire walking its rings in order, as wire::place_rings + wire::build_rings do
 // on the CPU, which stays the reference (tests/modules/wire/render/gpu_rings_test.cpp compares the two):
 //
@@ -27,9 +27,9 @@
 // strips and lines, hysteresis on counts and sides kept on the GPU between builds of the same wires; below the node
 // resolution unless LodSettings::keep_node_resolution, the span hierarchy built per wire as the segments are
 // visited and decided as update_lod decides it). A wire's rings get a range of the ring buffer by an atomic counter (no scan).
-// The renderer's nodes path (src/node_path.cpp) runs the same program in stages (LOD, the indirect commands, the
-// rings with their draw and chunk records) and draws a wire that does not fit the ring buffer with one ring a
-// segment from a reserve.
+// The renderer's nodes path (src/node_path.cpp) runs the same programs with the commands program between them (LOD,
+// the indirect commands, the rings with their draw and chunk records) and draws a wire that does not fit the ring
+// buffer with one ring a segment from a reserve.
 #pragma once
 
 #include "wire/lod.hpp"
@@ -83,14 +83,14 @@ struct GpuRingResult {
     float holonomy_rad = 0.0f;      ///< closed loops: FrameStats::holonomy_rad
 };
 
-/// The ring compute pass (owns its GL program and buffers: create, use and destroy it with the same context
+/// The ring compute pass (owns its GL programs and buffers: create, use and destroy it with the same context
 /// current).
 class GpuRingPass {
 public:
-    /// Compiles the compute program. Fails (with the driver's log) without GL 4.3 compute.
+    /// Compiles the LOD and rings programs. Fails (with the driver's log) without GL 4.3 compute.
     static engine::Expected<GpuRingPass> create();
 
-    /// Every wire's rings from `curves`' last build (one dispatch). jobs.size() must equal the number of wires of
+    /// Every wire's rings from `curves`' last build (a dispatch of the LOD program, then one of the rings program). jobs.size() must equal the number of wires of
     /// that build and each job's counts its wire's segment count; otherwise the call fails naming the wire.
     /// With `lod`, the counts come from the LOD on the GPU (see the file comment).
     [[nodiscard]] Status build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs,
@@ -101,7 +101,7 @@ public:
 
 
 private:
-    engine::gfx::Program program_;
+    engine::gfx::Program lod_program_, ring_program_;
     engine::gfx::Buffer jobs_, counts_, rings_, state_, counter_, visible_;
     std::vector<uint32_t> count_first_, segments_;  // per wire of the last build: its counts' range
     std::size_t ring_capacity_ = 0, count_total_ = 0, state_wires_ = 0;
