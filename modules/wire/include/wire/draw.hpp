@@ -73,11 +73,7 @@ struct DrawItem {
     /// renderer checks the rings itself.
     std::optional<bool> radius_varies;
     // gpu_nodes path
-    /// The wire's last valid nodes (the systems' checks); alive until the draw returns. The renderer draws them
-    /// (unless `packed_nodes` or `curve` is set) and fits from them how the wire moved since the nodes it last got
-    /// for it, which turns the first frame it keeps as the CPU path's carried_frames turns its own: give them with
-    /// `packed_nodes` and `curve` too (null: the first frame is the last one projected onto the new first tangent).
-    const WireNodes* nodes = nullptr;
+    const WireNodes* nodes = nullptr;  ///< validated nodes (the systems' checks); alive until the draw returns
     /// `nodes` packed for the GPU (wire::pack_nodes, done by the systems on their worker threads); when set, the
     /// renderer copies it and does not read `nodes`.
     const PackedNodes* packed_nodes = nullptr;
@@ -88,6 +84,13 @@ struct DrawItem {
     /// Changes whenever `nodes` or `spline` change; the renderer keeps the wire's curve on the GPU while
     /// (wire_id, nodes_generation) stays the same. 0: unknown (the nodes are sent every frame).
     uint64_t nodes_generation = 0;
+    /// How the wire moved since the nodes the renderer last got for it: the vector part of wire::carried_rotation
+    /// (motion.hpp), which turns the first frame kept on the GPU as the CPU path's carried_frames turns its own.
+    /// Zero: none known (the first frame is the last one projected onto the new first tangent).
+    glm::vec3 motion{};
+    /// Instead of `motion`: the GPU fits it against the nodes it got last for this wire, by index (wire::
+    /// samples_match says when that equals fit_motion's match by id; the nodes must be packed without merging).
+    bool fit_motion = false;
 
     uint32_t sides = 8;      ///< radial sides of a tube (>= 3); 2 = camera-facing strip, 1 = one-pixel AA line
     bool closed = false;     ///< closed loop (the last ring connects back to the first)

@@ -28,38 +28,14 @@ GpuCurveHeader packed_header(const PackedNodes& p, uint32_t segment_first, uint3
                                                             : kKindCatmullRom;
     h.flags = (p.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
               (p.per_node_kb ? kHeaderPerNode : 0u) | (p.stretch ? kHeaderStretch : 0u) |
-              (material << kHeaderMaterialShift);
+              (motion.fit ? kHeaderFitMotion : 0u) | (material << kHeaderMaterialShift);
     h.kb = {p.alpha, p.tension, p.bias, p.continuity};
     h.extra_first = extra_first;
     h.slot = slot;
     h.origin_m[0] = static_cast<float>(p.origin_m.x), h.origin_m[1] = static_cast<float>(p.origin_m.y),
     h.origin_m[2] = static_cast<float>(p.origin_m.z);  // exact: pack_nodes made it a float_point
-    set_motion(h, motion);
-    return h;
-}
-
-WireMotion motion_since(SentMotion& sent, const WireNodes* nodes, bool unmerged) {
-    WireMotion m;
-    if (nodes == nullptr) {
-        sent = SentMotion{};
-        return m;
-    }
-    if (unmerged && sent.unmerged && samples_match(sent.reference, *nodes)) {
-        m.fit = true;
-    } else if (sent.reference.count != 0) {
-        MotionReference from = sent.reference;
-        weigh_reference(from);
-        const glm::dquat q = carried_rotation(fit_motion(from, *nodes));
-        m.rotation = glm::vec3(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
-    }
-    sent.reference = motion_samples(*nodes);
-    sent.unmerged = unmerged;
-    return m;
-}
-
-void set_motion(GpuCurveHeader& h, const WireMotion& motion) {
-    h.flags = (h.flags & ~kHeaderFitMotion) | (motion.fit ? kHeaderFitMotion : 0u);
     h.motion[0] = motion.rotation.x, h.motion[1] = motion.rotation.y, h.motion[2] = motion.rotation.z;
+    return h;
 }
 
 void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, uint32_t material, bool caps,
@@ -97,7 +73,7 @@ void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, 
     h.slot = slot;
     h.origin_m[0] = static_cast<float>(origin.x), h.origin_m[1] = static_cast<float>(origin.y),
     h.origin_m[2] = static_cast<float>(origin.z);
-    set_motion(h, motion);
+    h.motion[0] = motion.rotation.x, h.motion[1] = motion.rotation.y, h.motion[2] = motion.rotation.z;
     out.headers.push_back(h);
     const std::size_t n = curve.radius_m.size();
     const auto radius = [&](std::size_t j) { return n == 0 ? kDefaultWireRadius_m : curve.radius_m[j % n]; };

@@ -5,7 +5,6 @@
 #pragma once
 
 #include "wire/lod.hpp"
-#include "wire/motion.hpp"
 #include "wire/packed_nodes.hpp"
 #include "wire/curve.hpp"
 #include "wire/status.hpp"
@@ -59,23 +58,6 @@ struct WireMotion {
     glm::vec3 rotation{};
     bool fit = false;
 };
-
-/// What the renderer sent of a wire last (kept in its slot): the motion reference of those nodes
-/// (wire::motion_samples; count 0: none) and whether they went packed with none merged.
-struct SentMotion {
-    MotionReference reference{};
-    bool unmerged = false;
-};
-
-/// How a wire moved since the nodes last sent for it (`sent`), which becomes `nodes`' (the wire's last valid
-/// nodes; null: none known). The GPU fits it where matching by index is matching by id: the nodes go packed with
-/// none merged (`unmerged`), they did the last time, and the ids at the reference's samples sit where they sat
-/// (wire::samples_match). Otherwise the CPU fits it by id from the last reference (an id event, merged nodes, a
-/// blended curve: wire::fit_motion, carried_rotation's vector part); none the first time.
-WireMotion motion_since(SentMotion& sent, const WireNodes* nodes, bool unmerged);
-
-/// Writes `motion` into a header (its rotation, and the flag that has the curve pass fit it).
-void set_motion(GpuCurveHeader& h, const WireMotion& motion);
 
 /// One frame's upload of wires for the curve pass.
 struct WireUpload {

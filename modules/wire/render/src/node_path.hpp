@@ -13,8 +13,6 @@
 #include "wire/render/node_stream.hpp"
 #include "wire/render/wire_renderer.hpp"
 
-#include "gpu_wire_data.hpp"
-
 #include "engine/gfx/range_allocator.hpp"
 #include "engine/gfx/resources.hpp"
 #include "engine/gfx/stream_buffer.hpp"
@@ -108,7 +106,6 @@ private:
         uint64_t generation = 0;
         uint64_t last_frame = 0;
         bool built = false;  ///< its curve is on the GPU
-        SentMotion sent{};   ///< what its last nodes were (the next ones' motion is fitted from them)
     };
     Status grow_slots(std::size_t slots);
     /// View `view`'s LOD and frame state (view 0: slot_state_), made (cleared) on first use; null if it cannot be.

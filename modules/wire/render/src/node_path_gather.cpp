@@ -86,7 +86,6 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
         const bool changed = i < changed_item_.size() && changed_item_[i] != 0;
         if (changed) {
             uint32_t segments = 0;
-            bool unmerged = false;  // the nodes go packed with none merged
             const std::size_t nodes_before = up.nodes.size(), extras_before = up.extras.size();
             const std::size_t node_pieces_before = node_pieces_.size(),
                               extra_pieces_before = extra_pieces_.size();
@@ -96,9 +95,9 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                 // region.
                 const PackedNodes& p = *item.packed_nodes;
                 up.headers.push_back(packed_header(p, slot.segment_first, slot.index, item.material,
-                                                   item.caps, {}, static_cast<uint32_t>(node_total),
+                                                   item.caps, {item.motion, item.fit_motion},
+                                                   static_cast<uint32_t>(node_total),
                                                    static_cast<uint32_t>(extra_total)));
-                unmerged = item.nodes != nullptr && p.nodes.size() == item.nodes->size();
                 node_pieces_.push_back({p.nodes.data(), 0, p.nodes.size(), node_total});
                 node_total += p.nodes.size();
                 if (!p.extras.empty()) {
@@ -110,13 +109,12 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                 // Made here (a blended curve's segments; nodes not packed by the systems): into `up`, then
                 // copied.
                 if (has_curve) {
-                    append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps, {},
-                                    up);
+                    append_segments(*item.curve, slot.segment_first, slot.index, item.material, item.caps,
+                                    {item.motion, false}, up);
                     segments = static_cast<uint32_t>(item.curve->segment_count());
-                } else if (append_wire(*item.nodes, item.spline, slot.segment_first, slot.index, item.material,
-                                       item.caps, {}, up, segments)) {
-                    unmerged = up.nodes.size() - nodes_before == item.nodes->size();
-                } else {
+                } else if (!append_wire(*item.nodes, item.spline, slot.segment_first, slot.index,
+                                        item.material, item.caps, {item.motion, item.fit_motion}, up,
+                                        segments)) {
                     ++stats.wires_skipped;  // the systems validate; a kind the GPU does not build is skipped
                                             // here
                     continue;
@@ -130,10 +128,6 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                     {nullptr, extras_before, up.extras.size() - extras_before, extra_total});
                 extra_total += up.extras.size() - extras_before;
             }
-            // How the wire moved since its last nodes (the slot's reference becomes these nodes').
-            const bool had_reference = slot.sent.reference.count != 0;
-            const WireMotion motion = motion_since(slot.sent, item.nodes, unmerged);
-            set_motion(up.headers.back(), motion);
             // The wire's most sides (the LOD's max_sides for it; its Style's).
             up.headers.back().flags |= std::min(std::max<uint32_t>(item.sides, 3u), kHeaderSidesMask)
                                        << kHeaderSidesShift;
@@ -146,7 +140,6 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                     node_pieces_.resize(node_pieces_before), extra_pieces_.resize(extra_pieces_before);
                     node_total = node_total_before, extra_total = extra_total_before;
                     slot.segments = 0, slot.built = false;
-                    slot.sent = SentMotion{};  // not sent: the next nodes start afresh, as in a new slot
                     ++stats.wires_skipped;
                     continue;
                 }
@@ -156,11 +149,6 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
             }
             slot.generation = item.nodes_generation;
             slot.built = true;
-            if (motion.fit) {
-                ++stats.motion_fitted_gpu;
-            } else if (had_reference && item.nodes != nullptr) {
-                ++stats.motion_fitted_cpu;
-            }
             changed_wires_.push_back({item.wire_id, slot.index, slot.segment_first, slot.segments});
         }
         if (!slot.built) continue;

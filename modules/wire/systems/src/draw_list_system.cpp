@@ -1,5 +1,5 @@
-// The draw-list stage: one DrawItem per visible wire, in entity order; on the nodes path the wire's last valid
-// nodes (packed) or its blended curve.
+// The draw-list stage: one DrawItem per visible wire, in entity order; on the nodes path the wire's nodes or
+// blended curve and its motion since the renderer's last nodes.
 #include "stages.hpp"
 
 namespace wire::systems {
@@ -33,6 +33,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         constexpr std::size_t kBlock = 256;
         const auto& styles = registry.storage<Style>();  // looked up here: the workers only read them
         const auto& curves = registry.storage<WireCurve>();
+        auto& rings = registry.storage<WireRings>();  // each item writes its own wire's motion reference
         parallel_over((visible.size() + kBlock - 1) / kBlock, [&](std::size_t block) {
           const std::size_t end = std::min(visible.size(), (block + 1) * kBlock);
           for (std::size_t v = block * kBlock; v < end; ++v) {
@@ -43,6 +44,9 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
                     prefetch_lines<false>(c, 64);
                     prefetch_lines<false>(&c->previous_nodes, sizeof(WireNodes));
                     prefetch_lines<false>(&c->packed, sizeof(PackedNodes));
+                }
+                if (const WireRings* r = rings.try_get(ahead)) {
+                    prefetch_lines<true>(&r->motion, sizeof(MotionReference) + sizeof(r->sent_curve));
                 }
                 if (const Style* s = styles.try_get(ahead)) prefetch_lines<false>(s, sizeof(Style));
             }
@@ -56,15 +60,33 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
             // The last valid nodes (the current ones unless they are invalid), or the curve built on the CPU: the
             // blended one while a pop-free blend is live (or a kind the GPU does not build).
             const bool cpu_curve = !curve->pop_free_stale || !gpu_builds(style->spline.kind);
-            // The renderer fits the wire's motion from the last valid nodes: given with the curve too.
-            item.nodes = &curve->previous_nodes;
             if (cpu_curve && !curve->curve.segments.empty()) {
                 item.curve = &curve->curve;
-            } else if (curve->packed.nodes.size() >= 2) {
-                item.packed_nodes = &curve->packed;
+            } else {
+                item.nodes = &curve->previous_nodes;
+                if (curve->packed.nodes.size() >= 2) item.packed_nodes = &curve->packed;
             }
             item.spline = spline_of(*style);
             item.nodes_generation = curve->generation;
+            WireRings* sent = rings.try_get(e);
+            if (sent != nullptr && sent->sent_curve != curve->generation) {
+                // New nodes for the renderer: how the wire moved since the last ones it got (rings_one's fit). The
+                // GPU fits it where matching by index is matching by id (packed nodes, none merged, now and the
+                // last time); here otherwise (an id event, merged nodes, a blended curve).
+                const WireNodes& nodes = curve->previous_nodes;
+                const bool unmerged = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() == nodes.size();
+                if (unmerged && sent->sent_unmerged && samples_match(sent->motion, nodes)) {
+                    item.fit_motion = true;
+                } else if (sent->motion.count != 0) {
+                    MotionReference from = sent->motion;
+                    weigh_reference(from);
+                    const glm::dquat q = carried_rotation(fit_motion(from, nodes));
+                    item.motion = glm::vec3(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+                }
+                sent->motion = motion_samples(nodes);
+                sent->sent_unmerged = unmerged;
+                sent->sent_curve = curve->generation;
+            }
             item.sides = style->max_sides ? std::max<uint32_t>(style->max_sides, 3) : kDefaultMaxSides;
             item.closed = style->closed;
             item.caps = caps_of(*style);

@@ -162,7 +162,7 @@ TEST_F(NodeStreamTest, DrawsTheListsRingsOverRandomFamiliesWhileMoving) {
     for (int f = 0; f < kFrames; ++f) {
         std::vector<wire::WireNodes> nodes;
         for (const StreamCase& c : cases) nodes.push_back(at_frame(c, f));
-        // The list: one item a wire (the renderer has the GPU fit the motion by index: none merged, no ids).
+        // The list: one item a wire, the motion fitted on the GPU by index (as the systems ask when ids match).
         DrawList list = nodes_list();
         for (std::size_t k = 0; k < cases.size(); ++k) {
             DrawItem item;
@@ -170,6 +170,7 @@ TEST_F(NodeStreamTest, DrawsTheListsRingsOverRandomFamiliesWhileMoving) {
             item.nodes = &nodes[k];
             item.spline = wire::SplineSettings{.kind = cases[k].style.kind, .radius_m = cases[k].style.radius_m};
             item.nodes_generation = static_cast<uint64_t>(f + 1);
+            item.fit_motion = f > 0;
             item.sides = cases[k].style.max_sides;
             list.items.push_back(item);
         }
@@ -581,6 +582,7 @@ TEST_F(NodeStreamTest, ListAndStreamInOneDrawAsEachAlone) {
             // Every third wire keeps its generation from frame 1 on: unchanged, listed.
             item.nodes_generation = (k / 2) % 3 == 0 ? static_cast<uint64_t>(std::min(f, 1) + 1) : static_cast<uint64_t>(f + 1);
             if ((k / 2) % 3 == 0) nodes[k] = at_frame(cases[k], std::min(f, 1));
+            item.fit_motion = f > 0;
             item.sides = cases[k].style.max_sides;
             list.items.push_back(item);
         }

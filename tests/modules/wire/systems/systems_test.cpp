@@ -650,5 +650,61 @@ TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
     EXPECT_TRUE(w.ctx.new_errors.empty());  // once
 }
 
+// The nodes path carries the first frame with the wire's motion. Each draw item whose nodes changed says how: the
+// GPU fits it (fit_motion: packed nodes, none merged, the ids at the reference's nodes where they were when the
+// renderer last got the wire: matching by index is matching by id), or the CPU did (an id event, a blended
+// curve: `motion`, carried_rotation's vector part of the fit from the nodes sent last). A frame without a change
+// sends nothing; a wire turned while culled is fitted across the gap (the GPU keeps the last upload's reference).
+TEST(WireSystems, NodesPathSendsTheWiresMotion) {
+    World w;
+    w.ctx.path = UploadPath::gpu_nodes;
+    WireNodes nodes = cable(12, {-2, 0, 0}, 4.0, 0.6);
+    for (uint32_t i = 0; i < 12; ++i) nodes.ids.push_back(100 + 10 * i);
+    const Entity e = spawn_wire(w.registry, nodes, {.spline = {.kind = SplineKind::catmull_rom}});
+    const auto item_of = [&](Entity x) -> const DrawItem* {
+        for (const DrawItem& it : w.ctx.draw_list.items)
+            if (it.wire_id == engine::ecs::to_integral(x)) return &it;
+        return nullptr;
+    };
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    EXPECT_EQ(item_of(e)->motion, glm::vec3(0.0f));  // the first nodes: nothing to carry from
+    EXPECT_FALSE(item_of(e)->fit_motion);
+    const glm::dvec3 pivot(-2.0, 0.0, 0.0);
+    const auto turn = [&](const glm::dquat& q, const glm::dvec3& about) {
+        for (glm::dvec3& p : edit_nodes(w.registry, e).positions) p = about + q * (p - about);
+    };
+    const glm::dquat q = glm::angleAxis(0.05, glm::normalize(glm::dvec3(1.0, 2.0, 0.5)));
+    turn(q, pivot);
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    EXPECT_TRUE(item_of(e)->fit_motion);  // the common case: on the GPU
+    EXPECT_EQ(item_of(e)->motion, glm::vec3(0.0f));
+    // Taken far behind the camera, turned there, brought back: the GPU fits across the gap.
+    const auto shift = [&](double dz) {
+        for (glm::dvec3& p : edit_nodes(w.registry, e).positions) p.z += dz;
+    };
+    shift(5000.0);
+    w.run();
+    EXPECT_EQ(item_of(e), nullptr);  // culled
+    turn(q, pivot + glm::dvec3(0.0, 0.0, 5000.0));
+    w.run();
+    shift(-5000.0);
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    EXPECT_TRUE(item_of(e)->fit_motion);
+    // A node inserted while the wire turns: the ids moved, so the CPU fits (from the nodes sent last, by id).
+    const auto& p = w.registry.get<Nodes>(e).positions;
+    insert_node(w.registry, e, 6, 0.5 * (p[5] + p[6]) + glm::dvec3(0, 0.02, 0));
+    turn(q, pivot);
+    w.run();
+    ASSERT_NE(item_of(e), nullptr);
+    EXPECT_FALSE(item_of(e)->fit_motion);
+    const glm::vec3 m = item_of(e)->motion;
+    EXPECT_NEAR(m.x, q.x, 1e-6);
+    EXPECT_NEAR(m.y, q.y, 1e-6);
+    EXPECT_NEAR(m.z, q.z, 1e-6);
+}
+
 }  // namespace
 }  // namespace wire::systems

@@ -161,10 +161,6 @@ struct DrawStats {
     std::size_t indirect_commands = 0;
     std::size_t multi_draw_calls = 0;  ///< glMultiDrawElementsIndirect calls: one per (class, material) in use
     std::size_t chunks = 0;            ///< gpu-rings: chunk records (instances) drawn
-    /// gpu-nodes: wires sent this frame whose motion since their last nodes (DrawItem::nodes) the GPU fits
-    /// (packed with none merged, now and the last time, the ids at the samples where they sat: matching by index
-    /// is matching by id), and those the CPU fitted by id (an id event, merged nodes, a blended curve).
-    std::size_t motion_fitted_gpu = 0, motion_fitted_cpu = 0;
     /// Success, or the frame's first problem: why it drew nothing (a program that did not build, a buffer that
     /// could not be made), or which item it skipped and why (gpu-nodes: a material out of range, a wire id listed
     /// twice; the rest is drawn). draw() also logs each distinct message once to stderr.

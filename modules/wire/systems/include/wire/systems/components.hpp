@@ -107,9 +107,13 @@ struct WireRings {
     bool radius_varies = false;        ///< with `packed`: some ring's radius differs from ring 0's
     float u_close = 0.0f;              ///< closed wires: texture u where the loop closes (0 for open wires)
     FrameSettings frame_settings{};    ///< what the last build seeded its first normal with (wire_ring_set redoes it)
-    /// The nodes ring 0's frame was built from: their motion carries it on (the nodes path keeps its own, in
-    /// the renderer).
+    /// The nodes ring 0's frame was built from: their motion carries it on. UploadPath::gpu_nodes: the nodes the
+    /// renderer was last given for this wire (motion_samples: the rotation from them to the next ones turns the
+    /// first frame the GPU kept, DrawItem::motion / fit_motion), WireCurve::generation `sent_curve`, and whether
+    /// they went as packed nodes none of which were merged (the GPU then fits the next motion itself).
     MotionReference motion{};
+    uint64_t sent_curve = 0;
+    bool sent_unmerged = false;
     uint64_t generation = 0;           ///< +1 each time the rings are rebuilt
     uint64_t seen_curve = 0;           ///< WireCurve::generation the rings were built from
     uint64_t seen_lod = 0;             ///< WireLodState::generation the rings were built from
