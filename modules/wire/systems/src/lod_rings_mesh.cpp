@@ -1,5 +1,5 @@
 // The LOD, rings and mesh stages: each over the wires whose input changed, in parallel (one wire's work in
-// stages.hpp: the curve stage runs it too for the wires it rebuilt).
+// one_wire.cpp: the curve stage runs it too for the wires it rebuilt).
 #include "stages.hpp"
 
 namespace wire::systems {

@@ -44,11 +44,23 @@ protected:
         glGetProgramResourceiv(p.id(), GL_BUFFER_VARIABLE, index, 1, &what, 1, nullptr, &value);
         return value;
     }
+    /// The draw record (GpuDraw) as `p` declares it: written by the rings program, read by the vertex shader.
+    static void expect_draw_record(const gfx::Program& p);
     std::unique_ptr<platform::Context> ctx_;
 };
 
 #define EXPECT_FIELD(program, glsl, type, member) \
     EXPECT_EQ(offset(program, glsl), static_cast<GLint>(offsetof(type, member))) << (glsl)
+
+void GpuLayout::expect_draw_record(const gfx::Program& p) {
+    EXPECT_EQ(stride(p, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));
+    EXPECT_FIELD(p, "draws[0].offset_m", GpuDraw, offset_m);
+    EXPECT_FIELD(p, "draws[0].ring_first", GpuDraw, ring_first);
+    EXPECT_FIELD(p, "draws[0].ring_count", GpuDraw, ring_count);
+    EXPECT_FIELD(p, "draws[0].sides", GpuDraw, sides);
+    EXPECT_FIELD(p, "draws[0].flags", GpuDraw, flags);
+    EXPECT_FIELD(p, "draws[0].u_close", GpuDraw, u_close);
+}
 
 TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
     auto lod = gfx::make_program({.label = "layout: ring LOD", .compute = ring_lod_program_source()});
@@ -87,13 +99,7 @@ TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
         EXPECT_FIELD(p, "headers[0].motion[0]", GpuCurveHeader, motion);
     }
     // The draw record the rings program writes and the vertex shader reads (GpuDraw).
-    EXPECT_EQ(stride(*rings, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));
-    EXPECT_FIELD(*rings, "draws[0].offset_m", GpuDraw, offset_m);
-    EXPECT_FIELD(*rings, "draws[0].ring_first", GpuDraw, ring_first);
-    EXPECT_FIELD(*rings, "draws[0].ring_count", GpuDraw, ring_count);
-    EXPECT_FIELD(*rings, "draws[0].sides", GpuDraw, sides);
-    EXPECT_FIELD(*rings, "draws[0].flags", GpuDraw, flags);
-    EXPECT_FIELD(*rings, "draws[0].u_close", GpuDraw, u_close);
+    expect_draw_record(*rings);
     // The indirect commands the commands program writes: 5 words each (DrawElementsIndirectCommand), as a word
     // array.
     EXPECT_EQ(property(*commands, "commands[0]", GL_ARRAY_STRIDE), 4);
@@ -115,13 +121,7 @@ TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
         const std::string fragment = fragment_source(FragmentOutput::color, "", "");
         auto rings = gfx::make_program({.vertex = vertex, .fragment = fragment, .label = "layout: ring vertex"});
         ASSERT_TRUE(rings.ok()) << rings.error().message;
-        EXPECT_EQ(stride(*rings, "draws[0].offset_m"), static_cast<GLint>(sizeof(GpuDraw)));
-        EXPECT_FIELD(*rings, "draws[0].offset_m", GpuDraw, offset_m);
-        EXPECT_FIELD(*rings, "draws[0].ring_first", GpuDraw, ring_first);
-        EXPECT_FIELD(*rings, "draws[0].ring_count", GpuDraw, ring_count);
-        EXPECT_FIELD(*rings, "draws[0].sides", GpuDraw, sides);
-        EXPECT_FIELD(*rings, "draws[0].flags", GpuDraw, flags);
-        EXPECT_FIELD(*rings, "draws[0].u_close", GpuDraw, u_close);
+        expect_draw_record(*rings);
         EXPECT_EQ(property(*rings, "chunks[0]", GL_ARRAY_STRIDE), 8);  // kChunkRecordBytes: (draw index, first band)
     }
 }
