@@ -46,6 +46,8 @@ protected:
     }
     /// The draw record (GpuDraw) as `p` declares it: written by the rings program, read by the vertex shader.
     static void expect_draw_record(const gfx::Program& p);
+    /// Every field of the wire header (GpuCurveHeader) in `p`'s record array `array`, and its stride.
+    static void expect_header(const gfx::Program& p, const std::string& array);
     std::unique_ptr<platform::Context> ctx_;
 };
 
@@ -60,6 +62,21 @@ void GpuLayout::expect_draw_record(const gfx::Program& p) {
     EXPECT_FIELD(p, "draws[0].sides", GpuDraw, sides);
     EXPECT_FIELD(p, "draws[0].flags", GpuDraw, flags);
     EXPECT_FIELD(p, "draws[0].u_close", GpuDraw, u_close);
+}
+
+void GpuLayout::expect_header(const gfx::Program& p, const std::string& array) {
+    SCOPED_TRACE(array);
+    const std::string at = array + "[0].";
+    EXPECT_EQ(stride(p, at + "node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
+    EXPECT_FIELD(p, at + "node_first", GpuCurveHeader, node_first);
+    EXPECT_FIELD(p, at + "node_count", GpuCurveHeader, node_count);
+    EXPECT_FIELD(p, at + "segment_first", GpuCurveHeader, segment_first);
+    EXPECT_FIELD(p, at + "flags", GpuCurveHeader, flags);
+    EXPECT_FIELD(p, at + "kb", GpuCurveHeader, kb);
+    EXPECT_FIELD(p, at + "extra_first", GpuCurveHeader, extra_first);
+    EXPECT_FIELD(p, at + "slot", GpuCurveHeader, slot);
+    EXPECT_FIELD(p, at + "origin_m[0]", GpuCurveHeader, origin_m);
+    EXPECT_FIELD(p, at + "motion[0]", GpuCurveHeader, motion);
 }
 
 TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
@@ -87,16 +104,7 @@ TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
         EXPECT_FIELD(p, "slot_state[0].lod", SlotState, lod);
         EXPECT_FIELD(p, "slot_state[0].first_normal", SlotState, first_normal);
         // The wire header (GpuCurveHeader), as the ring pass reads it per slot.
-        EXPECT_EQ(stride(p, "headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
-        EXPECT_FIELD(p, "headers[0].node_first", GpuCurveHeader, node_first);
-        EXPECT_FIELD(p, "headers[0].node_count", GpuCurveHeader, node_count);
-        EXPECT_FIELD(p, "headers[0].segment_first", GpuCurveHeader, segment_first);
-        EXPECT_FIELD(p, "headers[0].flags", GpuCurveHeader, flags);
-        EXPECT_FIELD(p, "headers[0].kb", GpuCurveHeader, kb);
-        EXPECT_FIELD(p, "headers[0].extra_first", GpuCurveHeader, extra_first);
-        EXPECT_FIELD(p, "headers[0].slot", GpuCurveHeader, slot);
-        EXPECT_FIELD(p, "headers[0].origin_m[0]", GpuCurveHeader, origin_m);
-        EXPECT_FIELD(p, "headers[0].motion[0]", GpuCurveHeader, motion);
+        expect_header(p, "headers");
     }
     // The draw record the rings program writes and the vertex shader reads (GpuDraw).
     expect_draw_record(*rings);
@@ -108,10 +116,8 @@ TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
 TEST_F(GpuLayout, CurvePassAndVertexShaderRecordsMatchTheirCppMirrors) {
     auto curves = gfx::make_program({.label = "layout: curves", .compute = curve_program_source()});
     ASSERT_TRUE(curves.ok()) << curves.error().message;
-    EXPECT_EQ(stride(*curves, "headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
-    EXPECT_FIELD(*curves, "headers[0].origin_m[0]", GpuCurveHeader, origin_m);
-    EXPECT_FIELD(*curves, "headers[0].motion[0]", GpuCurveHeader, motion);
-    EXPECT_EQ(stride(*curves, "slot_headers[0].node_first"), static_cast<GLint>(sizeof(GpuCurveHeader)));
+    expect_header(*curves, "headers");       // this upload's, as the CPU wrote them
+    expect_header(*curves, "slot_headers");  // the copies it keeps per slot
     EXPECT_EQ(stride(*curves, "refs[0].origin"), static_cast<GLint>(sizeof(MotionRef)));
     EXPECT_FIELD(*curves, "refs[0].origin", MotionRef, origin);
     EXPECT_FIELD(*curves, "refs[0].counts", MotionRef, counts);

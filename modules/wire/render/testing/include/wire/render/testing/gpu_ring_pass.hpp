@@ -90,8 +90,9 @@ public:
     /// Compiles the LOD and rings programs. Fails (with the driver's log) without GL 4.3 compute.
     static engine::Expected<GpuRingPass> create();
 
-    /// Every wire's rings from `curves`' last build (a dispatch of the LOD program, then one of the rings program). jobs.size() must equal the number of wires of
-    /// that build and each job's counts its wire's segment count; otherwise the call fails naming the wire.
+    /// Every wire's rings from `curves`' last build (a dispatch of the LOD program, then one of the rings
+    /// program). jobs.size() must equal the number of wires of that build and each job's counts its wire's segment
+    /// count; otherwise the call fails naming the wire.
     /// With `lod`, the counts come from the LOD on the GPU (see the file comment).
     [[nodiscard]] Status build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs,
                                const GpuLodFrame* lod = nullptr);
