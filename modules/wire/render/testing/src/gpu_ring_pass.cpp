@@ -53,7 +53,8 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
         segments[w] = static_cast<uint32_t>(segs);
         visible[w] = h.slot;
         count_total += segs;
-        j.flags = jobs[w].carry_last ? 0u : 2u | (jobs[w].has_previous_normal ? 1u : 0u);
+        if (!jobs[w].carry_last)
+            j.flags = detail::kJobGivesPrevious | (jobs[w].has_previous_normal ? detail::kJobHasPrevious : 0u);
         carry_last = carry_last || jobs[w].carry_last;
         j.previous_normal = {jobs[w].previous_normal.x, jobs[w].previous_normal.y, jobs[w].previous_normal.z, 0.0f};
         if (lod != nullptr) {
