@@ -453,9 +453,14 @@ void Soak::check_frame() {
             if (item.packed_nodes == nullptr && item.curve == nullptr)
                 fail("gpu-nodes item %zu (wire %u) has neither packed nodes nor a curve", k, id);
             if (item.packed_nodes != nullptr) {
-                if (item.packed_nodes->nodes.size() < 2) fail("wire %u: %zu packed nodes", id, item.packed_nodes->nodes.size());
-                for (const glm::vec4& n : item.packed_nodes->nodes)
+                const wire::PackedNodes& p = *item.packed_nodes;
+                if (p.node_count < 2) fail("wire %u: %zu packed nodes", id, p.node_count);
+                if (p.records.size() != (p.quantised ? p.node_count + 1 : 2 * p.node_count))
+                    fail("wire %u: %zu node records for %zu nodes", id, p.records.size(), p.node_count);
+                for (std::size_t j = 0; j < p.node_count; ++j) {
+                    const glm::vec4 n = p.node(j);
                     if (!std::isfinite(n.x + n.y + n.z + n.w) || !(n.w > 0.0f)) fail("wire %u: a packed node is not finite", id);
+                }
             }
             if (item.curve != nullptr && item.curve->segments.empty()) fail("wire %u: an empty curve", id);
         } else {

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <string>
 
@@ -18,7 +19,7 @@ bool gpu_builds(SplineKind kind) {
            kind == SplineKind::automatic;
 }
 
-Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes& out) {
+Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes& out, NodeFormat format) {
     if (!gpu_builds(spline.kind)) {
         return Status::error("the GPU curve pass does not build this spline kind (it builds linear, Catmull-Rom, "
                              "c2 and automatic wires)");
@@ -41,11 +42,10 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
     // The origin: the centre of the nodes' box (float offsets then span at most half the wire). The input's box:
     // the merged nodes are among the input's, so it holds them (and is theirs up to the merge tolerance).
     const glm::dvec3 lo = merged.lo, hi = merged.hi;
-    double chord = 0.0;
-    for (std::size_t k = 1; k <= chords.segs; ++k) chord = std::max(chord, chords.len[k]);
+    double chord = 0.0, shortest = HUGE_VAL;
+    for (std::size_t k = 1; k <= chords.segs; ++k) chord = std::max(chord, chords.len[k]), shortest = std::min(shortest, chords.len[k]);
     out.origin_m = float_point(0.5 * (lo + hi));
     out.half_diagonal_m = glm::length(glm::max(hi - out.origin_m, out.origin_m - lo));  // the box from the origin
-    out.max_chord_m = chord;
     out.closed = spline.closed;
     out.kind = spline.kind;
     out.alpha = static_cast<float>(spline.alpha);
@@ -82,16 +82,68 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
             out.extras.push_back(v);
         }
     }
-    // w: build_curve's Curve::radius_m (a node's radius, else the wire's).
+    // The radius: build_curve's Curve::radius_m (a node's radius, else the wire's).
     const float wire_radius = spline.radius_m > 0.0f ? spline.radius_m : kDefaultWireRadius_m;
-    out.nodes.resize(n);
-    out.max_radius_m = wire_radius;
-    for (std::size_t j = 0; j < n; ++j) {
+    const auto radius_of = [&](std::size_t j) {
         const float r = wn.radius_m.empty() ? 0.0f : wn.radius_m[source[j]];
-        const float radius = r > 0.0f ? r : wire_radius;
-        out.max_radius_m = std::max(out.max_radius_m, static_cast<double>(radius));
-        out.nodes[j] = glm::vec4(glm::vec3(curve[j] - out.origin_m), radius);
+        return r > 0.0f ? r : wire_radius;
+    };
+    bool one_radius = true;
+    out.max_radius_m = wire_radius;
+    if (!wn.radius_m.empty()) {
+        const float r0 = radius_of(0);
+        for (std::size_t j = 0; j < n; ++j) {
+            const float r = radius_of(j);
+            one_radius &= r == r0;
+            out.max_radius_m = std::max(out.max_radius_m, static_cast<double>(r));
+        }
     }
+    // The quantum 2^e: the smallest whose 21-bit integers hold the largest offset component (the box from the
+    // origin), kept if it holds the nodes within the file comment's bounds.
+    const glm::dvec3 reach = glm::max(hi - out.origin_m, out.origin_m - lo);
+    const double most = std::max({reach.x, reach.y, reach.z});
+    int e = std::ilogb(std::max(most, 1e-300)) - 19;
+    if (std::nearbyint(std::ldexp(most, -e)) > double(kQuantBias - 1)) ++e;
+    const double half_quantum = std::ldexp(0.5, e);
+    out.quantised = format == NodeFormat::fitted && one_radius && e >= -120 && half_quantum <= kQuantumOfRadius * radius_of(0) &&
+                    half_quantum <= kQuantumOfChord * shortest;
+    if (out.quantised && spline.kind == SplineKind::automatic) {
+        // The automatic spline reads each node's turn (tension.cpp: below ~1e-6 rad it is rounding noise of
+        // collinear nodes; above, a turn its neighbours do not predict is tensed). Nodes moved by at most delta
+        // turn a node by at most 2 delta (1 / h_in + 1 / h_out): quantised only where that stays below 1/16 of
+        // every node's turn (its sine, which is smaller), so the quantum can neither make nor unmake a turn.
+        const double delta = std::sqrt(3.0) * half_quantum;
+        const std::size_t first = spline.closed ? 0 : 1, end = spline.closed ? n : n - 1;
+        for (std::size_t i = first; i < end && out.quantised; ++i) {
+            const glm::dvec3 a(chords.ex[i], chords.ey[i], chords.ez[i]);
+            const glm::dvec3 b(chords.ex[i + 1], chords.ey[i + 1], chords.ez[i + 1]);
+            const double most_noise = 32.0 * delta * (1.0 / chords.len[i] + 1.0 / chords.len[i + 1]);
+            const glm::dvec3 c = glm::cross(a, b);
+            out.quantised = glm::dot(a, b) <= 0.0 || glm::dot(c, c) >= most_noise * most_noise;
+        }
+    }
+    out.quantum_exp = out.quantised ? e : 0;
+    out.node_count = n;
+    out.records.resize(out.quantised ? n + 1 : 2 * n);
+    if (out.quantised) {
+        out.records[0] = glm::uvec2(std::bit_cast<uint32_t>(radius_of(0)), static_cast<uint32_t>(e + int(kQuantExpBias)));
+        for (std::size_t j = 0; j < n; ++j) {
+            const glm::dvec3 o = curve[j] - out.origin_m;
+            const auto q = [&](double v) { return static_cast<uint32_t>(std::llrint(std::ldexp(v, -e)) + kQuantBias); };
+            const uint32_t x = q(o.x), y = q(o.y), z = q(o.z);
+            out.records[j + 1] = glm::uvec2(x | (y << kQuantBits), (y >> (32 - kQuantBits)) | (z << (2 * kQuantBits - 32)));
+        }
+        // The held nodes lie within half a quantum of the input on each axis: the cull's box and chords grow by it.
+        out.half_diagonal_m += std::sqrt(3.0) * half_quantum;
+        chord += 2.0 * std::sqrt(3.0) * half_quantum;
+    } else {
+        for (std::size_t j = 0; j < n; ++j) {
+            const glm::vec3 o(curve[j] - out.origin_m);
+            out.records[2 * j] = glm::uvec2(std::bit_cast<uint32_t>(o.x), std::bit_cast<uint32_t>(o.y));
+            out.records[2 * j + 1] = glm::uvec2(std::bit_cast<uint32_t>(o.z), std::bit_cast<uint32_t>(radius_of(j)));
+        }
+    }
+    out.max_chord_m = chord;
     // K of node_bounding_sphere: 2 |1 - t| (1 + |b|) (1 + |c|) at the worst node (t with the curvature-driven
     // tension, as the GPU gets it); 1 for linear.
     out.tangent_factor = 1.0;
@@ -108,6 +160,28 @@ Status pack_nodes(const WireNodes& wn, const SplineSettings& spline, PackedNodes
         }
     }
     return Status::success();
+}
+
+glm::vec4 PackedNodes::node(std::size_t j) const {
+    if (!quantised) {
+        const glm::uvec2 a = records[2 * j], b = records[2 * j + 1];
+        return {std::bit_cast<float>(a.x), std::bit_cast<float>(a.y), std::bit_cast<float>(b.x),
+                std::bit_cast<float>(b.y)};
+    }
+    const glm::uvec2 w = records[j + 1];
+    const uint32_t x = w.x & kQuantMask, y = ((w.x >> kQuantBits) | (w.y << (32 - kQuantBits))) & kQuantMask,
+                   z = (w.y >> (2 * kQuantBits - 32)) & kQuantMask;
+    const auto v = [&](uint32_t q) {
+        return std::ldexp(static_cast<float>(static_cast<int32_t>(q) - static_cast<int32_t>(kQuantBias)), quantum_exp);
+    };
+    return {v(x), v(y), v(z), std::bit_cast<float>(records[0].x)};
+}
+
+glm::dvec3 PackedNodes::held(const glm::dvec3& world_m) const {
+    const glm::dvec3 o = world_m - origin_m;
+    if (!quantised) return origin_m + float_point(o);
+    const auto q = [&](double v) { return std::ldexp(std::nearbyint(std::ldexp(v, -quantum_exp)), quantum_exp); };
+    return origin_m + glm::dvec3(q(o.x), q(o.y), q(o.z));
 }
 
 glm::dvec3 float_point(const glm::dvec3& p) {

@@ -26,8 +26,9 @@ enum class UploadPath : uint8_t {
     cpu_mesh,   ///< vertices + indices built on the CPU (TubeVertex, 32 bytes a vertex)
     gpu_rings,  ///< ring records only (packed to 28 bytes a ring by the renderer, retained on the GPU while a
                 ///< wire's rings are unchanged); the vertex shader expands sides from gl_VertexID
-    /// nodes only (issue 30): the nodes of wires whose nodes changed, 16 bytes a node plus a 64-byte header, and
-    /// 4 bytes a visible wire; curve, LOD (at node resolution), frames, rings and the draw's arguments are
+    /// nodes only: the nodes of wires whose nodes changed (8 bytes a node plus 8 where the wire's nodes are
+    /// quantised, else 16; packed_nodes.hpp) plus a 64-byte header, and 4 bytes a visible wire; curve, LOD (below
+    /// the node resolution too), frames, rings and the draw's arguments are
     /// computed on the GPU (wire/render's nodes path), the gpu-rings vertex shader draws them
     gpu_nodes,
 };

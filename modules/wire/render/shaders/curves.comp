@@ -6,7 +6,8 @@
 // in float); node j writes its incoming segment (put_segment), holding its outgoing tangent for the next node.
 layout(local_size_x = 64) in;
 layout(std430, binding = CURVE_HEADERS) readonly buffer Headers { GpuCurveHeader headers[]; };
-layout(std430, binding = CURVE_NODES) readonly buffer Nodes { vec4 nodes[]; };  // xyz: offset from the origin; w: radius
+// The nodes in 8-byte units, float or quantised (gpu_records.h, GpuCurveHeader::node_first): node() and radius().
+layout(std430, binding = CURVE_NODES) readonly buffer Nodes { uvec2 nodes[]; };
 layout(std430, binding = CURVE_SEGMENTS) writeonly buffer Segments { vec4 segments[]; };  // 4 per segment: see put_segment
 layout(std430, binding = CURVE_SCRATCH) buffer Scratch { dvec4 scratch[]; };  // c2: 2 per node (solve state, then D)
 // Per-node tension, bias, continuity (vec4 a node), then stretch (4 segments a vec4), from GpuCurveHeader.extra_first.
@@ -23,7 +24,26 @@ uniform uint u_list_first;
 uniform bool u_persist;
 uniform bool u_motion;
 
-vec3 node(GpuCurveHeader h, uint j) { return nodes[h.node_first + j].xyz; }
+// Curve node j's offset from the origin, and its radius.
+vec3 node(GpuCurveHeader h, uint j) {
+    if ((h.flags & kHeaderQuantised) != 0u) {
+        uvec2 w = nodes[h.node_first + 1u + j];
+        uvec3 q = uvec3(w.x, (w.x >> kQuantBits) | (w.y << (32u - kQuantBits)), w.y >> (2u * kQuantBits - 32u));
+        ivec3 v = ivec3(q & uvec3(kQuantMask)) - ivec3(int(kQuantBias));
+        return ldexp(vec3(v), ivec3(int(nodes[h.node_first].y) - int(kQuantExpBias)));
+    }
+    uint a = h.node_first + 2u * j;
+    return uintBitsToFloat(uvec3(nodes[a], nodes[a + 1u].x));
+}
+float radius(GpuCurveHeader h, uint j) {
+    bool quantised = (h.flags & kHeaderQuantised) != 0u;
+    return uintBitsToFloat(quantised ? nodes[h.node_first].x : nodes[h.node_first + 2u * j + 1u].y);
+}
+// Given segments: vec4 k of the wire's (two units each).
+vec4 given(GpuCurveHeader h, uint k) {
+    uint a = h.node_first + 2u * k;
+    return uintBitsToFloat(uvec4(nodes[a], nodes[a + 1u]));
+}
 
 // c2 (kind 2): node tangents per unit chord D from the C2 spline's tangent system with chordal knots (rows
 // a D[j-1] + 2 D[j] + c D[j+1] = 3 (a e_in + c e_out), a = h_out / (h_in + h_out), c = h_in / (h_in + h_out));
@@ -230,8 +250,8 @@ float seg_stretch(GpuCurveHeader h, uint k) {
 }
 void put_segment(GpuCurveHeader h, uint k, vec3 p0, vec3 t0, vec3 t1, vec3 chord_k) {
     uint s = 4u * (h.segment_first + k);
-    segments[s] = vec4(p0, nodes[h.node_first + k].w);
-    segments[s + 1u] = vec4(t0 / 3.0, nodes[h.node_first + (k + 1u) % h.node_count].w);
+    segments[s] = vec4(p0, radius(h, k));
+    segments[s + 1u] = vec4(t0 / 3.0, radius(h, (k + 1u) % h.node_count));
     segments[s + 2u] = vec4(chord_k - (t0 + t1) / 3.0, seg_stretch(h, k));
     segments[s + 3u] = vec4(t1 / 3.0, 0.0);
 }

@@ -17,7 +17,7 @@ void main() {
     if (u_persist) slot_headers[h.slot] = h;
     if ((h.flags & kHeaderGivenSegments) != 0u) {  // a blended curve: its segments as they came
         uint segs = (h.flags & kHeaderClosed) != 0u ? h.node_count : h.node_count - 1u;
-        for (uint k = 0u; k < 4u * segs; ++k) segments[4u * h.segment_first + k] = nodes[h.node_first + k];
+        for (uint k = 0u; k < 4u * segs; ++k) segments[4u * h.segment_first + k] = given(h, k);
         return;
     }
     uint n = h.node_count;
@@ -33,8 +33,8 @@ void main() {
             double keep0 = keep_at(h, k), keep1 = keep_at(h, (k + 1u) % n);
             dvec3 t0 = scratch[sidx(h, k)].xyz * (len * keep0), t1 = scratch[sidx(h, (k + 1u) % n)].xyz * (len * keep1);
             uint s = 4u * (h.segment_first + k);
-            segments[s] = vec4(vec3(p0), nodes[h.node_first + k].w);
-            segments[s + 1u] = vec4(vec3(t0 / 3.0), nodes[h.node_first + (k + 1u) % n].w);
+            segments[s] = vec4(vec3(p0), radius(h, k));
+            segments[s + 1u] = vec4(vec3(t0 / 3.0), radius(h, (k + 1u) % n));
             segments[s + 2u] = vec4(vec3((p1 - p0) - (t0 + t1) / 3.0), seg_stretch(h, k));
             segments[s + 3u] = vec4(vec3(t1 / 3.0), 0.0);
         }

@@ -31,7 +31,15 @@ WIRE_CONST uint kHeaderStretch = 32u;        // per-segment stretch in the extra
 WIRE_CONST uint kHeaderGivenSegments = 64u;  // the segments are given (a blend): 4 vec4 each at node_first
 WIRE_CONST uint kHeaderFitMotion = 128u;     // the curve pass fits the motion (and writes it on the slot's copy)
 WIRE_CONST uint kHeaderSidesShift = 8u, kHeaderSidesMask = 255u;  // bits 8-15: the wire's most sides (0: LOD's)
-WIRE_CONST uint kHeaderMaterialShift = 16u;                        // bits 16-31: the material
+WIRE_CONST uint kHeaderQuantised = 65536u;                         // bit 16: the nodes are 8-byte fixed point
+WIRE_CONST uint kHeaderMaterialShift = 17u;                        // bits 17-31: the material
+WIRE_CONST uint kMaxMaterials = 32768u;
+// A wire's nodes at node_first, in 8-byte units (uvec2) of the node array. Float records: 2 units a node, the
+// offset from the origin and the radius as floats (x, y, z, r). kHeaderQuantised: one unit holding the wire's radius
+// (a float's bits) and its quantum's exponent e + kQuantExpBias, then one unit a node: its offset as three 21-bit
+// integers q (x in bits 0-20, y in 21-41, z in 42-62 of the 64), biased by kQuantBias: offset = (q - kQuantBias) 2^e
+// metres, exact in float. Given segments (kHeaderGivenSegments): 4 vec4 a segment, 2 units each.
+WIRE_CONST uint kQuantBits = 21u, kQuantMask = 2097151u, kQuantBias = 1048576u, kQuantExpBias = 256u;
 WIRE_CONST uint kKindLinear = 0u, kKindCatmullRom = 1u, kKindC2 = 2u, kKindAutomatic = 3u;
 
 // The curve pass's per-slot motion reference: motion_reference's samples of the last upload's curve nodes.

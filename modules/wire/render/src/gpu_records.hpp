@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "wire/packed_nodes.hpp"
+
 namespace wire::render::detail {
 
 using uint = std::uint32_t;
@@ -30,5 +32,8 @@ static_assert(sizeof(MotionRef) == 192, "the curve pass's std430 motion referenc
 static_assert(sizeof(Job) == 64, "the ring pass's std430 job record");
 static_assert(sizeof(SlotState) == 32, "the ring pass's std430 slot record");
 static_assert(sizeof(GpuDraw) == 32, "the std430 draw record");
+static_assert(kQuantBits == wire::kQuantBits && kQuantMask == wire::kQuantMask && kQuantBias == wire::kQuantBias &&
+                  kQuantExpBias == wire::kQuantExpBias,
+              "pack_nodes' quantised format is the one the curve program decodes");
 
 }  // namespace wire::render::detail

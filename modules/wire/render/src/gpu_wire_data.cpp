@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <numbers>
 
@@ -20,7 +21,7 @@ GpuCurveHeader packed_header(const PackedNodes& p, uint32_t segment_first, uint3
                              bool caps, const WireMotion& motion, uint32_t node_first, uint32_t extra_first) {
     GpuCurveHeader h;
     h.node_first = node_first;
-    h.node_count = static_cast<uint32_t>(p.nodes.size());
+    h.node_count = static_cast<uint32_t>(p.node_count);
     h.segment_first = segment_first;
     const uint32_t kind = p.kind == SplineKind::linear      ? kKindLinear
                           : p.kind == SplineKind::c2        ? kKindC2
@@ -28,7 +29,8 @@ GpuCurveHeader packed_header(const PackedNodes& p, uint32_t segment_first, uint3
                                                             : kKindCatmullRom;
     h.flags = (p.closed ? kHeaderClosed : 0u) | (kind << kHeaderKindShift) | (caps ? kHeaderCaps : 0u) |
               (p.per_node_kb ? kHeaderPerNode : 0u) | (p.stretch ? kHeaderStretch : 0u) |
-              (motion.fit ? kHeaderFitMotion : 0u) | (material << kHeaderMaterialShift);
+              (motion.fit ? kHeaderFitMotion : 0u) | (p.quantised ? kHeaderQuantised : 0u) |
+              (material << kHeaderMaterialShift);
     h.kb = {p.alpha, p.tension, p.bias, p.continuity};
     h.extra_first = extra_first;
     h.slot = slot;
@@ -43,7 +45,7 @@ void append_packed(const PackedNodes& p, uint32_t segment_first, uint32_t slot, 
     out.headers.push_back(packed_header(p, segment_first, slot, material, caps, motion,
                                         static_cast<uint32_t>(out.nodes.size()),
                                         static_cast<uint32_t>(out.extras.size())));
-    out.nodes.insert(out.nodes.end(), p.nodes.begin(), p.nodes.end());
+    out.nodes.insert(out.nodes.end(), p.records.begin(), p.records.end());
     out.extras.insert(out.extras.end(), p.extras.begin(), p.extras.end());
 }
 
@@ -80,11 +82,16 @@ void append_segments(const Curve& curve, uint32_t segment_first, uint32_t slot, 
     for (std::size_t k = 0; k < curve.segment_count(); ++k) {
         const CubicBezier& c = curve.segments[k];
         const float stretch = k < curve.stretch.size() ? curve.stretch[k] : 1.0f;
-        out.nodes.emplace_back(glm::vec3(c.b0 - origin), radius(k));
-        out.nodes.emplace_back(glm::vec3(c.b1 - c.b0), radius(k + 1));
-        out.nodes.emplace_back(glm::vec3(c.b2 - c.b1), stretch);
-        out.nodes.emplace_back(glm::vec3(c.b3 - c.b2), 0.0f);
+        push_vec4(out.nodes, glm::vec4(glm::vec3(c.b0 - origin), radius(k)));
+        push_vec4(out.nodes, glm::vec4(glm::vec3(c.b1 - c.b0), radius(k + 1)));
+        push_vec4(out.nodes, glm::vec4(glm::vec3(c.b2 - c.b1), stretch));
+        push_vec4(out.nodes, glm::vec4(glm::vec3(c.b3 - c.b2), 0.0f));
     }
+}
+
+void push_vec4(std::vector<glm::uvec2>& nodes, const glm::vec4& v) {
+    nodes.emplace_back(std::bit_cast<uint32_t>(v.x), std::bit_cast<uint32_t>(v.y));
+    nodes.emplace_back(std::bit_cast<uint32_t>(v.z), std::bit_cast<uint32_t>(v.w));
 }
 
 void set_lod_uniforms(const engine::gfx::Program& program, const LodView& v, const LodSettings& st) {

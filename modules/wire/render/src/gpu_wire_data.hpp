@@ -1,5 +1,5 @@
 // Internal: what the GPU wire passes share: the records (gpu_records.hpp), the binding points, and the CPU side
-// of a wire's upload: its curve nodes (float offsets from its origin, the radius in w), header and extras
+// of a wire's upload: its curve nodes (wire::PackedNodes' records), header and extras
 // (per-node tension, bias, continuity; per-segment stretch). The renderer's nodes path and the test passes
 // (wire::render_testing) use them.
 #pragma once
@@ -13,6 +13,7 @@
 
 #include "gpu_records.hpp"
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -62,7 +63,7 @@ struct WireMotion {
 /// One frame's upload of wires for the curve pass.
 struct WireUpload {
     std::vector<GpuCurveHeader> headers;
-    std::vector<glm::vec4> nodes;   ///< 16 bytes a curve node
+    std::vector<glm::uvec2> nodes;  ///< the node array in 8-byte units (PackedNodes::records; given segments)
     std::vector<glm::vec4> extras;  ///< only for wires that carry per-node kb or stretch
     void clear() { headers.clear(), nodes.clear(), extras.clear(); }
 };
@@ -84,6 +85,9 @@ Status append_wire(const WireNodes& nodes, const SplineSettings& spline, uint32_
 /// The ring LOD program's uniforms for a view and settings (LodSettings' defaults applied as update_lod does), on
 /// `program`, the program in use.
 void set_lod_uniforms(const engine::gfx::Program& program, const LodView& view, const LodSettings& settings);
+
+/// Appends `v` to a node array (two 8-byte units).
+void push_vec4(std::vector<glm::uvec2>& nodes, const glm::vec4& v);
 
 /// Appends a curve given as segments (a wire in a pop-free blend): 4 vec4 a segment in `nodes` (b0 from the
 /// origin with its start node's radius in w; b1 - b0 with the end node's radius; b2 - b1 with the stretch;

@@ -225,7 +225,7 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
-        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
+        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->node_count >= 2;
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         ++visible;
         const auto it = slots_.find(item.wire_id);
@@ -240,12 +240,12 @@ std::size_t NodePath::upload_bytes(const DrawList& list) {
             continue;
         }
         if (packed) {
-            nodes += 16 * item.packed_nodes->nodes.size();
+            nodes += 8 * item.packed_nodes->records.size();
             extras += 16 * item.packed_nodes->extras.size();
             continue;
         }
         const std::size_t n = item.nodes->size();
-        nodes += 16 * n;
+        nodes += 16 * n;  // the float format's, at most (packed here by pack_nodes)
         extras += 16 * n + 16 * ((n + 3) / 4);
     }
     // prepare()'s layout: each array at least one record (a buffer range of 0 bytes cannot be bound).

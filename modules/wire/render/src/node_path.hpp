@@ -132,7 +132,7 @@ private:
     /// The ring pass's counts of kReadbackSlots frames ago, once the fence after their copy has signalled: the ring
     /// buffer's size, and the coarse wires and triangles they report.
     void read_counts(DrawStats& stats);
-    /// What gather() found: vec4s for the region's node and extra arrays, segments of the visible wires.
+    /// What gather() found: 8-byte units and vec4s for the region's node and extra arrays, segments of the visible wires.
     struct Gathered {
         std::size_t node_total = 0, extra_total = 0, segments_visible = 0;
     };
@@ -176,10 +176,10 @@ private:
     std::vector<uint8_t> material_used_;
     std::vector<uint8_t> changed_item_;  ///< per item of the list upload_bytes() saw: it sends its nodes
     std::vector<Slot*> item_slot_;       ///< per item: its slot when upload_bytes() found one (map nodes are stable)
-    /// A run of vec4s the frame copies into the region's node (or extra) array at `dst`: from `src`, or (src null)
-    /// from the frame's own nodes at `own` (those made on the render thread).
+    /// A run of 8-byte node units (or extra vec4s) the frame copies into the region's node (or extra) array at
+    /// `dst`: from `src`, or (src null) from the frame's own at `own` (those made on the render thread).
     struct Piece {
-        const glm::vec4* src = nullptr;
+        const void* src = nullptr;
         std::size_t own = 0, count = 0, dst = 0;
     };
     std::vector<Piece> node_pieces_, extra_pieces_;

@@ -55,7 +55,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     };
 
     // The region: headers | nodes | extras | visible slots of the unchanged wires.
-    const std::size_t real_node_bytes = node_total * sizeof(glm::vec4);
+    const std::size_t real_node_bytes = node_total * sizeof(glm::uvec2);
     const std::size_t real_extra_bytes = extra_total * sizeof(glm::vec4);
     const std::size_t header_bytes = std::max<std::size_t>(up.headers.size() * sizeof(GpuCurveHeader), 64);
     const std::size_t node_bytes = std::max<std::size_t>(real_node_bytes, sizeof(glm::vec4));
@@ -75,13 +75,13 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     if (!up.headers.empty()) std::memcpy(base, up.headers.data(), up.headers.size() * sizeof(GpuCurveHeader));
     // The nodes, copied once from where they are (the systems' packed nodes) into the region: on worker
     // threads when there are many (the one per-byte cost of the frame on the render thread).
-    const auto copy = [&](const std::vector<Piece>& pieces, const std::vector<glm::vec4>& own, std::byte* to,
-                          std::size_t first, std::size_t last) {
+    const auto copy = [&](const std::vector<Piece>& pieces, const auto& own, std::byte* to, std::size_t first,
+                          std::size_t last) {
+        constexpr std::size_t unit = sizeof(own[0]);
         for (std::size_t k = first; k < last; ++k) {
             const Piece& piece = pieces[k];
-            const glm::vec4* from = piece.src != nullptr ? piece.src : own.data() + piece.own;
-            if (piece.count != 0)
-                std::memcpy(to + piece.dst * sizeof(glm::vec4), from, piece.count * sizeof(glm::vec4));
+            const void* from = piece.src != nullptr ? piece.src : own.data() + piece.own;
+            if (piece.count != 0) std::memcpy(to + piece.dst * unit, from, piece.count * unit);
         }
     };
     if (real_node_bytes >= (std::size_t{256} << 10) && node_pieces_.size() >= 64) {
@@ -117,9 +117,10 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     // that does not fit is drawn with, until the buffer has grown from the count read back).
     const std::size_t reserve = segments_visible + visible_;
     const std::size_t chunk_capacity = (ring_capacity_ + reserve) / kChunkBands + 6 * visible_ + 1;
-    // c2 scratch, 2 dvec4 a node: the list's wires', then the stream's (at an aligned offset).
+    // c2 scratch, 2 dvec4 an 8-byte node unit (the curve program indexes it by node_first): the list's wires',
+    // then the stream's (at an aligned offset; 2 units a node).
     const std::size_t stream_scratch_at = changed_ ? align_up(node_total * 2 * 32) : 0;
-    const std::size_t scratch_need = stream_scratch_at + (stream_changed_ ? stream_nodes() * 2 * 32 : 0);
+    const std::size_t scratch_need = stream_scratch_at + (stream_changed_ ? stream_nodes() * 2 * 2 * 32 : 0);
     const auto need = [&](gfx::Buffer& b, std::size_t& capacity, std::size_t bytes, const char* label) {
         return ensure(b, capacity, bytes, label, false);
     };

@@ -35,7 +35,7 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                                     DrawStats& stats) {
     Gathered g;
     std::size_t& node_total = g.node_total;
-    std::size_t& extra_total = g.extra_total;  // vec4s in the region's node and extra arrays
+    std::size_t& extra_total = g.extra_total;  // 8-byte units and vec4s in the region's node and extra arrays
     std::size_t& segments_visible = g.segments_visible;
     up.clear();
     node_pieces_.clear(), extra_pieces_.clear();
@@ -45,15 +45,16 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
     for (std::size_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
-        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
+        const bool packed = item.packed_nodes != nullptr && item.packed_nodes->node_count >= 2;
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
-        if (item.material >= materials) {
+        if (item.material >= std::min<std::size_t>(materials, kMaxMaterials)) {
             // The other paths assert this; here the GPU would index past its buckets: skipped, said once.
             ++stats.wires_skipped;
             if (stats.status.ok())
                 stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": material " +
                                              std::to_string(item.material) + " is out of range (" +
-                                             std::to_string(materials) + " materials): not drawn");
+                                             std::to_string(materials) + " materials, the nodes path draws " +
+                                             std::to_string(kMaxMaterials) + " at most): not drawn");
             continue;
         }
         Slot* known = i < item_slot_.size() ? item_slot_[i] : nullptr;
@@ -98,8 +99,8 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
                                                    item.caps, {item.motion, item.fit_motion},
                                                    static_cast<uint32_t>(node_total),
                                                    static_cast<uint32_t>(extra_total)));
-                node_pieces_.push_back({p.nodes.data(), 0, p.nodes.size(), node_total});
-                node_total += p.nodes.size();
+                node_pieces_.push_back({p.records.data(), 0, p.records.size(), node_total});
+                node_total += p.records.size();
                 if (!p.extras.empty()) {
                     extra_pieces_.push_back({p.extras.data(), 0, p.extras.size(), extra_total});
                     extra_total += p.extras.size();

@@ -141,9 +141,10 @@ bool second_look(StreamState& s, uint32_t index, std::size_t n, Position positio
         s.refuse(index, st.index, st.message);
         return false;
     }
-    std::memcpy(dst, packed.nodes.data(), packed.nodes.size() * sizeof(glm::vec4));
-    w.count = static_cast<uint32_t>(packed.nodes.size());
-    w.unmerged = packed.nodes.size() == n;
+    // The stream's records are floats (a quantised packing's nodes decoded: what the ECS path would send).
+    for (std::size_t j = 0; j < packed.node_count; ++j) dst[j] = packed.node(j);
+    w.count = static_cast<uint32_t>(packed.node_count);
+    w.unmerged = packed.node_count == n;
     for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(packed.origin_m[a]);
     for (int a = 0; a < 3; ++a) w.centre[a] = static_cast<float>(packed.origin_m[a]);  // a float point
     w.has_centre = true;
@@ -174,7 +175,7 @@ bool finish_write(StreamState& s, uint32_t index, std::size_t first, std::size_t
         for (int a = 0; a < 3; ++a) w.centre[a] = static_cast<float>(centre[a]);
         w.has_centre = true;
     }
-    w.node_first = static_cast<uint32_t>(first);
+    w.node_first = static_cast<uint32_t>(2 * first);  // 8-byte units: a float record is two
     s.accepted(w, index);
     return true;
 }

@@ -164,7 +164,7 @@ std::size_t plan_nodes_frame(const DrawList& list, NodesPlan& plan) {
     thread_local PackedNodes packed;
     for (const DrawItem& item : list.items) {
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
-        const bool has_packed = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() >= 2;
+        const bool has_packed = item.packed_nodes != nullptr && item.packed_nodes->node_count >= 2;
         if (!has_curve && !has_packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
         auto [it, fresh] = plan.sent.try_emplace(item.wire_id);
         NodesPlan::Sent& s = it->second;
@@ -179,9 +179,9 @@ std::size_t plan_nodes_frame(const DrawList& list, NodesPlan& plan) {
         if (has_curve) {
             wire_bytes += 64 * item.curve->segment_count();
         } else if (has_packed) {
-            wire_bytes += 16 * (item.packed_nodes->nodes.size() + item.packed_nodes->extras.size());
+            wire_bytes += 8 * item.packed_nodes->records.size() + 16 * item.packed_nodes->extras.size();
         } else if (pack_nodes(*item.nodes, item.spline, packed).ok()) {
-            wire_bytes += 16 * (packed.nodes.size() + packed.extras.size());
+            wire_bytes += 8 * packed.records.size() + 16 * packed.extras.size();
         } else {
             plan.sent.erase(it);  // not drawn; sent again next frame
             continue;

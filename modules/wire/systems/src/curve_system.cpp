@@ -129,7 +129,7 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 prefetch_lines<false>(nodes.positions.data(), nodes.positions.size() * sizeof(glm::dvec3));
                 prefetch_lines<true>(ahead.previous_nodes.positions.data(),
                                      ahead.previous_nodes.positions.size() * sizeof(glm::dvec3));
-                prefetch_lines<true>(ahead.packed.nodes.data(), ahead.packed.nodes.size() * sizeof(glm::vec4));
+                prefetch_lines<true>(ahead.packed.records.data(), ahead.packed.records.size() * sizeof(glm::uvec2));
             }
             CurveJob& job = jobs[i];
             CurveStep step;

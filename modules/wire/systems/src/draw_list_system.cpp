@@ -64,7 +64,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
                 item.curve = &curve->curve;
             } else {
                 item.nodes = &curve->previous_nodes;
-                if (curve->packed.nodes.size() >= 2) item.packed_nodes = &curve->packed;
+                if (curve->packed.node_count >= 2) item.packed_nodes = &curve->packed;
             }
             item.spline = spline_of(*style);
             item.nodes_generation = curve->generation;
@@ -74,7 +74,7 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
                 // GPU fits it where matching by index is matching by id (packed nodes, none merged, now and the
                 // last time); here otherwise (an id event, merged nodes, a blended curve).
                 const WireNodes& nodes = curve->previous_nodes;
-                const bool unmerged = item.packed_nodes != nullptr && item.packed_nodes->nodes.size() == nodes.size();
+                const bool unmerged = item.packed_nodes != nullptr && item.packed_nodes->node_count == nodes.size();
                 if (unmerged && sent->sent_unmerged && samples_match(sent->motion, nodes)) {
                     item.fit_motion = true;
                 } else if (sent->motion.count != 0) {

@@ -24,6 +24,7 @@
 #include "engine/platform/capture.hpp"
 #include "engine/platform/context.hpp"
 #include "engine/scene/camera.hpp"
+#include "wire/packed_nodes.hpp"
 #include "wire/draw.hpp"
 #include "wire/lod.hpp"
 #include "wire/rings.hpp"
@@ -199,8 +200,14 @@ TEST_F(DrawnRingsTest, NodesPathRingsMatchTheCpuReferenceOverRandomFamilies) {
     std::string worst_name, worst_frame_name;
     for (uint32_t seed = 1; seed <= kWires; ++seed) {
         const FamilyWire w = family_wire(seed);
+        // The reference is built from the nodes the GPU holds (pack_nodes' quantised or float-rounded nodes), so
+        // this measures the GPU's arithmetic; the picture test below compares with the double nodes.
+        wire::PackedNodes packed;
+        ASSERT_TRUE(wire::pack_nodes(w.nodes, w.spline, packed).ok()) << w.name;
+        wire::WireNodes held = w.nodes;
+        for (glm::dvec3& p : held.positions) p = packed.held(p);
         wire::Curve curve;
-        ASSERT_TRUE(wire::build_curve(w.nodes, w.spline, curve).ok()) << w.name;
+        ASSERT_TRUE(wire::build_curve(held, w.spline, curve).ok()) << w.name;
         const wire::LodView view = wire::LodView::perspective(w.camera.position, w.camera.target, w.camera.up,
                                                               w.camera.fov_y_rad, kWidth, kHeight, w.camera.near_m,
                                                               w.camera.far_m);

@@ -2,7 +2,8 @@
 // random families (catenaries, taut zig-zags, helices, wrapped cables, closed loops), every kind the pass builds
 // (linear; Catmull-Rom uniform, centripetal, chordal and random alpha with random wire-wide tension, bias and
 // continuity, per-node values and curvature-driven tension; c2, open and closed), at random scales and up to 1e5 m from the origin. Every control point of every segment is
-// compared with build_curve of the nodes the GPU holds (rounded to float relative to the wire's origin); the
+// compared with build_curve of the nodes the GPU holds (rounded relative to the wire's origin to float, or to its
+// quantum where pack_nodes quantises it: PackedNodes::held); the
 // error is stated relative to the wire's extent (its largest node distance from that origin): float rounding of
 // an offset is 2^-24 of the extent (6e-8), and a control point is a short sum of such offsets and products.
 #include "wire/render/testing/gpu_curve_pass.hpp"
@@ -12,7 +13,7 @@
 #include "wire/rings.hpp"
 #include "wire/lod.hpp"
 #include "wire/motion.hpp"
-#include "wire/packed_nodes.hpp"  // float_point
+#include "wire/packed_nodes.hpp"
 #include "wire/tessellate.hpp"
 
 #include "wire/spline.hpp"
@@ -70,10 +71,14 @@ struct Kind {
     SplineSettings spline;
 };
 
-// The nodes the GPU holds: each rounded to float relative to the wire's origin.
-WireNodes rounded_to(const WireNodes& w, const glm::dvec3& origin_m) {
+// The nodes the GPU holds: each as pack_nodes rounds it relative to the wire's origin (to float, or to the wire's
+// quantum where it quantises the wire).
+WireNodes rounded_to(const WireNodes& w, const SplineSettings& s, const glm::dvec3& origin_m) {
+    PackedNodes packed;
+    EXPECT_TRUE(pack_nodes(w, s, packed).ok());
+    EXPECT_EQ(packed.origin_m, origin_m);
     WireNodes rounded = w;
-    for (glm::dvec3& p : rounded.positions) p = origin_m + float_point(p - origin_m);
+    for (glm::dvec3& p : rounded.positions) p = packed.held(p);
     return rounded;
 }
 
@@ -184,7 +189,7 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
     std::vector<double> errors;  // per wire: max control-point error / extent
     double worst = 0.0;
     std::string worst_case;
-    std::size_t segments = 0;
+    std::size_t segments = 0, quantised_total = 0;
     for (const Kind& kind : kinds) {
         double kind_worst = 0.0, kind_rounding = 0.0;
         std::vector<GpuCurveWire> inputs;
@@ -199,10 +204,17 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
         std::vector<GpuCurveResult> results;
         pass->read_segments(results);
         ASSERT_EQ(results.size(), wires.size());
-        // The upload is nodes (16 B each) and a 64-byte header per wire.
-        std::size_t nodes = 0;
-        for (const WireNodes& w : wires) nodes += w.size();
-        EXPECT_EQ(pass->node_bytes(), 16 * nodes);
+        // The upload is nodes (quantised: 8 B each and 8 a wire; else 16 B each) and a 64-byte header per wire.
+        std::size_t node_bytes = 0, quantised = 0;
+        for (std::size_t i = 0; i < wires.size(); ++i) {
+            PackedNodes packed;
+            ASSERT_TRUE(pack_nodes(wires[i], settings[i], packed).ok());
+            const std::size_t n = wires[i].size();  // the families merge nothing
+            node_bytes += packed.quantised ? 8 * n + 8 : 16 * n;
+            quantised += packed.quantised ? 1 : 0;
+        }
+        EXPECT_EQ(pass->node_bytes(), node_bytes);
+        quantised_total += quantised;
         EXPECT_EQ(pass->header_bytes(), 64 * wires.size());
         // Extras: per-node tension, bias and continuity (16 bytes a curve node, only for Catmull-Rom wires that
         // carry them) and stretch (4 bytes a segment, in vec4s, for wires that carry it).
@@ -229,7 +241,7 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
             // the curve is reported beside it: the c2 spline's not-a-knot ends amplify it by the ratio of the
             // first two chords (a 4-node wire with 100:1 chords moves 1e-4 of its extent), whatever computes it.
             Curve cpu, exact;
-            ASSERT_TRUE(build_curve(rounded_to(wires[i], gpu.origin_m), settings[i], cpu).ok()) << labels[i];
+            ASSERT_TRUE(build_curve(rounded_to(wires[i], settings[i], gpu.origin_m), settings[i], cpu).ok()) << labels[i];
             ASSERT_TRUE(build_curve(wires[i], settings[i], exact).ok()) << labels[i];
             ASSERT_EQ(gpu.segments.size(), cpu.segments.size()) << labels[i];
             double extent = 0.0;
@@ -259,8 +271,9 @@ TEST(GpuCurves, MatchTheCpuReferenceOverRandomFamilies) {
     std::vector<double> sorted = errors;
     std::sort(sorted.begin(), sorted.end());
     const auto q = [&](double f) { return sorted[static_cast<std::size_t>(f * (sorted.size() - 1))]; };
-    std::printf("gpu curves: %zu wires, %zu segments | control point error / extent: median %.3g, p90 %.3g, max %.3g (%s)\n",
-                errors.size(), segments, q(0.5), q(0.9), q(1.0), worst_case.c_str());
+    std::printf("gpu curves: %zu wires (%zu quantised), %zu segments | control point error / extent: median %.3g, p90 "
+                "%.3g, max %.3g (%s)\n",
+                errors.size(), quantised_total, segments, q(0.5), q(0.9), q(1.0), worst_case.c_str());
     // 32 float roundings of the extent (2^-24 each; the output's own rounding is 1 of them). Measured: at most 9
     // (5.3e-7, c2 on a 4-node wire with 100:1 chords; 8.6e-5 while its solve was in float).
     EXPECT_LE(worst, 32.0 * std::ldexp(1.0, -24)) << worst_case;
@@ -363,7 +376,7 @@ TEST_F(GpuRings, MatchTheCpuReferenceOverRandomFamilies) {
         std::vector<GpuRingJob> jobs(wires.size());
         std::vector<std::string> how(wires.size());
         for (std::size_t i = 0; i < wires.size(); ++i) {
-            ASSERT_TRUE(build_curve(rounded_to(wires[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
+            ASSERT_TRUE(build_curve(rounded_to(wires[i], settings[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
             const std::size_t n = cpu[i].segment_count();
             const int mode = rng.integer(0, 2);
             if (mode == 0) {
@@ -543,7 +556,7 @@ TEST_F(GpuRings, CarryTheFirstFrameWithTheWiresMotion) {
         std::vector<Curve> cpu(wires.size());
         std::vector<GpuRingJob> jobs(wires.size());
         for (std::size_t i = 0; i < wires.size(); ++i) {
-            ASSERT_TRUE(build_curve(rounded_to(nodes[i], segs[i].origin_m), wires[i].spline, cpu[i]).ok())
+            ASSERT_TRUE(build_curve(rounded_to(nodes[i], wires[i].spline, segs[i].origin_m), wires[i].spline, cpu[i]).ok())
                 << wires[i].label;
             if (f == 0) wires[i].counts.assign(cpu[i].segment_count(), static_cast<uint32_t>(rng.integer(1, 6)));
             jobs[i].counts = wires[i].counts;
@@ -645,7 +658,7 @@ TEST_F(GpuRings, LodMatchesUpdateLod) {
     curves->read_segments(segs);
     std::vector<Curve> cpu(wires.size());
     for (std::size_t i = 0; i < wires.size(); ++i) {
-        ASSERT_TRUE(build_curve(rounded_to(wires[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
+        ASSERT_TRUE(build_curve(rounded_to(wires[i], settings[i], segs[i].origin_m), settings[i], cpu[i]).ok()) << labels[i];
     }
 
     // Both LODs, the same shots for each: at node resolution, and below it (the spans).

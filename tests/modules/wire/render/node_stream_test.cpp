@@ -162,13 +162,17 @@ TEST_F(NodeStreamTest, DrawsTheListsRingsOverRandomFamiliesWhileMoving) {
     for (int f = 0; f < kFrames; ++f) {
         std::vector<wire::WireNodes> nodes;
         for (const StreamCase& c : cases) nodes.push_back(at_frame(c, f));
-        // The list: one item a wire, the motion fitted on the GPU by index (as the systems ask when ids match).
+        // The list: one item a wire, the motion fitted on the GPU by index (as the systems ask when ids match),
+        // its nodes packed as the stream writes them (float records).
         DrawList list = nodes_list();
+        std::vector<wire::PackedNodes> packed(cases.size());
         for (std::size_t k = 0; k < cases.size(); ++k) {
             DrawItem item;
             item.wire_id = 1000 + k;
             item.nodes = &nodes[k];
             item.spline = wire::SplineSettings{.kind = cases[k].style.kind, .radius_m = cases[k].style.radius_m};
+            ASSERT_TRUE(wire::pack_nodes(nodes[k], item.spline, packed[k], wire::NodeFormat::floats).ok());
+            item.packed_nodes = &packed[k];
             item.nodes_generation = static_cast<uint64_t>(f + 1);
             item.fit_motion = f > 0;
             item.sides = cases[k].style.max_sides;

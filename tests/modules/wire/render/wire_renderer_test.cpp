@@ -597,9 +597,15 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
         DrawStats third_stats;
         (void)render(*ctx, renderer, gpu, view.camera, node_settings, &third_stats);
         EXPECT_EQ(third_stats.bytes_uploaded, 0u);  // the same slots again: nothing (the list is kept on the GPU)
-        std::size_t nodes = 0;
-        for (const wire::WireNodes& n : scene.nodes) nodes += n.size();
-        EXPECT_EQ(gpu_stats.bytes_uploaded, 16 * nodes + 64 * wire_count);
+        // Each wire's nodes as pack_nodes packs them (8 bytes each and 8 a wire quantised, else 16 each) and its
+        // 64-byte header.
+        std::size_t node_bytes = 0;
+        for (std::size_t k = 0; k < wire_count; ++k) {
+            wire::PackedNodes packed;
+            ASSERT_TRUE(wire::pack_nodes(scene.nodes[k], scene.settings[k].spline, packed).ok());
+            node_bytes += 8 * packed.records.size();
+        }
+        EXPECT_EQ(gpu_stats.bytes_uploaded, node_bytes + 64 * wire_count);
         for (const platform::Image* image : {&first, &second}) {
             const Comparison c = compare(reference, *image, bg.data(), 2);
             const EdgeComparison e = compare_off_edges(reference, *image, bg.data());

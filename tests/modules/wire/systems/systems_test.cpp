@@ -606,7 +606,7 @@ TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
     ASSERT_NE(item_of(e), nullptr);
     EXPECT_NE(item_of(e)->packed_nodes, nullptr);
     EXPECT_EQ(item_of(e)->curve, nullptr);
-    EXPECT_EQ(item_of(e)->packed_nodes->nodes.size(), 12u);
+    EXPECT_EQ(item_of(e)->packed_nodes->node_count, 12u);
     EXPECT_EQ(w.ctx.stats.rings_built, 0u);
     EXPECT_EQ(w.ctx.stats.meshes_built, 0u);
     EXPECT_TRUE(w.registry.get<WireCurve>(e).curve.segments.empty());  // built on the GPU, not kept here
@@ -635,17 +635,17 @@ TEST(WireSystems, NodesPathSendsPackedNodesBlendsAndLastValidNodes) {
     edit_nodes(w.registry, e).positions[0].y += 0.01;  // the next change takes the fast path: packed nodes
     w.run();
     ASSERT_NE(item_of(e)->packed_nodes, nullptr);
-    EXPECT_EQ(item_of(e)->packed_nodes->nodes.size(), 13u);
+    EXPECT_EQ(item_of(e)->packed_nodes->node_count, 13u);
 
     // A bad update: reported once, the last valid nodes keep drawing.
-    const std::vector<glm::vec4> last_valid = item_of(e)->packed_nodes->nodes;
+    const std::vector<glm::uvec2> last_valid = item_of(e)->packed_nodes->records;
     edit_nodes(w.registry, e).positions[2].x = std::numeric_limits<double>::quiet_NaN();
     w.run();
     EXPECT_NE(wire_error(w.registry, e), nullptr);
     EXPECT_EQ(w.ctx.new_errors.size(), 1u);
     ASSERT_NE(item_of(e), nullptr);
     ASSERT_NE(item_of(e)->packed_nodes, nullptr);
-    EXPECT_EQ(item_of(e)->packed_nodes->nodes, last_valid);
+    EXPECT_EQ(item_of(e)->packed_nodes->records, last_valid);
     w.run();
     EXPECT_TRUE(w.ctx.new_errors.empty());  // once
 }

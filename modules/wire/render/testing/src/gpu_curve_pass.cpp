@@ -47,10 +47,10 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
         segment_first += segs;
     }
     header_data_ = up.headers;
-    std::vector<glm::vec4>& node_data = up.nodes;
+    std::vector<glm::uvec2>& node_data = up.nodes;
     std::vector<glm::vec4>& extras = up.extras;
     segment_total_ = segment_first;
-    node_bytes_ = node_data.size() * sizeof(glm::vec4);
+    node_bytes_ = node_data.size() * sizeof(glm::uvec2);
     header_bytes_ = header_data_.size() * sizeof(GpuCurveHeader);
     extra_bytes_ = extras.size() * sizeof(glm::vec4);
     if (extras.empty()) extras.emplace_back(0.0f);  // a buffer of size 0 cannot be bound
@@ -58,7 +58,7 @@ Status GpuCurvePass::build(std::span<const GpuCurveWire> wires) {
 
     auto headers =
         engine::gfx::make_buffer(std::span<const GpuCurveHeader>(header_data_), "wire gpu curve headers");
-    auto nodes = engine::gfx::make_buffer(std::span<const glm::vec4>(node_data), "wire gpu curve nodes");
+    auto nodes = engine::gfx::make_buffer(std::span<const glm::uvec2>(node_data), "wire gpu curve nodes");
     auto segments = engine::gfx::make_buffer({.size_bytes = segment_total_ * 4 * sizeof(glm::vec4),
                                               .dynamic = true,
                                               .label = "wire gpu curve segments"});

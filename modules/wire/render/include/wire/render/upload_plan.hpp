@@ -155,8 +155,8 @@ struct NodesPlan {
 
 /// The bytes one draw() of `list` on the nodes path writes (its DrawStats::bytes_uploaded, node stream aside), with
 /// `plan` updated as the renderer updates its slots: for each drawn wire whose nodes it has not got (new, evicted,
-/// or nodes_generation changed or 0) a 64-byte header and its nodes as wire::pack_nodes packs them (16 bytes each,
-/// and the extras) or its CPU-built curve's segments (64 bytes each); 4 bytes for each other drawn wire when
+/// or nodes_generation changed or 0) a 64-byte header and its nodes as wire::pack_nodes packs them (8 bytes each
+/// and 8 for the wire quantised, else 16 each; and the extras) or its CPU-built curve's segments (64 bytes each); 4 bytes for each other drawn wire when
 /// that list differs from the one kept on the GPU (or outgrew its buffer). Frames the GPU side could not compute
 /// (buffers that could not be made) are not modelled.
 std::size_t plan_nodes_frame(const DrawList& list, NodesPlan& plan);
