@@ -279,10 +279,13 @@ def test_a_wire_updated_1000_times_does_not_grow_memory():
         if i % 100 == 0:
             rt.render()
 
-    for i in range(200):  # warm-up: containers at their working capacity, allocator pools settled
+    # Warm-up: containers at their working capacity, allocator pools settled. Under CPU load (ctest -j2) the
+    # process's RSS still grows by 4-16 KiB per 100 updates until about update 1,300 and then stays flat (measured
+    # over 3,000 updates), so the window starts after 1,500.
+    for i in range(1500):
         step(i)
     systems_before, rss_before = rt.memory(w), rss_kib()
-    for i in range(200, 1200):
+    for i in range(1500, 2500):
         step(i)
     systems_after, rss_after = rt.memory(w), rss_kib()
     assert systems_after == systems_before
