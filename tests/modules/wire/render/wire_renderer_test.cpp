@@ -1208,6 +1208,58 @@ TEST(WireRendererTest, CulledWiresComeBackWithoutUpload) {
     EXPECT_EQ(stats.wires_uploaded, all.items.size()) << "culled for 6 frames: evicted";
 }
 
+// The nodes path keeps a wire's slot (its curve, LOD state and first frame, on the GPU) while it is not drawn: back
+// within retain_frames it sends nothing but its slot; not drawn for longer, the slot is given back (looked for every
+// 16th frame, so up to 15 frames late) and the wire's nodes go up again. What CulledWiresComeBackWithoutUpload
+// shows for gpu-rings' residency.
+TEST(WireRendererTest, NodesSlotsOutliveShortCullsAndAreEvictedAfterRetainFrames) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer renderer = make_renderer({.retain_frames = 5});
+    const Scene scene = test_scene();
+    DrawList all{.path = UploadPath::gpu_nodes, .items = {}};
+    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
+        DrawItem item;
+        item.wire_id = 710000 + i;
+        item.nodes = &scene.nodes[i];
+        item.spline = scene.settings[i].spline;
+        item.nodes_generation = 1;
+        item.sides = 16;
+        item.caps = scene.settings[i].tube.caps;
+        all.items.push_back(item);
+    }
+    const DrawList none{.path = UploadPath::gpu_nodes, .items = {}};
+    const std::size_t n = all.items.size();
+    DrawStats stats;
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, n);
+    EXPECT_EQ(renderer.info().node_path_wires, n);
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, 0u);
+    EXPECT_EQ(stats.bytes_uploaded, 4 * n) << "unchanged wires: their slots";
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.bytes_uploaded, 0u) << "the same slots again: kept on the GPU";
+    std::size_t evicted = 0;
+    for (int f = 0; f < 5; ++f) {
+        render(*ctx, renderer, none, scene_camera(), {}, &stats);
+        evicted += stats.wires_evicted;
+    }
+    EXPECT_EQ(evicted, 0u);
+    EXPECT_EQ(renderer.info().node_path_wires, n);
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, 0u) << "not drawn for 5 frames: the slots were kept";
+    EXPECT_EQ(stats.bytes_uploaded, 0u) << "the empty frames left the kept list of slots as it was: nothing sent";
+    for (int f = 0; f < 5 + 16 + 1; ++f) {
+        render(*ctx, renderer, none, scene_camera(), {}, &stats);
+        evicted += stats.wires_evicted;
+    }
+    EXPECT_EQ(evicted, n);
+    EXPECT_EQ(renderer.info().node_path_wires, 0u);
+    render(*ctx, renderer, all, scene_camera(), {}, &stats);
+    EXPECT_EQ(stats.wires_uploaded, n) << "not drawn for 22 frames: evicted, sent again";
+    EXPECT_EQ(renderer.info().node_path_wires, n);
+}
+
 // A small ring storage grows while wires are added: each image equals a roomy renderer's, old buffers are
 // deleted once their fences pass, at most a few live at once.
 TEST(WireRendererTest, RetainedRingStorageGrowsWithoutLeaks) {
