@@ -1414,6 +1414,71 @@ TEST(WireRendererTest, DrawCommandsDoNotGrowWithWires) {
     }
 }
 
+// The nodes path's draw commands do not grow with the wires either: the GPU writes one command per (material, side
+// count, chunk kind) and the frame issues one multi-draw per (class, material). 10 wires (3 tube side counts, 2
+// materials, a thin cable and a thinner one) and the same 10 listed 100 times (new wire ids, the same nodes, so the
+// same LOD) draw with the same commands and multi-draws, and 100 times the triangles (counted on the GPU, read back
+// 3 frames late: the 8th frame's).
+TEST(WireRendererTest, NodesPathDrawCommandsDoNotGrowWithWires) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer renderer = make_renderer();
+    const uint32_t blue = renderer.add_material({.tint = {0.2f, 0.4f, 1.0f}});
+    std::vector<wire::WireNodes> nodes;
+    std::vector<wire::SplineSettings> splines;
+    std::vector<uint32_t> materials, most_sides;
+    const uint32_t sides[] = {6, 8, 12};
+    for (int i = 0; i < 8; ++i) {
+        const double x = -2.0 + 0.5 * i;
+        nodes.push_back(hanging_cable({x, 1.2, -0.4}, {x + 0.4, 0.9 - 0.1 * i, 0.3}, 0.3 + 0.05 * i, 5 + i));
+        splines.push_back(wire_settings(0.02f + 0.003f * static_cast<float>(i), sides[i % 3]).spline);
+        materials.push_back(i % 2 == 0 ? 0u : blue);
+        most_sides.push_back(sides[i % 3]);
+    }
+    const std::vector<wire::WireNodes> cables = thin_cables(29, 2);
+    for (const float radius : {0.004f, 0.0008f}) {
+        nodes.push_back(cables[nodes.size() - 8]);
+        splines.push_back(wire_settings(radius, 5).spline);
+        materials.push_back(0);
+        most_sides.push_back(5);
+    }
+    const auto list_of = [&](int copies) {
+        DrawList list{.path = UploadPath::gpu_nodes, .items = {}};
+        for (int copy = 0; copy < copies; ++copy) {
+            for (std::size_t i = 0; i < nodes.size(); ++i) {
+                DrawItem item;
+                item.wire_id = (uint64_t{720000} + i) + (static_cast<uint64_t>(copies + copy) << 40);
+                item.nodes = &nodes[i];
+                item.spline = splines[i];
+                item.nodes_generation = 1;
+                item.material = materials[i];
+                item.sides = most_sides[i];
+                item.caps = true;
+                list.items.push_back(item);
+            }
+        }
+        return list;
+    };
+    const DrawList small = list_of(1), large = list_of(100);
+    ASSERT_EQ(small.items.size(), 10u);
+    ASSERT_EQ(large.items.size(), 1000u);
+    DrawStats a, b;
+    for (int frame = 0; frame < 8; ++frame) render(*ctx, renderer, small, scene_camera(), {}, &a);
+    for (int frame = 0; frame < 8; ++frame) render(*ctx, renderer, large, scene_camera(), {}, &b);
+    ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+    std::printf("nodes path: 10 wires %zu draw commands in %zu multi-draws, %zu triangles; 1,000 wires %zu in %zu, "
+                "%zu triangles\n",
+                a.indirect_commands, a.multi_draw_calls, a.triangles, b.indirect_commands, b.multi_draw_calls,
+                b.triangles);
+    EXPECT_EQ(a.draw_items, 10u);
+    EXPECT_EQ(b.draw_items, 1000u);
+    EXPECT_GT(a.triangles, 0u);
+    EXPECT_EQ(b.triangles, 100 * a.triangles);
+    EXPECT_EQ(b.indirect_commands, a.indirect_commands);
+    EXPECT_EQ(b.multi_draw_calls, a.multi_draw_calls);
+    EXPECT_EQ(b.wires_coarse, 0u) << "the ring buffer had grown by the 8th frame";
+}
+
 // Item 2 of issue 11: the LOD switches a tube to a strip when its projected radius falls below 2 px
 // (LodSettings::strip_radius_px); the switch must not pop. Random cables (fixed seed), each with the radius that
 // projects to exactly 2 px at its nearest point, drawn as the tube the LOD uses there (5 sides at 0.5 px) and as
