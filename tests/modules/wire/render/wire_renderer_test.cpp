@@ -120,6 +120,23 @@ struct Scene {
         }
         return out;
     }
+
+    /// The same wires on the nodes path (their nodes; curve, LOD and rings on the GPU), with `lod`.
+    DrawList node_list(const wire::LodSettings& lod = {}) const {
+        DrawList out{.path = UploadPath::gpu_nodes, .items = {}, .lod = lod};
+        for (std::size_t i = 0; i < nodes.size(); ++i) {
+            DrawItem item;
+            item.material = materials[i];
+            item.wire_id = id_base + i;
+            item.nodes = &nodes[i];
+            item.spline = settings[i].spline;
+            item.nodes_generation = generation;
+            item.sides = settings[i].tube.sides == 0 ? 8 : std::max(settings[i].tube.sides, 3u);
+            item.caps = settings[i].tube.caps;
+            out.items.push_back(item);
+        }
+        return out;
+    }
 };
 
 wire::PipelineSettings wire_settings(float radius_m, uint32_t sides, bool closed = false) {
@@ -648,9 +665,10 @@ TEST(WireRendererTest, DrawIndexAttributeFallbackMatches) {
     std::printf("ARB_shader_draw_parameters used: %s\n", preferred.info().draw_parameters ? "yes" : "no");
     EXPECT_FALSE(fallback.info().draw_parameters);
     const Scene scene = test_scene();
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
-        const platform::Image a = render(*ctx, preferred, scene.list(path), scene_camera());
-        const platform::Image b = render(*ctx, fallback, scene.list(path), scene_camera());
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+        const DrawList list = path == UploadPath::gpu_nodes ? scene.node_list() : scene.list(path);
+        const platform::Image a = render(*ctx, preferred, list, scene_camera());
+        const platform::Image b = render(*ctx, fallback, list, scene_camera());
         EXPECT_TRUE(a.rgba == b.rgba) << "path " << static_cast<int>(path);
     }
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
@@ -933,12 +951,14 @@ TEST(WireRendererTest, FarFromOriginKeepsPrecision) {
     engine::scene::Camera far_camera = camera;  // the camera's eye and target are double
     far_camera.position += far;
     far_camera.target += far;
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
-        const platform::Image a = render(*ctx, renderer, near_scene.list(path), camera);
-        const platform::Image b = render(*ctx, renderer, far_scene.list(path), far_camera);
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+        const bool nodes = path == UploadPath::gpu_nodes;
+        const platform::Image a = render(*ctx, renderer, nodes ? near_scene.node_list() : near_scene.list(path), camera);
+        const platform::Image b =
+            render(*ctx, renderer, nodes ? far_scene.node_list() : far_scene.list(path), far_camera);
         const Comparison c = compare(a, b, bg.data(), 2);
         std::printf("far from origin (%s): %zu px differ, %zu off silhouettes, max %d\n",
-                    path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings", c.mismatched, c.off_silhouette,
+                    std::string(wire::upload_path_name(path)).c_str(), c.mismatched, c.off_silhouette,
                     c.max_difference);
         EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.pixels));
     }
