@@ -893,12 +893,33 @@ TEST(WireRendererTest, MaterialsAndWireframe) {
     const uint32_t blue = renderer.add_material({.tint = {0.2f, 0.4f, 1.0f}});
     Scene scene = test_scene();
     for (std::size_t i = 0; i < scene.materials.size(); i += 2) scene.materials[i] = blue;
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+        const bool nodes = path == UploadPath::gpu_nodes;
+        const DrawList list = nodes ? scene.node_list() : scene.list(path);
         DrawStats stats;
-        const platform::Image filled = render(*ctx, renderer, scene.list(path), scene_camera(), {}, &stats);
+        const platform::Image filled = render(*ctx, renderer, list, scene_camera(), {}, &stats);
+        std::size_t bluish = 0, orange = 0;
+        for (std::size_t i = 0; i < filled.rgba.size(); i += 4) {
+            bluish += filled.rgba[i + 2] > filled.rgba[i] + 30;
+            orange += filled.rgba[i] > filled.rgba[i + 2] + 30;
+        }
+        EXPECT_GT(bluish, 500u) << upload_path_name(path);
+        EXPECT_GT(orange, 500u) << upload_path_name(path);
+        DrawStats line_stats;
+        const platform::Image lines = render(*ctx, renderer, list, scene_camera(), {.wireframe = true}, &line_stats);
+        const std::size_t filled_px = covered_pixels(filled, bg.data());
+        const std::size_t line_px = covered_pixels(lines, bg.data());
+        EXPECT_GT(line_px, filled_px / 10) << upload_path_name(path);
+        EXPECT_LT(line_px, filled_px) << upload_path_name(path);
+        if (nodes) {
+            // One multi-draw per (class, material): the tubes and strips, then the (here empty) lines, of each
+            // material in use; the GPU writes every bucket's command.
+            EXPECT_EQ(stats.multi_draw_calls, 4u);
+            save(filled, "wire_render_materials_nodes.png");
+            continue;
+        }
         EXPECT_EQ(stats.multi_draw_calls, 2u);
         // cpu-mesh: one command a material; gpu-rings: one per (material, side count, chunk kind) in use.
-        const DrawList list = scene.list(path);
         EXPECT_EQ(stats.indirect_commands, wire::render::draw_commands(list));
         std::set<std::pair<uint32_t, uint32_t>> material_sides;
         std::size_t chunks = 0;
@@ -912,23 +933,10 @@ TEST(WireRendererTest, MaterialsAndWireframe) {
             EXPECT_LE(stats.indirect_commands, material_sides.size() * wire::render::kChunkKinds);
             EXPECT_EQ(stats.chunks, chunks);
         }
-        std::size_t bluish = 0, orange = 0;
-        for (std::size_t i = 0; i < filled.rgba.size(); i += 4) {
-            bluish += filled.rgba[i + 2] > filled.rgba[i] + 30;
-            orange += filled.rgba[i] > filled.rgba[i + 2] + 30;
-        }
-        EXPECT_GT(bluish, 500u);
-        EXPECT_GT(orange, 500u);
-        const platform::Image lines =
-            render(*ctx, renderer, scene.list(path), scene_camera(), {.wireframe = true}, &stats);
         if (path == UploadPath::gpu_rings) {
             save(filled, "wire_render_materials.png");
             save(lines, "wire_render_wireframe.png");
         }
-        const std::size_t filled_px = covered_pixels(filled, bg.data());
-        const std::size_t line_px = covered_pixels(lines, bg.data());
-        EXPECT_GT(line_px, filled_px / 10);
-        EXPECT_LT(line_px, filled_px);
     }
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
