@@ -261,7 +261,7 @@ std::vector<std::vector<unsigned char>> run_scene(int threads, UploadPath path, 
 }
 
 TEST(WireSystems, DrawListIsByteEqualForOneAndTwoThreads) {
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
         const auto one = run_scene(1, path);
         const auto two = run_scene(2, path);
         ASSERT_EQ(one.size(), two.size());
