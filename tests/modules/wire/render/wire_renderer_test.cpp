@@ -1352,9 +1352,11 @@ TEST(WireRendererTest, NoDebugOutputErrors) {
          }});
     WireRenderer renderer = make_renderer({.region_bytes = 1024});
     const Scene scene = test_scene();
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
-        for (int frame = 0; frame < 4; ++frame) render(ctx, renderer, scene.list(path), scene_camera());
-        render(ctx, renderer, scene.list(path), scene_camera(), {.wireframe = true});
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+        // The nodes path: its compute passes and the ring buffer's growth (read back 3 frames late) too.
+        const DrawList list = path == UploadPath::gpu_nodes ? scene.node_list({.tolerance_px = 0.01}) : scene.list(path);
+        for (int frame = 0; frame < 6; ++frame) render(ctx, renderer, list, scene_camera());
+        render(ctx, renderer, list, scene_camera(), {.wireframe = true});
     }
     engine::gfx::disable_debug_output();
     for (const std::string& e : errors) ADD_FAILURE() << e;
