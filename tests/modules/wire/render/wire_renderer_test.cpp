@@ -832,16 +832,18 @@ TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
         pool.add(hanging_cable({x, 1.3, -0.5}, {x + 0.3, -1.4, 0.4 - 0.05 * i}, 0.2, 5),
                  wire_settings(0.03f + 0.002f * static_cast<float>(i), 8));
     }
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
         // Rings streamed (not retained), so the stream buffer carries them; RetainedRingStorage... tests the
-        // retained buffer's growth.
+        // retained buffer's growth. The nodes path's nodes and headers go through the stream buffer too (both
+        // renderers see the same frames, so their LOD state is the same).
         WireRenderer growing = make_renderer({.region_bytes = 512, .retain_rings = false});
         WireRenderer roomy = make_renderer({.region_bytes = std::size_t{8} << 20, .retain_rings = false});
-        const DrawList all = pool.list(path);
+        const DrawList all = path == UploadPath::gpu_nodes ? pool.node_list() : pool.list(path);
         std::size_t growths = 0, max_live = 0;
         for (std::size_t count = 1; count <= all.items.size(); count += 3) {
             DrawList list{.path = path,
-                          .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)}};
+                          .items = {all.items.begin(), all.items.begin() + static_cast<long>(count)},
+                          .lod = all.lod};
             DrawStats stats;
             const platform::Image got = render(*ctx, growing, list, scene_camera(), {}, &stats);
             const platform::Image want = render(*ctx, roomy, list, scene_camera());
@@ -855,7 +857,7 @@ TEST(WireRendererTest, StreamBufferGrowsWithoutLeaks) {
         render(*ctx, growing, all, scene_camera());  // retired buffers are collected at the start of a frame
         const std::vector<unsigned> allocated = growing.info().allocated_stream_buffers;
         std::printf("%s: %zu growths to %zu bytes a region, at most %zu live buffers, %zu live at the end\n",
-                    path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings", growths, growing.info().region_bytes,
+                    std::string(wire::upload_path_name(path)).c_str(), growths, growing.info().region_bytes,
                     max_live, growing.info().live_stream_buffers);
         EXPECT_GE(growths, 2u);
         EXPECT_EQ(allocated.size(), growths + 1);
