@@ -810,14 +810,17 @@ TEST(WireRendererTest, FramesAreDeterministic) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
     const Scene scene = test_scene();
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+        // The nodes path: the second frame draws from the state its first left on the GPU (the slots' curves,
+        // LOD and first frames), from the next region.
+        const DrawList list = path == UploadPath::gpu_nodes ? scene.node_list() : scene.list(path);
         WireRenderer first = make_renderer();
-        const platform::Image a = render(*ctx, first, scene.list(path), scene_camera());
-        const platform::Image b = render(*ctx, first, scene.list(path), scene_camera());  // next region
+        const platform::Image a = render(*ctx, first, list, scene_camera());
+        const platform::Image b = render(*ctx, first, list, scene_camera());  // next region
         WireRenderer second = make_renderer();
-        const platform::Image c = render(*ctx, second, scene.list(path), scene_camera());
-        EXPECT_TRUE(a.rgba == b.rgba);
-        EXPECT_TRUE(a.rgba == c.rgba);
+        const platform::Image c = render(*ctx, second, list, scene_camera());
+        EXPECT_TRUE(a.rgba == b.rgba) << upload_path_name(path);
+        EXPECT_TRUE(a.rgba == c.rgba) << upload_path_name(path);
     }
 }
 
@@ -893,12 +896,14 @@ TEST(WireRendererTest, ShaderErrorCarriesDriverLog) {
     auto flat =
         WireRenderer::create({.shading_glsl = "vec3 shade(vec3 a, vec3 n, vec3 e) { return vec3(1.0); }\n"});
     ASSERT_TRUE(flat.ok()) << flat.error().message;
-    const platform::Image image =
-        render(*ctx, flat.value(), test_scene().list(UploadPath::gpu_rings), scene_camera());
-    std::size_t white = 0;
-    for (std::size_t i = 0; i < image.rgba.size(); i += 4)
-        white += image.rgba[i] == 255 && image.rgba[i + 2] == 255;
-    EXPECT_GT(white, image.rgba.size() / 4 / 20);
+    const Scene scene = test_scene();
+    for (const DrawList& list : {scene.list(UploadPath::gpu_rings), scene.node_list()}) {
+        const platform::Image image = render(*ctx, flat.value(), list, scene_camera());
+        std::size_t white = 0;
+        for (std::size_t i = 0; i < image.rgba.size(); i += 4)
+            white += image.rgba[i] == 255 && image.rgba[i + 2] == 255;
+        EXPECT_GT(white, image.rgba.size() / 4 / 20) << upload_path_name(list.path);
+    }
 }
 
 // Materials: one multi-draw per material in use; tints reach the pixels. Wireframe covers fewer pixels.
