@@ -702,10 +702,12 @@ TEST(WireRendererTest, KnownWireSilhouetteHasNoCracks) {
         Scene scene;
         scene.add(hanging_cable({-1.8, 0.2, 0.0}, {1.8, 0.2, 0.0}, k.sag_m, 7), wire_settings(radius_m, 8));
         const wire::RingSet& rings = scene.pipelines[0].rings();
-        for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
-            const platform::Image image = render(*ctx, renderer, scene.list(path), camera);
-            save(image, std::string("wire_render_silhouette_") + k.name + "_" +
-                            (path == UploadPath::cpu_mesh ? "cpu" : "gpu") + ".png");
+        for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+            // The nodes path: its own curve, LOD and rings on the GPU, checked along the CPU reference's.
+            const DrawList list = path == UploadPath::gpu_nodes ? scene.node_list() : scene.list(path);
+            const platform::Image image = render(*ctx, renderer, list, camera);
+            save(image, std::string("wire_render_silhouette_") + k.name + "_" + std::string(upload_path_name(path)) +
+                            ".png");
             std::size_t checked = 0, cracks = 0, across_missing = 0, halo = 0;
             for (std::size_t i = 0; i + 1 < rings.centre_m.size(); ++i) {
                 const glm::dvec3 a = rings.origin_m + rings.centre_m[i];
@@ -733,7 +735,7 @@ TEST(WireRendererTest, KnownWireSilhouetteHasNoCracks) {
             std::printf(
                 "%s %s: %zu centre-line samples, %zu uncovered, %zu uncovered across, %zu covered beyond "
                 "the radius (%.1f px)\n",
-                k.name, path == UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-rings", checked, cracks,
+                k.name, std::string(upload_path_name(path)).c_str(), checked, cracks,
                 across_missing, halo, radius_px);
             EXPECT_GT(checked, 100u);
             EXPECT_EQ(cracks, 0u);
