@@ -1648,6 +1648,78 @@ TEST(WireRendererTest, GpuRingsStripsMatchCpuMesh) {
     }
 }
 
+// The nodes path's strips and phone-wire lines (the GPU's LOD choosing them, the ring vertex shader expanding
+// them) against cpu-mesh drawing the CPU reference's (update_lod with the same settings at node resolution,
+// place_rings, build_rings, build_strip from the double nodes): the 12 thin cables forced to strips, then to
+// lines, the same picture (<= 0.5% of pixels over 2/255, none off silhouettes) and the same triangles.
+TEST(WireRendererTest, NodesStripsAndLinesMatchCpuMesh) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer renderer = make_renderer();
+    const std::vector<uint8_t> bg = background_pixel(*ctx, renderer);
+    const engine::scene::Camera camera = origin_camera();
+    const std::vector<wire::WireNodes> cables = thin_cables(1102, 12);
+    const wire::LodView view = wire::LodView::perspective(camera.position, camera.target, camera.up,
+                                                          camera.fov_y_rad, kWidth, kHeight, camera.near_m,
+                                                          camera.far_m);
+    for (const uint32_t want : {2u, 1u}) {
+        // Strips: every wire under the strip radius, none under the line radius; lines: every wire under both.
+        const wire::LodSettings lod{.keep_node_resolution = true,
+                                    .strip_radius_px = 1e9,
+                                    .line_radius_px = want == 1 ? 1e9 : -1.0};
+        DrawList cpu{.path = UploadPath::cpu_mesh, .items = {}};
+        DrawList gpu{.path = UploadPath::gpu_nodes, .items = {}, .lod = lod};
+        std::vector<wire::TubeMesh> meshes(cables.size());  // the cpu-mesh items' vertices point into these
+        for (std::size_t c = 0; c < cables.size(); ++c) {
+            const wire::SplineSettings spline = wire_settings(c % 2 == 0 ? 0.004f : 0.0008f, 5).spline;
+            wire::Curve curve;
+            ASSERT_TRUE(wire::build_curve(cables[c], spline, curve).ok());
+            wire::WireLod wl;
+            wire::update_lod(curve, view, lod, wl, static_cast<const wire::BoundingSphere*>(nullptr));
+            ASSERT_TRUE(wl.visible) << "cable " << c;
+            ASSERT_EQ(wl.drawn_sides, want) << "cable " << c;
+            std::vector<wire::RingParam> params;
+            wire::place_rings(curve, wl.counts, params);
+            wire::RingSet rings;
+            wire::build_rings(curve, params, {}, rings);
+            wire::build_strip(rings, meshes[c]);
+            DrawItem item;
+            item.wire_id = 730000 + 16 * want + c;
+            item.origin_m = meshes[c].origin_m;
+            item.vertices = meshes[c].vertices;
+            item.indices = meshes[c].indices;
+            item.sides = want;
+            item.closed = rings.closed;
+            item.caps = true;
+            cpu.items.push_back(item);
+            DrawItem node_item;
+            node_item.wire_id = item.wire_id;
+            node_item.nodes = &cables[c];
+            node_item.spline = spline;
+            node_item.nodes_generation = 1;
+            node_item.sides = 5;
+            node_item.caps = true;
+            gpu.items.push_back(node_item);
+        }
+        DrawStats cs, gs;
+        const platform::Image a = render(*ctx, renderer, cpu, camera, {}, &cs);
+        platform::Image b;
+        for (int frame = 0; frame < 4; ++frame) b = render(*ctx, renderer, gpu, camera, {}, &gs);  // triangles: 3 late
+        save(b, want == 2 ? "wire_render_strips_nodes.png" : "wire_render_lines_nodes.png");
+        EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+        EXPECT_EQ(gs.triangles, cs.triangles);
+        const Comparison c = compare(a, b, bg.data(), 2);
+        const std::size_t covered = covered_pixels(a, bg.data());
+        std::printf("nodes path %s: %zu covered px, %zu differ by > 2/255, %zu off silhouettes, max %d; triangles "
+                    "%zu\n",
+                    want == 2 ? "strips" : "lines", covered, c.mismatched, c.off_silhouette, c.max_difference,
+                    gs.triangles);
+        EXPECT_GT(covered, 1000u);
+        EXPECT_LE(static_cast<double>(c.mismatched), 0.005 * static_cast<double>(c.pixels));
+        EXPECT_EQ(c.off_silhouette, 0u);
+    }
+}
+
 // ---- phone-wire anti-aliasing (issue 11 item 3) --------------------------------------------------------------
 
 /// Cables x-major on screen (roll within +-35 degrees) at 12-30 m, projected radius 0.1-0.45 px at the centre.
