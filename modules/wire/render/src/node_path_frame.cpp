@@ -29,9 +29,10 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     std::size_t segments_visible = gathered.segments_visible;  // the stream's wires add theirs
     changed_ = up.headers.size();
     // The streamed wires (node_stream.cpp): their headers into the stream's region, the unchanged ones
-    // listed.
+    // listed; a material the header cannot hold is out of range, as for the list's items.
     stream_changed_ = 0;
-    if (stream_ != nullptr) stream_changed_ = emit_stream(ctx.materials.size(), segments_visible, stats);
+    const std::size_t materials = std::min<std::size_t>(ctx.materials.size(), kMaxMaterials);
+    if (stream_ != nullptr) stream_changed_ = emit_stream(materials, segments_visible, stats);
     unchanged_ = visible_slots_.size();
     visible_ = changed_ + stream_changed_ + unchanged_;
     stats.wires_uploaded = changed_ + stream_changed_;

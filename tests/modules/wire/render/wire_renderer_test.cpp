@@ -1269,17 +1269,7 @@ TEST(WireRendererTest, NodesSlotsOutliveShortCullsAndAreEvictedAfterRetainFrames
     ASSERT_NE(ctx, nullptr);
     WireRenderer renderer = make_renderer({.retain_frames = 5});
     const Scene scene = test_scene();
-    DrawList all{.path = UploadPath::gpu_nodes, .items = {}};
-    for (std::size_t i = 0; i < scene.nodes.size(); ++i) {
-        DrawItem item;
-        item.wire_id = 710000 + i;
-        item.nodes = &scene.nodes[i];
-        item.spline = scene.settings[i].spline;
-        item.nodes_generation = 1;
-        item.sides = 16;
-        item.caps = scene.settings[i].tube.caps;
-        all.items.push_back(item);
-    }
+    const DrawList all = scene.node_list();
     const DrawList none{.path = UploadPath::gpu_nodes, .items = {}};
     const std::size_t n = all.items.size();
     DrawStats stats;
