@@ -24,15 +24,17 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     ++frame_;
     read_counts(stats);
     thread_local WireUpload up;  // headers, and the nodes made here (not packed by the systems)
-    const Gathered gathered = gather(list, ctx.materials.size(), up, stats);
+    // The materials the nodes path draws: the renderer's, up to what the header's material field holds; an item or
+    // streamed wire with another is out of range.
+    materials_ = std::min<std::size_t>(ctx.materials.size(), kMaxMaterials);
+    const Gathered gathered = gather(list, materials_, up, stats);
     const std::size_t node_total = gathered.node_total, extra_total = gathered.extra_total;
     std::size_t segments_visible = gathered.segments_visible;  // the stream's wires add theirs
     changed_ = up.headers.size();
     // The streamed wires (node_stream.cpp): their headers into the stream's region, the unchanged ones
-    // listed; a material the header cannot hold is out of range, as for the list's items.
+    // listed.
     stream_changed_ = 0;
-    const std::size_t materials = std::min<std::size_t>(ctx.materials.size(), kMaxMaterials);
-    if (stream_ != nullptr) stream_changed_ = emit_stream(materials, segments_visible, stats);
+    if (stream_ != nullptr) stream_changed_ = emit_stream(materials_, segments_visible, stats);
     unchanged_ = visible_slots_.size();
     visible_ = changed_ + stream_changed_ + unchanged_;
     stats.wires_uploaded = changed_ + stream_changed_;
@@ -112,7 +114,6 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     // Per-frame GPU buffers.
     if (ring_capacity_ == 0) ring_capacity_ = std::max<std::size_t>(4096, 8 * segments_visible + visible_);
     side_slots_ = max_sides_ + 1;
-    materials_ = ctx.materials.size();
     const std::size_t buckets = materials_ * side_slots_ * 6;
     // The reserve after the ring buffer's estimate: one ring a segment for every visible wire (what a wire
     // that does not fit is drawn with, until the buffer has grown from the count read back).

@@ -47,14 +47,14 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
         const bool packed = item.packed_nodes != nullptr && item.packed_nodes->node_count >= 2;
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
-        if (item.material >= std::min<std::size_t>(materials, kMaxMaterials)) {
+        if (item.material >= materials) {
             // The other paths assert this; here the GPU would index past its buckets: skipped, said once.
             ++stats.wires_skipped;
             if (stats.status.ok())
                 stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": material " +
-                                             std::to_string(item.material) + " is out of range (" +
-                                             std::to_string(materials) + " materials, the nodes path draws " +
-                                             std::to_string(kMaxMaterials) + " at most): not drawn");
+                                             std::to_string(item.material) +
+                                             " is out of range (the nodes path draws materials below " +
+                                             std::to_string(materials) + "): not drawn");
             continue;
         }
         Slot* known = i < item_slot_.size() ? item_slot_[i] : nullptr;

@@ -137,12 +137,11 @@ bool second_look(StreamState& s, uint32_t index, std::size_t n, Position positio
             nodes.radius_m[j] = *reinterpret_cast<const float*>(reinterpret_cast<const char*>(radius) + j * radius_stride);
         }
     }
-    if (Status st = pack_nodes(nodes, detail::spline_of(s.styles[index]), packed); !st) {
+    if (Status st = pack_nodes(nodes, detail::spline_of(s.styles[index]), packed, NodeFormat::floats); !st) {
         s.refuse(index, st.index, st.message);
         return false;
     }
-    // The stream's records are floats (a quantised packing's nodes decoded: what the ECS path would send).
-    for (std::size_t j = 0; j < packed.node_count; ++j) dst[j] = packed.node(j);
+    std::memcpy(dst, packed.records.data(), packed.records.size() * sizeof(packed.records[0]));  // float records
     w.count = static_cast<uint32_t>(packed.node_count);
     w.unmerged = packed.node_count == n;
     for (int a = 0; a < 3; ++a) w.origin[a] = static_cast<float>(packed.origin_m[a]);
