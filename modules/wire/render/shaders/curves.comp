@@ -24,16 +24,19 @@ uniform uint u_list_first;
 uniform bool u_persist;
 uniform bool u_motion;
 
-// Curve node j's offset from the origin, and its radius.
+// Curve node j's offset from the origin, and its radius. Branch-free: both formats are decoded and one selected.
+// node() is inlined wherever it is called (the automatic spline's turn weights alone call it some 60 times, in
+// ten places), and a branch here multiplied the program's control flow: llvmpipe took 7 minutes to compile it
+// (9 s branch-free; ShaderResources.CurveProgramHasNoBranchInNode).
 vec3 node(GpuCurveHeader h, uint j) {
-    if ((h.flags & kHeaderQuantised) != 0u) {
-        uvec2 w = nodes[h.node_first + 1u + j];
-        uvec3 q = uvec3(w.x, (w.x >> kQuantBits) | (w.y << (32u - kQuantBits)), w.y >> (2u * kQuantBits - 32u));
-        ivec3 v = ivec3(q & uvec3(kQuantMask)) - ivec3(int(kQuantBias));
-        return ldexp(vec3(v), ivec3(int(nodes[h.node_first].y) - int(kQuantExpBias)));
-    }
-    uint a = h.node_first + 2u * j;
-    return uintBitsToFloat(uvec3(nodes[a], nodes[a + 1u].x));
+    bool quantised = (h.flags & kHeaderQuantised) != 0u;
+    uint at = quantised ? h.node_first + 1u + j : h.node_first + 2u * j;
+    uvec2 w = nodes[at];
+    uint z = nodes[quantised ? at : at + 1u].x;  // the float record's z (in bounds either way)
+    uvec3 q = uvec3(w.x, (w.x >> kQuantBits) | (w.y << (32u - kQuantBits)), w.y >> (2u * kQuantBits - 32u));
+    ivec3 v = ivec3(q & uvec3(kQuantMask)) - ivec3(int(kQuantBias));
+    vec3 held = ldexp(vec3(v), ivec3(int(nodes[h.node_first].y) - int(kQuantExpBias)));
+    return quantised ? held : uintBitsToFloat(uvec3(w, z));
 }
 float radius(GpuCurveHeader h, uint j) {
     bool quantised = (h.flags & kHeaderQuantised) != 0u;
