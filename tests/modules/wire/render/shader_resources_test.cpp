@@ -128,3 +128,29 @@ TEST(ShaderResources, BindingMacrosAreDistinctWithinEachProgram) {
 }
 
 }  // namespace
+
+namespace {
+
+// The body of the GLSL function whose definition starts with `signature` in `source` (up to its closing brace at
+// the start of a line); empty when it is not found.
+std::string function_body(const std::string& source, const std::string& signature) {
+    const std::size_t at = source.find(signature);
+    if (at == std::string::npos) return {};
+    const std::size_t end = source.find("\n}", at);
+    return end == std::string::npos ? std::string{} : source.substr(at, end - at);
+}
+
+}  // namespace
+
+// node() is inlined at every call site of the curve program (some 60 in the automatic spline's turn weights, in ten
+// places): a branch in it multiplied the program's control flow, and llvmpipe took 7 minutes to compile the program
+// cold (a fresh machine's first nodes-path frame); branch-free, 9 s. Its two formats are decoded and one selected.
+TEST(ShaderResources, CurveProgramHasNoBranchInNode) {
+    const std::string body = function_body(curve_program_source(), "vec3 node(GpuCurveHeader h, uint j) {");
+    ASSERT_FALSE(body.empty()) << "node() not found in the curve program";
+    EXPECT_EQ(body.find("if ("), std::string::npos) << body;
+    EXPECT_EQ(body.find("for ("), std::string::npos) << body;
+    std::size_t returns = 0;
+    for (std::size_t p = body.find("return"); p != std::string::npos; p = body.find("return", p + 1)) ++returns;
+    EXPECT_EQ(returns, 1u) << body;
+}
