@@ -106,8 +106,10 @@ wire::SplineSettings spline_of(const std::string& name) {
 }
 
 wire::UploadPath path_of(const std::string& name) {
+    if (const std::string_view note = wire::retired_path_note(name); !note.empty())
+        if (PyErr_WarnEx(PyExc_DeprecationWarning, std::string(note).c_str(), 2) < 0) throw py::error_already_set();
     if (const std::optional<wire::UploadPath> p = wire::parse_upload_path(name)) return *p;
-    value_error("path: expected 'auto', 'nodes', 'cpu' or 'gpu', got '" + name + "'");
+    value_error("path: expected 'auto', 'nodes' or 'cpu', got '" + name + "'");
 }
 
 glm::dvec3 vec3_of(const std::vector<double>& v, const char* what) {
@@ -380,7 +382,7 @@ public:
         wire::render::DrawSettings settings;
         settings.light = light_;
         drawn_ = renderer_.draw(ctx_.draw_list, ctx_.camera, settings);
-        gpu_rings_read_ = false;
+        read_rings_done_ = false;
         rendered_ = true;
         render_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         engine::platform::Image image = engine::platform::read_pixels(*gl_);
@@ -416,13 +418,13 @@ public:
             if (!rendered_)
                 throw std::runtime_error("rings: on the 'nodes' path the GPU computes the rings when render() draws; "
                                          "call render() first");
-            if (!gpu_rings_read_) {
+            if (!read_rings_done_) {
                 gl_->make_current();
-                if (engine::Status st = renderer_.read_drawn_rings(gpu_rings_); !st)
+                if (engine::Status st = renderer_.read_drawn_rings(read_rings_); !st)
                     throw std::runtime_error("rings: " + st.message);
-                gpu_rings_read_ = true;
+                read_rings_done_ = true;
             }
-            for (const wire::render::DrawnRings& d : gpu_rings_) {
+            for (const wire::render::DrawnRings& d : read_rings_) {
                 if (d.wire_id == engine::ecs::to_integral(w)) return rings_dict(d.rings);
             }
             return py::none();  // culled
@@ -508,8 +510,8 @@ private:
     wire::systems::WireContext ctx_;
     std::vector<wire::systems::ErrorReport> errors_;
     wire::RingSet ring_set_;
-    std::vector<wire::render::DrawnRings> gpu_rings_;  ///< the nodes path: the last render()'s, read back
-    bool gpu_rings_read_ = false, rendered_ = false;
+    std::vector<wire::render::DrawnRings> read_rings_;  ///< the nodes path: the last render()'s, read back
+    bool read_rings_done_ = false, rendered_ = false;
     wire::render::Light light_{.to_light = {0.3f, 1.0f, 0.4f}, .ambient = 0.35f, .specular = 0.25f};
     wire::render::DrawStats drawn_{};
     double render_ms_ = 0.0;
@@ -569,8 +571,8 @@ PYBIND11_MODULE(wires, m) {
              py::arg("threads") = 0, py::arg("pop_free") = true,
              "path: 'auto' (the default: 'nodes' where the GL context has compute shaders, else 'cpu'; logged on "
              "stderr), 'nodes' (nodes only: curve, LOD and rings computed on the GPU), 'cpu' (meshes: the portable "
-             "reference) or 'gpu' (ring records); threads: worker threads of the systems (0: all "
-             "cores)")
+             "reference; 'gpu', retired, draws on 'nodes' with a DeprecationWarning); threads: worker threads "
+             "of the systems (0: all cores)")
         .def("spawn", &Runtime::spawn, py::arg("positions"), py::arg("ids") = py::none(),
              py::arg("stretch") = py::none(), py::arg("radii") = py::none(), py::arg("radius") = 0.01f,
              py::arg("material") = 0u, py::arg("spline") = "auto", py::arg("closed") = false,
@@ -636,7 +638,7 @@ PYBIND11_MODULE(wires, m) {
         .def_property_readonly("gl_renderer", &Runtime::gl_renderer)
         .def_property_readonly(
             "path", [](const Runtime& r) { return std::string(wire::upload_path_name(r.path())); },
-            "The upload path it draws with: 'nodes', 'cpu' or 'gpu' (with path='auto', what the context allows)")
+            "The upload path it draws with: 'nodes' or 'cpu' (with path='auto', what the context allows)")
         .def_property_readonly("wire_count", &Runtime::wire_count)
         .def("should_close", &Runtime::should_close, "Window: polls events; true once the user closed it");
 

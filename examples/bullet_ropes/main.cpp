@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     app.add_option("--path", opt.path,
                    "Wire upload path: auto (nodes where the GL context has compute shaders, else cpu; logged), "
                    "nodes (the ropes' nodes only: curve, LOD and rings in compute shaders), cpu (meshes: the "
-                   "portable reference) or gpu (ring records)")
+                   "portable reference); gpu, retired, draws on nodes")
         ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}))
         ->capture_default_str();
     app.add_flag("--set-nodes", opt.set_nodes,
@@ -107,6 +107,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bullet_ropes: %s\n", view.error().message.c_str());
         return 1;
     }
+    if (const std::string_view note = wire::retired_path_note(opt.path); !note.empty())
+        std::fprintf(stderr, "bullet_ropes: %s\n", std::string(note).c_str());
     wires.path = opt.path == "auto" ? view->preferred_path() : *wire::parse_upload_path(opt.path);
     if (wires.path == wire::UploadPath::gpu_nodes && !opt.set_nodes) {
         // The nodes path: Bullet's node records go straight into the renderer's mapped memory (the node stream).

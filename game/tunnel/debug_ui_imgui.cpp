@@ -50,15 +50,11 @@ public:
         if (ImGui::SliderFloat("LOD tolerance px", &tolerance, 0.1f, 8.0f, "%.2f",
                                ImGuiSliderFlags_Logarithmic))
             o.lod_tolerance_px = tolerance;
-        int path = o.upload_path == wire::UploadPath::gpu_rings ? 1 : o.upload_path == wire::UploadPath::gpu_nodes ? 2 : 0;
+        int path = o.upload_path == wire::UploadPath::gpu_nodes ? 1 : 0;
         ImGui::RadioButton("cpu mesh", &path, 0);
         ImGui::SameLine();
-        ImGui::RadioButton("gpu rings", &path, 1);
-        ImGui::SameLine();
-        ImGui::RadioButton("gpu nodes", &path, 2);
-        o.upload_path = path == 1   ? wire::UploadPath::gpu_rings
-                        : path == 2 ? wire::UploadPath::gpu_nodes
-                                    : wire::UploadPath::cpu_mesh;
+        ImGui::RadioButton("gpu nodes", &path, 1);
+        o.upload_path = path == 1 ? wire::UploadPath::gpu_nodes : wire::UploadPath::cpu_mesh;
         ImGui::Checkbox("wireframe (F1)", &o.wireframe);
         ImGui::SameLine();
         ImGui::Checkbox("pop-free", &o.pop_free);

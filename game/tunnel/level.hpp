@@ -89,7 +89,7 @@ struct LevelFrameStats {
     double time_s = 0.0;
     std::size_t wires = 0;
     std::size_t wires_drawn = 0;    ///< draw items the wire renderer drew
-    std::size_t wire_vertices = 0;  ///< cpu_mesh: uploaded; gpu_rings: expanded by the vertex shader
+    std::size_t wire_vertices = 0;  ///< cpu_mesh: uploaded; gpu_nodes: 0 (expanded on the GPU)
     std::size_t wire_triangles = 0;
     std::size_t wire_bytes_uploaded = 0;
     bool wire_waited_for_gpu =

@@ -313,7 +313,7 @@ int main(int argc, char** argv) {
     app.add_option("--path", args.path,
                    "wire upload path: auto (default: nodes where the GL context has compute shaders, else cpu; "
                    "logged at start), nodes (nodes only: curve, LOD and rings in compute shaders), cpu (meshes "
-                   "built on the CPU: the portable reference) or gpu (ring records)")
+                   "built on the CPU: the portable reference); gpu, retired, draws on nodes")
         ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}));
     app.add_option("--spline", args.spline, "catmull-rom, c2, automatic or linear")
         ->check(CLI::IsMember({"catmull-rom", "c2", "automatic", "linear"}));
@@ -349,6 +349,8 @@ int main(int argc, char** argv) {
         return 1;
     }
     tunnel::LevelOptions& o = level.value()->options();
+    if (const std::string_view note = wire::retired_path_note(args.path); !note.empty())
+        std::fprintf(stderr, "tunnel: %s\n", std::string(note).c_str());
     if (args.path != "auto") o.upload_path = *wire::parse_upload_path(args.path);
     o.spline = args.spline == "c2"          ? wire::SplineKind::c2
                : args.spline == "automatic" ? wire::SplineKind::automatic

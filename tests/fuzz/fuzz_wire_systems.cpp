@@ -10,6 +10,7 @@
 // WIRE_FUZZ_DUMP=1 prints the decoded operations.
 #include "fuzz_checks.hpp"
 
+#include <wire/packed_nodes.hpp>
 #include <wire/spline.hpp>
 #include <wire/systems/api.hpp>
 #include <wire/systems/systems.hpp>
@@ -266,6 +267,19 @@ struct Harness {
                 wire_fuzz::require(wire_fuzz::finite_vec(v.position) && wire_fuzz::finite_vec(v.normal) && wire_fuzz::finite_vec(v.uv),
                                    "mesh vertex not finite");
             for (uint32_t i : item.indices) wire_fuzz::require(i < item.vertices.size(), "mesh index out of range");
+            if (item.packed_nodes != nullptr) {  // the nodes path: what the GPU reads
+                const wire::PackedNodes& p = *item.packed_nodes;
+                wire_fuzz::require(p.node_count >= 2, "fewer than 2 packed nodes");
+                wire_fuzz::require(p.records.size() == (p.quantised ? p.node_count + 1 : 2 * p.node_count),
+                                   "packed node records do not match the node count");
+                for (std::size_t j = 0; j < p.node_count; ++j) {
+                    const glm::vec4 n = p.node(j);
+                    wire_fuzz::require(std::isfinite(n.x + n.y + n.z + n.w) && n.w > 0.0f, "packed node not finite");
+                }
+            }
+            if (ctx.draw_list.path == wire::UploadPath::gpu_nodes)
+                wire_fuzz::require(item.packed_nodes != nullptr || item.curve != nullptr,
+                                   "nodes-path item with neither packed nodes nor a curve");
         }
         wire_fuzz::require(ctx.stats.visible_wires + ctx.stats.culled_wires == registry.storage<ws::WireLodState>().size(),
                            "visible + culled differs from the wire count");
@@ -284,7 +298,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     FuzzedDataProvider in(data, size);
     Harness h;
     h.ctx.pop_free = in.ConsumeIntegral<uint8_t>() < 224;
-    h.ctx.path = in.ConsumeBool() ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_rings;
+    h.ctx.path = in.ConsumeBool() ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_nodes;
     const bool dump = want_dump();
 
     for (int step = 0; step < 96 && in.remaining_bytes() > 0; ++step) {
@@ -358,7 +372,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
                 break;
             case 10:
                 if (in.ConsumeBool()) h.ctx.pop_free = !h.ctx.pop_free;
-                else h.ctx.path = h.ctx.path == wire::UploadPath::cpu_mesh ? wire::UploadPath::gpu_rings : wire::UploadPath::cpu_mesh;
+                else
+                    h.ctx.path = h.ctx.path == wire::UploadPath::cpu_mesh ? wire::UploadPath::gpu_nodes
+                                                                          : wire::UploadPath::cpu_mesh;
                 if (dump) std::fprintf(stderr, "pop_free %d path %d\n", int(h.ctx.pop_free), int(h.ctx.path));
                 break;
             default: {

@@ -233,6 +233,19 @@ def test_default_path_is_nodes_with_compute_and_cpu_without(monkeypatch, capfd):
     assert wires.Runtime(64, 64, path="nodes").path == "nodes"  # a named path is taken as named
 
 
+def test_path_gpu_is_a_retired_name_of_nodes():
+    """'gpu' named the ring records the CPU built, retired in 0.4: for one release it draws on the nodes path and
+    warns; as an error under -W error, like any DeprecationWarning."""
+    with pytest.warns(DeprecationWarning, match="'gpu'.*retired"):
+        rt = wires.Runtime(64, 64, path="gpu")
+    assert rt.path == "nodes"
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        with pytest.raises(DeprecationWarning):
+            wires.Runtime(64, 64, path="gpu")
+
+
 # ---- pixels: the wire is drawn where its nodes project ----
 
 def test_image_shows_the_wire_where_its_nodes_project(tmp_path):

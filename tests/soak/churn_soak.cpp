@@ -245,7 +245,7 @@ private:
 
     // What was exercised, for the summary.
     std::size_t spawned_ = 0, destroyed_ = 0, moved_ = 0, edited_ = 0, inserted_ = 0, removed_ = 0, restyled_ = 0;
-    std::size_t frames_[3] = {0, 0, 0};  ///< frames drawn per upload path (cpu-mesh, gpu-rings, gpu-nodes)
+    std::size_t frames_[2] = {0, 0};  ///< frames drawn per upload path (cpu-mesh, gpu-nodes)
     std::size_t items_drawn_ = 0;
     GlObjects baseline_{};
     std::size_t max_live_stream_ = 0;
@@ -254,7 +254,7 @@ private:
 };
 
 const char* path_name(wire::UploadPath p) {
-    return p == wire::UploadPath::cpu_mesh ? "cpu-mesh" : p == wire::UploadPath::gpu_rings ? "gpu-rings" : "gpu-nodes";
+    return p == wire::UploadPath::cpu_mesh ? "cpu-mesh" : "gpu-nodes";
 }
 
 void Soak::fail(const char* fmt, ...) {
@@ -463,9 +463,7 @@ void Soak::check_frame() {
                 }
             }
             if (item.curve != nullptr && item.curve->segments.empty()) fail("wire %u: an empty curve", id);
-        } else {
-            if (!item.vertices.empty() || !item.indices.empty()) fail("gpu-rings item %zu carries a mesh", k);
-            if (!std::isfinite(item.u_close)) fail("wire %u: u_close is not finite", id);
+            if (!item.vertices.empty() || !item.indices.empty()) fail("gpu-nodes item %zu carries a mesh", k);
         }
     }
     const std::size_t live = good_.size() + bad_.size();
@@ -506,11 +504,9 @@ Sample Soak::sample(const wire::render::DrawStats& fs) {
              "framebuffers %d (%d)",
              gl.textures, baseline_.textures, gl.vertex_arrays, baseline_.vertex_arrays, gl.programs,
              programs, gl.shaders, baseline_.shaders, gl.framebuffers, baseline_.framebuffers);
-    // Every live GL buffer is either one the renderer made before the soak, or a stream buffer still alive.
-    // (The retained ring storage likewise: its current buffer plus retired ones waiting for fences; and the nodes
-    // path's buffers.)
+    // Every live GL buffer is either one the renderer made before the soak, a stream buffer still alive, or one of
+    // the nodes path's buffers.
     const int allowed = baseline_.buffers + static_cast<int>(renderer_->info().live_stream_buffers) - 1 +
-                        static_cast<int>(renderer_->info().live_ring_buffers) - 1 +
                         static_cast<int>(renderer_->info().node_path_buffers);
     if (gl.buffers > allowed)
         fail("%d GL buffers live, at most %d expected (%d at start, %zu live stream buffers): a buffer leaks",
@@ -536,7 +532,7 @@ void Soak::check_curve(const std::vector<Sample>& curve) {
     std::printf("rss: peak %ld KiB in the second quarter, %ld KiB in the last half (limit %ld)\n", q2, h2, limit);
 #if defined(__SANITIZE_ADDRESS__)
     // Under AddressSanitizer freed memory waits in its quarantine (256 MiB) before reuse, so RSS climbs by up to
-    // that much without a leak (this run's three upload paths in turn crossed the limit by 1%, while the same soak
+    // that much without a leak (a run with three upload paths in turn crossed the limit by 1%, while the same soak
     // without it plateaus at 118.6 MB over 8,000 frames); LeakSanitizer checks for leaks at exit instead.
     if (h2 > limit) std::printf("rss: above the limit under AddressSanitizer (its quarantine): not a failure here\n");
 #else
@@ -561,8 +557,7 @@ int Soak::run() {
         // not about texture quality.
         auto made = wire::render::WireRenderer::create(
             {.region_bytes = static_cast<std::size_t>(opt_.region_kib) * 1024,
-             .max_anisotropy = 1.0f,
-             .ring_storage_bytes = static_cast<std::size_t>(opt_.region_kib) * 1024});  // grows too
+             .max_anisotropy = 1.0f});
         if (!made.ok()) {
             std::fprintf(stderr, "churn_soak: WireRenderer::create: %s\n", made.error().message.c_str());
             return 1;
@@ -605,8 +600,8 @@ int Soak::run() {
     target_wires_ = integer(opt_.min_wires, opt_.max_wires);
     for (int i = 0; i < opt_.min_wires; ++i) spawn_good();
     for (frame_ = 0; frame_ < opt_.frames; ++frame_) {
-        const long turn = (frame_ / opt_.path_every) % 3;  // the three upload paths in turn
-        context_.path = turn == 0 ? wire::UploadPath::cpu_mesh : turn == 1 ? wire::UploadPath::gpu_rings : wire::UploadPath::gpu_nodes;
+        const long turn = (frame_ / opt_.path_every) % 2;  // the two upload paths in turn
+        context_.path = turn == 0 ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_nodes;
         if (frame_ > 0) churn();
         move_camera();
         schedule_.run(registry_, 1.0 / 60.0);
@@ -628,7 +623,7 @@ int Soak::run() {
         waits_ += fs.waited_for_gpu ? 1 : 0;
         growths_ += fs.buffer_grew ? 1 : 0;
         uploaded_ += fs.bytes_uploaded;
-        ++frames_[context_.path == wire::UploadPath::cpu_mesh ? 0 : context_.path == wire::UploadPath::gpu_rings ? 1 : 2];
+        ++frames_[context_.path == wire::UploadPath::cpu_mesh ? 0 : 1];
         max_live_stream_ = std::max(max_live_stream_, renderer_->info().live_stream_buffers);
         if (renderer_->info().live_stream_buffers > 3) fail("%zu live stream buffers", renderer_->info().live_stream_buffers);
 
@@ -654,12 +649,12 @@ int Soak::run() {
     }
     frame_ = opt_.frames - 1;
     check_curve(curve);
-    if (frames_[0] == 0 || frames_[1] == 0 || frames_[2] == 0)
+    if (frames_[0] == 0 || frames_[1] == 0)
         fail("not every upload path ran: raise --frames or lower --path-every");
 
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("frames %ld in %.1f s (%.1f frames/s): %zu cpu-mesh, %zu gpu-rings, %zu gpu-nodes\n", opt_.frames,
-                seconds, static_cast<double>(opt_.frames) / seconds, frames_[0], frames_[1], frames_[2]);
+    std::printf("frames %ld in %.1f s (%.1f frames/s): %zu cpu-mesh, %zu gpu-nodes\n", opt_.frames, seconds,
+                static_cast<double>(opt_.frames) / seconds, frames_[0], frames_[1]);
     std::printf("wires: %zu spawned, %zu destroyed, %zu live at the end; %zu items drawn\n", spawned_,
                 destroyed_, good_.size(), items_drawn_);
     std::printf("renderer: %.0f triangles and %.0f KiB uploaded a frame on average; %zu waits for the GPU, %zu "
@@ -676,10 +671,8 @@ int Soak::run() {
     for (const Sample& s : curve) gl_max = std::max(gl_max, s.gl_buffers);
     std::printf("gl buffers: %d at the start, at most %d; at most %zu live stream buffers, %zu allocated\n",
                 baseline_.buffers, gl_max, max_live_stream_, renderer_->info().allocated_stream_buffers.size());
-    std::printf("ring storage (gpu-rings retained): %zu bytes capacity, %zu live, %zu wires resident, %zu "
-                "buffers allocated\n",
-                renderer_->info().ring_storage_capacity, renderer_->info().ring_storage_live_bytes,
-                renderer_->info().resident_wires, renderer_->info().allocated_ring_buffers.size());
+    std::printf("nodes path: %zu wires in slots, %zu buffers\n", renderer_->info().node_path_wires,
+                renderer_->info().node_path_buffers);
     for (const engine::ecs::SystemStats& st : schedule_.stats())
         std::printf("  %-15s mean %.3f ms\n", st.name.c_str(), st.mean_ms);
     std::printf("  %-15s mean %.3f ms\n", "checks", check_s_ * 1e3 / static_cast<double>(opt_.frames));

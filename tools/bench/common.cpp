@@ -41,18 +41,15 @@ std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t 
            vertices * (sizeof(wire::TubeVertex) + wire::render::kVertexDrawIndexBytes) + indices * sizeof(uint32_t);
 }
 
-std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings) {
-    // Open capped tubes of one material and side count sharing the rings evenly: their chunk records and the
-    // frame's commands as the renderer writes them (exact for one wire).
-    if (items == 0) return 0;
-    const std::vector<wire::Ring> storage(rings / items + 1);  // chunk counts and bytes need only the ring count
-    wire::DrawList list{.path = wire::UploadPath::gpu_rings, .items = {}};
-    for (std::size_t i = 0; i < items; ++i) {
-        wire::DrawItem item;
-        item.rings = std::span<const wire::Ring>(storage.data(), rings / items + (i < rings % items ? 1 : 0));
-        list.items.push_back(item);
-    }
-    return wire::render::streamed_upload_bytes(list);
+std::size_t gpu_nodes_bytes(const wire::WireNodes& nodes, const wire::SplineSettings& spline) {
+    wire::DrawList list{.path = wire::UploadPath::gpu_nodes, .items = {}};
+    wire::DrawItem item;
+    item.wire_id = 1;
+    item.nodes = &nodes;
+    item.spline = spline;
+    list.items.push_back(item);
+    wire::render::NodesPlan plan;
+    return wire::render::plan_nodes_frame(list, plan);
 }
 
 std::size_t upload_bytes(const wire::DrawList& list) {

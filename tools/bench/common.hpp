@@ -35,17 +35,16 @@ double wall_ms();
 /// Median of `v` (0 for an empty vector). Takes a copy.
 double median(std::vector<double> v);
 
-/// Bytes WireRenderer::draw() memcpy's into its mapped buffers for `list` when every item is streamed
-/// (wire::render::streamed_upload_bytes): per drawn item a 32-byte draw record, plus vertices (32 B) with a
-/// 4-byte draw index each and indices (4 B), or 8-byte chunk records (one per 16 bands or fewer, plus caps) and
-/// packed ring records (28 B); per frame 20 bytes a draw command (a bounded number: one per class and material,
-/// gpu-rings also per side count and chunk kind). Items without geometry are skipped. The retained gpu-rings path: wire::render::plan_retained_frame.
+/// Bytes WireRenderer::draw() memcpy's into its mapped buffers for a cpu-mesh `list`
+/// (wire::render::streamed_upload_bytes): per drawn item a 32-byte draw record, vertices (32 B) with a 4-byte
+/// draw index each and indices (4 B); per frame 20 bytes a draw command (one per class and material). Items
+/// without geometry are skipped. The nodes path: wire::render::plan_nodes_frame.
 std::size_t upload_bytes(const wire::DrawList& list);
 /// The same for a cpu-mesh upload of `items` meshes of one material with these totals.
 std::size_t cpu_mesh_bytes(std::size_t items, std::size_t vertices, std::size_t indices);
-/// The same for a gpu-rings upload of `items` open capped wires of one material and side count with `rings`
-/// rings in total, shared evenly (exact for one wire).
-std::size_t gpu_rings_bytes(std::size_t items, std::size_t rings);
+/// The bytes the nodes path writes the first frame it draws one wire of these nodes (plan_nodes_frame: the
+/// 64-byte header, the nodes as pack_nodes packs them, the 4-byte list entry); 0 when they cannot be packed.
+std::size_t gpu_nodes_bytes(const wire::WireNodes& nodes, const wire::SplineSettings& spline);
 
 /// Whether `scene` is selected by the options.
 bool selected(const Options& o, const std::string& scene);

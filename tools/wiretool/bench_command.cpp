@@ -58,10 +58,10 @@ Action add_bench_command(CLI::App& app) {
     cmd->add_flag(
         "--gl", o->gl,
         "Draw with the real WireRenderer (headless EGL: llvmpipe, or a GPU's EGL device): `standard`, `swaying` "
-        "and `far` at --size with --wires wires on cpu-mesh, gpu-rings streamed and retained at 1, 2 and all threads, plus strips and lines off "
-        "with the one-draw baseline (bench_gl.csv, bench_gl.md): systems, draw() and GPU ms, draw commands, "
-        "bytes, memory; with `swaying` or `stream` selected, the node stream's rows at 1,000, 10,000 and 100,000 "
-        "moving wires (--wires: that count) beside this machine's copy floor (bench_gl_stream.csv)");
+        "and `far` at --size with --wires wires on cpu-mesh and gpu-nodes at 1, 2 and all threads, plus strips "
+        "and lines off with the one-draw baseline (bench_gl.csv, bench_gl.md): systems, draw() and GPU ms, draw "
+        "commands, bytes, memory; with `swaying` or `stream` selected, the node stream's rows at 1,000, 10,000 "
+        "and 100,000 moving wires (--wires: that count) beside this machine's copy floor (bench_gl_stream.csv)");
     cmd->add_option_function<std::string>(
            "--size",
            [o](const std::string& text) {

@@ -58,7 +58,7 @@ struct ViewOptions {
     std::string size = "1280x720";
     std::optional<double> tolerance_px;
     std::optional<std::string> spline;
-    std::string path;  ///< auto|cpu|gpu|nodes; empty: auto
+    std::string path;  ///< auto|cpu|nodes (gpu: retired, nodes); empty: auto
     std::string png_out, csv_out, stats_out;
     std::optional<double> ground_y;  ///< --ground: a horizontal plane at this height
     std::string light;               ///< --light DX,DY,DZ: toward the shadow-casting directional light
@@ -337,6 +337,8 @@ int run_view(const ViewOptions& o) try {
     auto made = wire::render::WireRenderer::create();
     if (!made) throw Failure{exit_failure, "cannot create the wire renderer: " + made.error().message};
     wire::render::WireRenderer renderer = std::move(made).value();
+    if (const std::string_view note = wire::retired_path_note(o.path); !note.empty())
+        std::fprintf(stderr, "wiretool view: %s\n", std::string(note).c_str());
     path = o.path.empty() || o.path == "auto" ? renderer.preferred_path()
                                               : *wire::parse_upload_path(o.path);  // CLI11 checked the name
     // Material 0 is the renderer's copper weave; wires cycle through it and five more tints.
@@ -420,7 +422,7 @@ int run_view(const ViewOptions& o) try {
     const bool png_every_frame = o.png_out.find(kPerFrameToken) != std::string::npos;
     std::string csv = std::string(kRingCsvHeader) + ",sides\n";
     wire::RingSet ring_set;  // per wire, for the CSV (reused)
-    std::vector<wire::render::DrawnRings> gpu_rings;  // the nodes path's, read back per frame
+    std::vector<wire::render::DrawnRings> drawn_rings;  // the nodes path's, read back per frame
     wire::Curve gpu_curve;                            // the nodes path: a wire's curve, for its screen error
     nlohmann::ordered_json frame_records = nlohmann::ordered_json::array();
     for (std::size_t f = 0; f < frames; ++f) {
@@ -482,9 +484,9 @@ int run_view(const ViewOptions& o) try {
         }
         std::vector<const wire::render::DrawnRings*> gpu_of(wires, nullptr);
         if (path == wire::UploadPath::gpu_nodes) {
-            if (engine::Status st = renderer.read_drawn_rings(gpu_rings); !st)
+            if (engine::Status st = renderer.read_drawn_rings(drawn_rings); !st)
                 throw Failure{exit_failure, "cannot read back the rings the GPU drew: " + st.message};
-            for (const wire::render::DrawnRings& d : gpu_rings) {
+            for (const wire::render::DrawnRings& d : drawn_rings) {
                 const auto it = wire_of_entity.find(d.wire_id);
                 if (it != wire_of_entity.end()) gpu_of[it->second] = &d;
             }
@@ -610,7 +612,7 @@ Action add_view_command(CLI::App& app) {
     cmd->add_option("--path", o->path, "Upload path: auto (default: nodes where the GL context has compute "
                                        "shaders, else cpu; logged on stderr), nodes (nodes only: curve, LOD, frames "
                                        "and rings in compute shaders), cpu (meshes built on the CPU: the portable "
-                                       "reference) or gpu (ring records, expanded in the vertex shader)")
+                                       "reference); gpu, retired, draws on nodes")
         ->check(CLI::IsMember({"auto", "cpu", "gpu", "nodes"}));
     cmd->add_option("--png", o->png_out,
                     "Write the last frame as PNG; if OUT contains %04d, every frame (%04d = frame number)");

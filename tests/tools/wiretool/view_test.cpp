@@ -344,7 +344,7 @@ TEST_F(WiretoolView, RandomScenesStayWithinTheToleranceOnEveryFrame) {
         const std::string in = write("random.json", random_flight(rng, 10).dump());
         const double tolerance = seed % 2 == 0 ? 0.5 : 1.0;
         const std::string args = in + " --size 640x360 --tolerance-px " + std::to_string(tolerance) +
-                                 (seed % 3 == 0 ? " --path gpu" : "") + " --stats " + path("s.json");
+                                 (seed % 3 == 0 ? " --path cpu" : "") + " --stats " + path("s.json");
         const ToolRun r = run(args);
         ASSERT_EQ(r.status, 0) << "seed " << seed << ": " << r.err;
         const json frames = read_json(path("s.json")).at("frames");
@@ -374,13 +374,27 @@ TEST_F(WiretoolView, RandomScenesStayWithinTheToleranceOnEveryFrame) {
                 near_rings, far_rings);
 }
 
+// `--path gpu` named the ring records the CPU built, retired in 0.4: it draws on the nodes path for one release
+// and says so on stderr.
+TEST_F(WiretoolView, PathGpuIsARetiredNameOfNodes) {
+    const std::string in = write("wires.json", json{{"wires", three_wires()}}.dump());
+    const ToolRun r = run(in + " --path gpu --size 320x180 --stats " + path("gpu.json"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(read_json(path("gpu.json")).at("summary").at("path"), "nodes");
+    EXPECT_NE(r.err.find("'gpu'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("retired"), std::string::npos) << r.err;
+    const ToolRun bad = run(in + " --path rings --size 320x180");
+    EXPECT_EQ(bad.status, 2) << "an unknown path is a usage error";
+}
+
 TEST_F(WiretoolView, DefaultCameraFramesTheWiresAndBothPathsAgree) {
     const std::string in = write("wires.json", json{{"wires", three_wires()}}.dump());
     ASSERT_EQ(run(in + " --path cpu --png " + path("cpu.png") + " --stats " + path("cpu.json") + " --csv " + path("cpu.csv")).status, 0);
-    ASSERT_EQ(run(in + " --path gpu --png " + path("gpu.png") + " --stats " + path("gpu.json")).status, 0);
+    ASSERT_EQ(run(in + " --path nodes --png " + path("nodes.png") + " --stats " + path("nodes.json")).status, 0);
     // The default: the nodes path under llvmpipe (GL 4.5 compute), drawing the CPU's rings.
     ASSERT_EQ(run(in + " --stats " + path("default.json")).status, 0);
-    const json cpu = read_json(path("cpu.json")), gpu = read_json(path("gpu.json")), nodes = read_json(path("default.json"));
+    const json cpu = read_json(path("cpu.json")), gpu = read_json(path("nodes.json"));
+    const json nodes = read_json(path("default.json"));
     EXPECT_EQ(cpu.at("summary").at("path"), "cpu");
     EXPECT_EQ(nodes.at("summary").at("path"), "nodes");
     EXPECT_EQ(nodes.at("frames")[0].at("rings"), cpu.at("frames")[0].at("rings"));
@@ -415,7 +429,7 @@ TEST_F(WiretoolView, DefaultCameraFramesTheWiresAndBothPathsAgree) {
     EXPECT_LT(y1, 719);
     EXPECT_GT(std::max((x1 - x0) / 1280.0, (y1 - y0) / 720.0), 0.4);
     // Both upload paths render the same image (up to rasterization differences on a few edge pixels).
-    const auto other = engine::platform::read_png(path("gpu.png"));
+    const auto other = engine::platform::read_png(path("nodes.png"));
     ASSERT_TRUE(other.ok());
     std::size_t differ = 0, drawn = 0;
     for (int y = 0; y < 720; ++y)
@@ -609,7 +623,7 @@ double percentile(std::vector<double> v, double q) {
 }
 
 // The same cables and camera 260 km and 1e6 m from the origin (random directions) draw the same picture as at the
-// origin: at most 1 % of the wire pixels off by more than 8/255, on the three upload paths, over random scenes. (A float
+// origin: at most 1 % of the wire pixels off by more than 8/255, on both upload paths, over random scenes. (A float
 // camera there steps by 3-6 cm: 17.6 % of the pixels were off at 260 km.)
 TEST_F(WiretoolView, OpenWorldFarFromTheOriginDrawsThePictureOfTheOrigin) {
     std::mt19937 rng(31);
@@ -624,7 +638,7 @@ TEST_F(WiretoolView, OpenWorldFarFromTheOriginDrawsThePictureOfTheOrigin) {
             const glm::dvec3 offset = distance * glm::normalize(glm::dvec3(gauss(rng), gauss(rng), gauss(rng)));
             const std::string far =
                 write("far.json", open_world_scene(open_world_cables(seed, offset), offset, 1, 0.0).dump());
-            for (const char* p : {"cpu", "gpu", "nodes"}) {
+            for (const char* p : {"cpu", "nodes"}) {
                 const std::string common = std::string(" --size 960x540 --path ") + p + " --png ";
                 ASSERT_EQ(run(origin + common + path("o.png")).status, 0);
                 const ToolRun r = run(far + common + path("f.png"));
@@ -654,7 +668,7 @@ TEST_F(WiretoolView, OpenWorldCameraStepsOfOneMillimetreMoveTheImageSmoothly) {
     const std::string origin =
         write("origin.json", open_world_scene(open_world_cables(7, glm::dvec3(0.0)), glm::dvec3(0.0), kFrames, 1e-3).dump());
     const std::string far = write("far.json", open_world_scene(open_world_cables(7, offset), offset, kFrames, 1e-3).dump());
-    for (const char* p : {"cpu", "gpu", "nodes"}) {
+    for (const char* p : {"cpu", "nodes"}) {
         const std::string common = std::string(" --size 960x540 --path ") + p + " --png ";
         ASSERT_EQ(run(origin + common + path("o_%04d.png")).status, 0);
         ASSERT_EQ(run(far + common + path("f_%04d.png")).status, 0);

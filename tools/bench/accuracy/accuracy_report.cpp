@@ -132,10 +132,10 @@ int write_accuracy_report(const Options& o, const std::vector<ReferenceScene>& s
                   "sides",
                   "vertices",
                   "bytes_cpu_mesh",
-                  "bytes_gpu_rings",
+                  "bytes_gpu_nodes",
                   "ns_per_vertex",
                   "us_per_wire_cpu_mesh",
-                  "us_per_wire_gpu_rings",
+                  "us_per_wire_gpu_nodes",
                   "max_world_error_m",
                   "max_screen_error_px",
                   "max_twist_deg",
@@ -157,12 +157,11 @@ int write_accuracy_report(const Options& o, const std::vector<ReferenceScene>& s
         "0.25, "
         "0.5, 1 and 2 px. Columns: rings, radial sides and tube vertices the LOD chose; bytes one frame "
         "uploads "
-        "(cpu-mesh: vertices + indices + draw record + command; gpu-rings: 48-byte ring records + draw "
-        "record + "
-        "command); CPU time of curve + lod + rings + mesh (cpu-mesh) or curve + lod + rings (gpu-rings) per "
-        "wire, "
-        "median of 3 trials, and per vertex; `max_world_error_m`: largest distance from the drawn centre "
-        "polyline "
+        "(cpu-mesh: vertices + indices + draw record + command; gpu-nodes: the first frame's 64-byte header, "
+        "packed nodes and list entry, independent of the tolerance); CPU time of curve + lod + rings + mesh "
+        "(cpu-mesh) or of packing the nodes (gpu-nodes; churn: the pop-free stage, which runs on the CPU on both "
+        "paths) per wire, median of 3 trials, and per vertex; `max_world_error_m`: largest distance from the "
+        "drawn centre polyline "
         "to the exact curve (spline error plus tessellation error); `max_screen_error_px`: largest pixel "
         "distance "
         "from the rendered curve to the drawn polyline; `max_twist_deg`: largest angle between a ring's "

@@ -5,6 +5,7 @@
 #include "bench/common.hpp"
 
 #include <wire/lod.hpp>
+#include <wire/packed_nodes.hpp>
 #include <wire/pop_free.hpp>
 #include <wire/rings.hpp>
 #include <wire/spline.hpp>
@@ -76,7 +77,7 @@ Row measure_row(const ReferenceScene& s, const Method& m, const wire::WireNodes&
     r.sides = w.lod.sides;
     r.vertices = w.mesh.vertices.size();
     r.bytes_cpu = cpu_mesh_bytes(1, w.mesh.vertices.size(), w.mesh.indices.size());
-    r.bytes_gpu = gpu_rings_bytes(1, w.rings.rings.size());
+    r.bytes_gpu = gpu_nodes_bytes(nodes, m.spline);
     r.world_m = world_error_m(s, w.curve, w.params);
     r.screen_px = wire::measure_screen_error(w.curve, w.params, s.view, 256).max_px;
     r.twist_deg = twist_error_deg(w.curve, w.params, w.rings);
@@ -88,12 +89,8 @@ Row measure_row(const ReferenceScene& s, const Method& m, const wire::WireNodes&
             tessellate(s.view, tol, m.frames, true, t);
         },
         min_ms);
-    r.us_gpu = time_us(
-        [&] {
-            (void)wire::build_curve(nodes, m.spline, t.curve);
-            tessellate(s.view, tol, m.frames, false, t);
-        },
-        min_ms);
+    wire::PackedNodes packed;
+    r.us_gpu = time_us([&] { (void)wire::pack_nodes(nodes, m.spline, packed); }, min_ms);
     r.ns_per_vertex = r.vertices > 0 ? 1e3 * r.us_cpu / static_cast<double>(r.vertices) : 0.0;
     return r;
 }
@@ -106,19 +103,24 @@ Row measure_churn_row(const ReferenceScene& s, const Method& m, const std::vecto
     r.tolerance_px = tol;
     wire::PopFreeCurve multires({.spline = m.spline});
     WireOutput w;
-    std::vector<double> us;
+    std::vector<double> us, us_nodes;
     std::size_t frames = 0;
     for (std::size_t f = 0; f < states.size(); ++f) {
         const double c0 = cpu_ms();
         if (!multires.update(states[f], w.curve)) continue;
+        const double c1 = cpu_ms();
         tessellate(s.view, tol, m.frames, true, w);
         us.push_back(1e3 * (cpu_ms() - c0));
+        // The nodes path runs the pop-free stage on the CPU too; a blending wire sends its curve's segments.
+        us_nodes.push_back(1e3 * (c1 - c0));
         ++frames;
         r.rings = std::max(r.rings, w.params.size());
         r.sides = std::max<std::size_t>(r.sides, w.lod.sides);
         r.vertices = std::max(r.vertices, w.mesh.vertices.size());
         r.bytes_cpu = std::max(r.bytes_cpu, cpu_mesh_bytes(1, w.mesh.vertices.size(), w.mesh.indices.size()));
-        r.bytes_gpu = std::max(r.bytes_gpu, gpu_rings_bytes(1, w.rings.rings.size()));
+        // The nodes path: a blending wire's curve as 64-byte segments (plan_nodes_frame), else its nodes.
+        r.bytes_gpu = std::max(r.bytes_gpu, multires.blending() ? 64 + 64 * w.curve.segment_count() + 4
+                                                                : gpu_nodes_bytes(states[f], m.spline));
         if (f % 10 == 0 || f + 1 == states.size()) {
             r.world_m = std::max(r.world_m, world_error_m(s, w.curve, w.params));
             r.screen_px =
@@ -127,8 +129,7 @@ Row measure_churn_row(const ReferenceScene& s, const Method& m, const std::vecto
         }
     }
     r.us_cpu = median(us);
-    r.us_gpu =
-        r.us_cpu;  // the frame cost is dominated by the pop-free curve stage; the tube is not split out here
+    r.us_gpu = median(us_nodes);
     r.ns_per_vertex = r.vertices > 0 ? 1e3 * r.us_cpu / static_cast<double>(r.vertices) : 0.0;
     (void)frames;
     return r;

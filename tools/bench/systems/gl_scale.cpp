@@ -29,13 +29,11 @@
 namespace wiretool::bench {
 namespace {
 
-enum class GlPathKind { cpu_mesh, gpu_streamed, gpu_retained, gpu_nodes, one_draw };
+enum class GlPathKind { cpu_mesh, gpu_nodes, one_draw };
 
 const char* path_name(GlPathKind k) {
     switch (k) {
         case GlPathKind::cpu_mesh: return "cpu-mesh";
-        case GlPathKind::gpu_streamed: return "gpu-rings";
-        case GlPathKind::gpu_retained: return "gpu-retained";
         case GlPathKind::gpu_nodes: return "gpu-nodes";
         case GlPathKind::one_draw: return "one-draw baseline";
     }
@@ -94,7 +92,6 @@ std::size_t visible_nodes(const wire::DrawList& list) {
     for (const wire::DrawItem& item : list.items) {
         if (item.nodes != nullptr) n += item.nodes->size();
         else if (item.curve != nullptr) n += item.curve->node_count();
-        else n += item.rings.size();  // not a nodes-path item: its rings
     }
     return n;
 }
@@ -120,7 +117,7 @@ public:
     void run_row(const Options& o, SceneKind kind, int wires, int threads, GlPathKind path, bool thin,
                  int frames, std::vector<Row>& rows) {
         const bool cpu = path == GlPathKind::cpu_mesh || path == GlPathKind::one_draw;
-        auto made = wire::render::WireRenderer::create({.retain_rings = path == GlPathKind::gpu_retained});
+        auto made = wire::render::WireRenderer::create();
         if (!made) {
             std::fprintf(stderr, "bench --gl: %s\n", made.error().message.c_str());
             return;
@@ -130,15 +127,12 @@ public:
         Row row;
         row.scene = scene_name(kind), row.wires = wires, row.threads = threads, row.path = path, row.thin = thin;
         row.f.timer = engine::gfx::GpuTimer::create();
-        wire::render::RingResidency model;  // what the retained renderer should send
         wire::render::NodesPlan seen;  // gpu-nodes: what the renderer has on the GPU
         MergedMesh merged;
         std::fprintf(stderr, "bench --gl: %s, %d wires, %dx%d, %d thread(s), %s%s\n", row.scene.c_str(), wires,
                      o.width_px, o.height_px, threads, path_name(path), thin ? "" : ", strips and lines off");
         RunSpec spec{.kind = kind,
-                     .path = cpu                              ? wire::UploadPath::cpu_mesh
-                             : path == GlPathKind::gpu_nodes ? wire::UploadPath::gpu_nodes
-                                                              : wire::UploadPath::gpu_rings,
+                     .path = cpu ? wire::UploadPath::cpu_mesh : wire::UploadPath::gpu_nodes,
                      .threads = threads,
                      .frames = frames,
                      .wires = wires,
@@ -157,8 +151,6 @@ public:
                 merged.build(ctx.draw_list);
                 list = &merged.list;
                 computed = upload_bytes(*list);
-            } else if (path == GlPathKind::gpu_retained) {
-                computed = wire::render::plan_retained_frame(ctx.draw_list, model).bytes;
             } else if (path == GlPathKind::gpu_nodes) {
                 computed = wire::render::plan_nodes_frame(ctx.draw_list, seen);
             } else {
@@ -199,7 +191,7 @@ public:
         std::erase_if(row.f.gpu_ms, [](double v) { return v < 0.0; });
         row.f.systems_ms = run.frame_wall_ms;  // per measured frame, the same frames as the draws
         row.wire_memory_bytes = static_cast<double>(run.memory.visible_bytes + run.memory.culled_bytes);
-        row.gpu_buffer_bytes = static_cast<double>(3 * renderer.info().region_bytes + renderer.info().ring_storage_capacity);
+        row.gpu_buffer_bytes = static_cast<double>(3 * renderer.info().region_bytes);
         rows.push_back(std::move(row));
     }
 
@@ -257,13 +249,11 @@ int run_gl_scale_bench(const Options& o) {
         const int wires = o.wires > 0 ? o.wires : scene_wire_count(kind);
         const std::size_t first = rows.size();
         for (int threads : thread_counts())
-            for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_streamed, GlPathKind::gpu_retained,
-                                 GlPathKind::gpu_nodes})
+            for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_nodes})
                 gl.run_row(o, kind, wires, threads, p, true, frames, rows);
         // Strips and lines off, so that the one-draw baseline draws exactly the triangles the paths draw.
         const int all = thread_counts().back();
-        for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_streamed, GlPathKind::gpu_retained,
-                             GlPathKind::gpu_nodes, GlPathKind::one_draw})
+        for (GlPathKind p : {GlPathKind::cpu_mesh, GlPathKind::gpu_nodes, GlPathKind::one_draw})
             gl.run_row(o, kind, wires, all, p, false, frames, rows);
         double baseline_gpu = 0.0;
         for (std::size_t r = first; r < rows.size(); ++r)
@@ -313,8 +303,8 @@ int run_gl_scale_bench(const Options& o) {
           "+ finish (the one-draw baseline: its draw + finish only); draw_commands: indirect commands (or "
           "draws) the GPU processes; draw_calls: GL multi-draw/draw calls; bytes_per_frame: what draw() "
           "memcpy'd (bytes_mismatch_frames: frames where that differs from the computed plan, must be 0); "
-          "wire_memory_bytes: the wire systems' state; gpu_buffer_bytes: the renderer's stream regions (3) and "
-          "retained ring storage. Rows with thin_wires off draw every wire as a tube; the one-draw baseline "
+          "wire_memory_bytes: the wire systems' state; gpu_buffer_bytes: the renderer's stream regions (3). Rows "
+          "with thin_wires off draw every wire as a tube; the one-draw baseline "
           "draws the same frame's triangles merged into one indexed mesh with one command (same shaders), and "
           "gpu_vs_one_draw is each such row's GPU ms over the baseline's (nan in rows with thin wires on).\n\n";
     md += table.markdown();

@@ -1,6 +1,6 @@
 // `wiretool bench --gl`, the scaling part: `standard`, `swaying` and `far` drawn by the real WireRenderer at
-// --size (default 1920x1080) with --wires wires, on every path (cpu-mesh, gpu-rings streamed, gpu-rings
-// retained) at 1, 2 and all hardware threads, plus a run with strips and lines off (every wire a tube) and the
+// --size (default 1920x1080) with --wires wires, on both paths (cpu-mesh, gpu-nodes) at 1, 2 and all hardware
+// threads, plus a run with strips and lines off (every wire a tube) and the
 // one-draw baseline of that run: the frame's triangles merged into one indexed mesh, drawn with one command by
 // the same renderer (same shaders), so the GPU ms of the wire paths against it is the price of drawing per wire.
 // Per row: systems wall ms, draw() wall ms, GPU ms (GL_TIME_ELAPSED), draw + glFinish ms, end to end ms, draw

@@ -78,9 +78,9 @@ FrameTimes run_systems_timed(engine::ecs::Registry& registry, wire::systems::Wir
     return t;
 }
 
-// A measured frame's times, counts and upload bytes (streamed, and retained for gpu-rings).
+// A measured frame's times, counts and upload bytes (`nodes_bytes`: plan_nodes_frame's, on the nodes path).
 void record_frame(SceneRun& out, const FrameTimes& t, engine::ecs::Registry& registry,
-                  const wire::systems::WireContext& ctx, const wire::render::RetainedFrame& retained) {
+                  const wire::systems::WireContext& ctx, std::size_t nodes_bytes) {
     out.system_cpu_ms.push_back(t.cpu);
     double total = 0.0;
     for (double v : t.cpu) total += v;
@@ -89,8 +89,8 @@ void record_frame(SceneRun& out, const FrameTimes& t, engine::ecs::Registry& reg
     out.visible.push_back(static_cast<double>(ctx.stats.visible_wires));
     out.rings.push_back(static_cast<double>(ctx.stats.rings));
     out.vertices.push_back(static_cast<double>(ctx.stats.vertices));
-    out.bytes.push_back(static_cast<double>(upload_bytes(ctx.draw_list)));
-    out.retained_bytes.push_back(static_cast<double>(retained.bytes));
+    out.bytes.push_back(static_cast<double>(
+        ctx.draw_list.path == wire::UploadPath::gpu_nodes ? nodes_bytes : upload_bytes(ctx.draw_list)));
     double segments = 0.0;
     for (const wire::DrawItem& item : ctx.draw_list.items)
         segments += static_cast<double>(
@@ -138,7 +138,7 @@ SceneRun run_scene(const RunSpec& spec) {
         sample_frames.push_back(1 + (spec.frames - 2) * k / std::max(1, spec.error_samples - 1));
 
     SceneRun out;
-    wire::render::RingResidency residency;  // the retained path's bookkeeping, as the renderer keeps it
+    wire::render::NodesPlan nodes_plan;  // the nodes path's slots, as the renderer keeps them
     uint64_t since = 0;
     for (int f = 0; f < spec.frames; ++f) {
         place_camera(ctx.camera, spec.kind, f);
@@ -147,14 +147,13 @@ SceneRun run_scene(const RunSpec& spec) {
                 sway_nodes(wire::systems::edit_nodes(registry, wires[i]), i, f);
         }
         const FrameTimes times = run_systems_timed(registry, ctx, since);
-        const wire::render::RetainedFrame retained =
-            spec.path == wire::UploadPath::gpu_rings
-                ? wire::render::plan_retained_frame(ctx.draw_list, residency)
-                : wire::render::RetainedFrame{};
+        const std::size_t nodes_bytes = spec.path == wire::UploadPath::gpu_nodes
+                                             ? wire::render::plan_nodes_frame(ctx.draw_list, nodes_plan)
+                                             : 0;
         if (spec.after_frame) spec.after_frame(ctx, f);
         if (f == 0) continue;  // the first frame builds everything: a loading cost, not a frame cost
 
-        record_frame(out, times, registry, ctx, retained);
+        record_frame(out, times, registry, ctx, nodes_bytes);
         if (!spec.sample_errors ||
             std::find(sample_frames.begin(), sample_frames.end(), f) == sample_frames.end())
             continue;

@@ -38,9 +38,9 @@ struct Sample {
 struct SceneRun {
     std::vector<std::array<double, kSystems>> system_cpu_ms;  ///< per measured frame
     std::vector<double> frame_cpu_ms, frame_wall_ms;
+    /// bytes: cpu-mesh streamed_upload_bytes; nodes path plan_nodes_frame (rings and vertices are 0 there: the
+    /// GPU computes them)
     std::vector<double> visible, rings, vertices, bytes;
-    std::vector<double>
-        retained_bytes;  ///< gpu-rings: what the retained path sends (upload_plan.hpp's model)
     std::vector<double> visible_segments;  ///< per frame: segments of the visible wires (uniform counts)
     std::vector<Sample> samples;
     double max_error_px = 0.0;

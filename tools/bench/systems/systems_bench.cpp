@@ -54,14 +54,14 @@ SceneRun run_adaptive(const Options& o, const SystemsPlan& plan, SceneKind kind,
     const int wires = scene_wire_count(kind);
     const int frames = scene_frames(o, plan, kind);
     std::fprintf(stderr, "bench: %s %s, %d wires, %d frames, %d thread(s)\n", name.c_str(),
-                 cpu ? "cpu-mesh" : "gpu-rings", wires, frames, o.threads);
+                 cpu ? "cpu-mesh" : "gpu-nodes", wires, frames, o.threads);
     RunSpec spec{.kind = kind,
                  .path = path,
                  .threads = o.threads,
                  .frames = frames,
                  .wires = wires,
-                 .sample_errors = true,
-                 .error_samples = plan.error_samples,
+                 .sample_errors = cpu,  // the nodes path's LOD runs on the GPU (bench --gl measures it)
+                 .error_samples = cpu ? plan.error_samples : 0,
                  .after_frame = {},
                  .spline = plan.spline};
     return run_scene(spec);
@@ -122,7 +122,7 @@ void bench_scene(const Options& o, const SystemsPlan& plan, SceneKind kind,
     const std::string name = scene_name(kind);
     const int wires = scene_wire_count(kind);
     const SceneRun cpu_run = run_adaptive(o, plan, kind, wire::UploadPath::cpu_mesh);
-    const SceneRun gpu_run = run_adaptive(o, plan, kind, wire::UploadPath::gpu_rings);
+    const SceneRun gpu_run = run_adaptive(o, plan, kind, wire::UploadPath::gpu_nodes);
     report.add_adaptive(name, o.spline, wires, cpu_run, gpu_run);
     const Uniform u = search_uniform(cpu_run);
     // Stage by stage, for the per-system columns and the uniform baseline's curve stage (the adaptive rows run

@@ -17,7 +17,7 @@ struct SystemsReport {
     std::string notes;         ///< per scene: the uniform baseline's choice
     std::string system_lines;  ///< per scene: per-system CPU table rows
     std::string memory_lines;  ///< per scene and path: memory table rows
-    std::string scene_bytes;   ///< per scene: gpu-rings streamed and retained bytes, cpu-mesh bytes, ratios
+    std::string scene_bytes;   ///< per scene: gpu-nodes bytes, cpu-mesh bytes, their ratio
     std::string thread_lines;  ///< per scene: 1 vs 2 threads
     std::string decision_lines;  ///< per scene: adaptive vs uniform CPU, lod share (issue 29's decisions)
     // The figures section (`standard`, `offscreen`, `far`; negative: the scene did not run).
@@ -29,8 +29,8 @@ struct SystemsReport {
 
     SystemsReport();
 
-    /// The rows of one scene's adaptive runs: memory (both paths), bench.csv (cpu-mesh, gpu-rings,
-    /// gpu-retained) and bytes uploaded.
+    /// The rows of one scene's adaptive runs: memory (both paths), bench.csv (cpu-mesh, gpu-nodes)
+    /// and bytes uploaded.
     void add_adaptive(const std::string& scene, const std::string& method, int wires, const SceneRun& cpu_run,
                       const SceneRun& gpu_run);
     /// The uniform baseline's bench.csv row and note, and the scene's per-system CPU row. `staged`: the

@@ -6,7 +6,6 @@
 #include "wire/lod.hpp"
 #include "wire/nodes.hpp"
 #include "wire/packed_nodes.hpp"
-#include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
 #include "wire/spline.hpp"
 #include "wire/tube.hpp"
@@ -23,29 +22,34 @@ namespace wire {
 
 /// How wire geometry reaches the GPU.
 enum class UploadPath : uint8_t {
-    cpu_mesh,   ///< vertices + indices built on the CPU (TubeVertex, 32 bytes a vertex)
-    gpu_rings,  ///< ring records only (packed to 28 bytes a ring by the renderer, retained on the GPU while a
-                ///< wire's rings are unchanged); the vertex shader expands sides from gl_VertexID
+    cpu_mesh,  ///< vertices + indices built on the CPU (TubeVertex, 32 bytes a vertex): the portable reference
     /// nodes only: the nodes of wires whose nodes changed (8 bytes a node plus 8 where the wire's nodes are
     /// quantised, else 16; packed_nodes.hpp) plus a 64-byte header, and 4 bytes a visible wire; curve, LOD (below
     /// the node resolution too), frames, rings and the draw's arguments are
-    /// computed on the GPU (wire/render's nodes path), the gpu-rings vertex shader draws them
+    /// computed on the GPU (wire/render's nodes path), the ring vertex shader draws them
     gpu_nodes,
 };
 
-/// The name of an upload path on command lines, in Python and in reports: "cpu" (cpu_mesh), "gpu" (gpu_rings),
-/// "nodes" (gpu_nodes).
+/// The name of an upload path on command lines, in Python and in reports: "cpu" (cpu_mesh), "nodes" (gpu_nodes).
 [[nodiscard]] constexpr std::string_view upload_path_name(UploadPath path) {
     switch (path) {
         case UploadPath::cpu_mesh: return "cpu";
-        case UploadPath::gpu_rings: return "gpu";
         case UploadPath::gpu_nodes: return "nodes";
     }
     return "?";
 }
-/// The path named `name` (upload_path_name's names); nullopt for any other name.
+/// The one-line notice a front end prints when `name` is a retired path's name ("gpu": the ring records the CPU
+/// built, retired in 0.4, drawn on the nodes path until the name goes in 0.5); empty for any other name.
+[[nodiscard]] constexpr std::string_view retired_path_note(std::string_view name) {
+    return name == "gpu" ? "upload path 'gpu' (ring records built on the CPU) was retired in 0.4: drawing on 'nodes' "
+                           "(the name goes in 0.5)"
+                         : "";
+}
+/// The path named `name` (upload_path_name's names; "gpu", retired, names gpu_nodes: see retired_path_note);
+/// nullopt for any other name.
 [[nodiscard]] constexpr std::optional<UploadPath> parse_upload_path(std::string_view name) {
-    for (UploadPath p : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+    if (name == "gpu") return UploadPath::gpu_nodes;
+    for (UploadPath p : {UploadPath::cpu_mesh, UploadPath::gpu_nodes}) {
         if (upload_path_name(p) == name) return p;
     }
     return std::nullopt;
@@ -56,23 +60,14 @@ enum class UploadPath : uint8_t {
 struct DrawItem {
     glm::dvec3 origin_m{};   ///< world position the item's geometry is relative to
     uint32_t material = 0;   ///< index into the renderer's material table (texture, colour)
-    uint64_t wire_id = 0;    ///< the wire's entity (unique while it lives; the retained ring storage's key)
-    /// gpu_rings: changes whenever `rings` change (WireRings::generation). The renderer keeps a wire's ring
-    /// records on the GPU while (wire_id, rings_generation) stays the same; 0 means unknown: upload every frame.
-    uint64_t rings_generation = 0;
+    uint64_t wire_id = 0;    ///< the wire's entity (unique while it lives; the nodes path's slot key)
 
     // cpu_mesh path
     std::span<const TubeVertex> vertices;  ///< tube vertices (cpu_mesh path)
     std::span<const uint32_t> indices;  ///< relative to this item's first vertex
 
-    // gpu_rings path
-    std::span<const Ring> rings;  ///< ring records (gpu_rings path)
-    /// gpu_rings: `rings` in the GPU's 28-byte form (the rings system packs them on its worker threads); empty:
-    /// the renderer packs them itself. Same count as `rings` when set.
-    std::span<const PackedRing> packed;
-    /// gpu_rings: whether the rings' radius varies along the wire (the shader then tilts normals); unset: the
-    /// renderer checks the rings itself.
-    std::optional<bool> radius_varies;
+    /// cpu_mesh: the rings the mesh was built from (not read by the renderer; checks and tools read them)
+    std::span<const Ring> rings;
     // gpu_nodes path
     const WireNodes* nodes = nullptr;  ///< validated nodes (the systems' checks); alive until the draw returns
     /// `nodes` packed for the GPU (wire::pack_nodes, done by the systems on their worker threads); when set, the

@@ -3,8 +3,8 @@
 // quaternion in "smallest three" form: the index of the largest component (2 bits) and the other three in
 // [-1/sqrt 2, 1/sqrt 2] as 20-bit fixed point (step 1.35e-6), the largest made positive and rebuilt as
 // sqrt(1 - a^2 - b^2 - c^2). Measured in upload_plan_test: frame angle error median 1.4e-6, max 3.6e-6 rad, so the rim moves
-// < 0.01 px for tubes up to thousands of pixels in radius. The rings system writes these on the gpu-rings path
-// (WireRings::packed, DrawItem::packed), in parallel, so the renderer's thread only copies them.
+// < 0.01 px for tubes up to thousands of pixels in radius. The nodes path's ring pass writes these on the GPU and
+// the ring vertex shader reads them; read_drawn_rings decodes them on the CPU (unpack_frame).
 #pragma once
 
 #include "wire/rings.hpp"

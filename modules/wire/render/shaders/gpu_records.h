@@ -77,7 +77,7 @@ struct SlotState {
 // The per-draw record the ring pass (or the CPU, on cpu-mesh) writes and the vertex shader reads.
 struct GpuDraw {
     vec3 offset_m;             // the wire's origin minus the camera position (the difference taken in double)
-    uint ring_first WIRE_ZERO;  // gpu-rings and nodes: first 32-bit word of the wire's PackedRings
+    uint ring_first WIRE_ZERO;  // first 32-bit word of the wire's PackedRings (the nodes path's ring pass writes them)
     uint ring_count WIRE_ZERO;
     uint sides WIRE_ZERO;
     uint flags WIRE_ZERO;  // kDraw* bits
@@ -85,6 +85,5 @@ struct GpuDraw {
 };
 WIRE_CONST uint kDrawClosed = 1u, kDrawCaps = 2u, kDrawTilt = 4u;
 WIRE_CONST uint kDrawStrip = 8u, kDrawLine = 16u;  // a camera-facing strip (sides 2), a phone-wire line (sides 1)
-WIRE_CONST uint kDrawStreamedRings = 32u;  // gpu-rings: the wire's rings are in the frame's region (binding 4)
 
 #endif

@@ -1,8 +1,6 @@
 // Packed ring records (wire::render::PackedRing, 7 words): centre xyz, radius, u (floats), frame quaternion in
 // smallest-three form (2-bit index of the largest component, three 20-bit components).
 layout(std430, binding = 1) readonly buffer Rings { uint ring_words[]; };
-// The retained path's wires that move (kDrawStreamedRings): their rings in the frame's stream region.
-layout(std430, binding = 4) readonly buffer StreamRings { uint stream_words[]; };
 // cos and sin of 2 pi j / n for n = 3, 4, ... (n + 1 entries each, the last repeating j = 0), computed as
 // wire::write_tube's side table (double, then float): the two paths place rim vertices identically.
 layout(std430, binding = 2) readonly buffer Circle { vec2 circle[]; };
@@ -14,12 +12,11 @@ const uint kCapVertexBase = 1073741824u;  // 1 << 30: vertex ids of the two caps
 struct Ring { vec3 centre_m; float radius_m; float u; vec3 normal; vec3 binormal; vec3 tangent; };
 
 uint ring_base(GpuDraw d, uint i) { return d.ring_first + i * 7u; }
-uint ring_word(GpuDraw d, uint w) { return (d.flags & kDrawStreamedRings) != 0u ? stream_words[w] : ring_words[w]; }
 vec3 ring_centre(GpuDraw d, uint i) {
   uint b = ring_base(d, i);
-  return vec3(uintBitsToFloat(ring_word(d, b)), uintBitsToFloat(ring_word(d, b + 1u)), uintBitsToFloat(ring_word(d, b + 2u)));
+  return vec3(uintBitsToFloat(ring_words[b]), uintBitsToFloat(ring_words[b + 1u]), uintBitsToFloat(ring_words[b + 2u]));
 }
-float ring_radius(GpuDraw d, uint i) { return uintBitsToFloat(ring_word(d, ring_base(d, i) + 3u)); }
+float ring_radius(GpuDraw d, uint i) { return uintBitsToFloat(ring_words[ring_base(d, i) + 3u]); }
 
 float fixed20(uint k) { return (float(k) / 1048575.0 * 2.0 - 1.0) * 0.70710678; }
 
@@ -27,9 +24,9 @@ Ring load_ring(GpuDraw d, uint i) {
   uint b = ring_base(d, i);
   Ring r;
   r.centre_m = ring_centre(d, i);
-  r.radius_m = uintBitsToFloat(ring_word(d, b + 3u));
-  r.u = uintBitsToFloat(ring_word(d, b + 4u));
-  uint w0 = ring_word(d, b + 5u), w1 = ring_word(d, b + 6u);
+  r.radius_m = uintBitsToFloat(ring_words[b + 3u]);
+  r.u = uintBitsToFloat(ring_words[b + 4u]);
+  uint w0 = ring_words[b + 5u], w1 = ring_words[b + 6u];
   uint largest = w0 & 3u;
   vec3 abc = vec3(fixed20((w0 >> 2u) & 1048575u), fixed20(((w0 >> 22u) | (w1 << 10u)) & 1048575u),
                   fixed20((w1 >> 10u) & 1048575u));

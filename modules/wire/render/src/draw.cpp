@@ -35,7 +35,7 @@ const detail::gfx::Program* WireRenderer::State::program_for(bool cpu, Output ou
     const std::string fragment = detail::fragment_source(
         depth ? detail::FragmentOutput::depth : detail::FragmentOutput::gbuffer, {}, gbuffer_glsl);
     const std::string label =
-        std::string(cpu ? "wire cpu-mesh" : "wire gpu-rings") + (depth ? " depth" : " gbuffer");
+        std::string(cpu ? "wire cpu-mesh" : "wire rings") + (depth ? " depth" : " gbuffer");
     Expected<gfx::Program> made =
         gfx::make_program({.vertex = cpu ? cpu_vertex : rings_vertex, .fragment = fragment, .label = label});
     if (!made) {
@@ -149,61 +149,35 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
                  Status::error("the node stream's wires draw on the nodes path; this draw list is on '" +
                                std::string(upload_path_name(list.path)) + "': they were not drawn"));
     }
-    const bool cpu = list.path == UploadPath::cpu_mesh;
-    const bool retained = !cpu && s.desc.retain_rings;
-
-    // (1) Items with geometry: opaque items (tubes, strips) first, then the blended phone-wire lines (sides
-    // 1), each by material (stable: equal materials keep the list's order); on gpu-rings by side count within
-    // a material (one index pattern per side count).
+    // cpu-mesh. (1) Items with geometry: opaque items (tubes, strips) first, then the blended phone-wire lines
+    // (sides 1), each by material (stable: equal materials keep the list's order).
     s.order.clear();
-    uint32_t max_sides = 0;
     for (uint32_t i = 0; i < list.items.size(); ++i) {
         const DrawItem& item = list.items[i];
         assert(item.material < s.materials.size() && "DrawItem::material out of range");
-        assert((cpu || item.sides >= 1) && "DrawItem::sides must be >= 1");
-        if (!has_geometry(item, list.path)) continue;
+        if (!has_geometry(item)) continue;
         s.order.push_back(i);
-        max_sides = std::max(max_sides, item.sides);
     }
     std::stable_sort(s.order.begin(), s.order.end(), [&](uint32_t a, uint32_t b) {
         const DrawItem& x = list.items[a];
         const DrawItem& y = list.items[b];
         if (detail::blended(x) != detail::blended(y)) return detail::blended(y);
-        if (x.material != y.material) return x.material < y.material;
-        return !cpu && x.sides < y.sides;
+        return x.material < y.material;
     });
-    if (retained) s.retain(list, stats);  // also on an empty list: culled and destroyed wires age out
-    const auto end_frame = [&] {
-        if (retained) s.ring_storage.end_frame();
-    };
-    if (s.order.empty()) {  // nothing to draw: no draw call
-        end_frame();
-        return stats;
-    }
-    if (!cpu) {
-        if (Status st = s.ensure_patterns(max_sides); !st) {
-            end_frame();
-            return s.failed(stats, st);
-        }
-    }
+    if (s.order.empty()) return stats;  // nothing to draw: no draw call
 
     // (2) The back end: runs, commands and the region's contents.
     const State::View view = State::view_of(camera);
     detail::ListFrame frame;
-    const Status prepared = cpu ? s.prepare_mesh(list, view.camera.position, frame, stats)
-                                : s.prepare_rings(list, view.camera.position, frame, stats);
-    if (!prepared) {  // no region: the frame's wires are skipped, the rest of the frame goes on
-        end_frame();
-        return s.failed(stats, prepared);
-    }
+    if (const Status prepared = s.prepare_mesh(list, view.camera.position, frame, stats); !prepared)
+        return s.failed(stats, prepared);  // no region: the frame's wires are skipped, the rest goes on
 
     // (3) Submit: GL state for the wires, the mode's program, the back end's bindings, one multi-draw per
     // run.
     Status no_program;
-    const gfx::Program* chosen = s.program_for(cpu, settings.output, no_program);
+    const gfx::Program* chosen = s.program_for(true, settings.output, no_program);
     if (chosen == nullptr) {
         s.stream.end();
-        end_frame();
         return s.failed(stats, no_program);
     }
     const gfx::Program& program = *chosen;
@@ -211,11 +185,7 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     const StreamRegion& region = frame.region;
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, region.buffer, static_cast<GLintptr>(region.offset_bytes),
                       static_cast<GLsizeiptr>(frame.draws_bytes));
-    if (cpu) {
-        s.bind_mesh(frame);
-    } else {
-        s.bind_rings(frame);
-    }
+    s.bind_mesh(frame);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, region.buffer);
     bool blending = false;
     for (std::size_t run = 0; run + 1 < s.run_first.size(); ++run) {
@@ -246,7 +216,6 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
         glDepthMask(GL_TRUE);
     }
     s.stream.end();
-    end_frame();
 
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     glBindVertexArray(0);

@@ -19,7 +19,6 @@ Status WireRenderer::State::prepare_mesh(const DrawList& list, const glm::dvec3&
     run_first.clear();
     run_command.clear();
     commands.clear();
-    chunks.clear();
     std::size_t vertex_total = 0, index_total = 0;
     for (std::size_t k = 0; k < n; ++k) {
         const DrawItem& item = list.items[order[k]];

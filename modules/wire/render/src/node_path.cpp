@@ -259,7 +259,6 @@ void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, Lines lines)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, rings_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ctx.circle);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, chunks_.id());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, rings_.id());
     ctx.vao.bind();
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, commands_.id());
     const std::size_t per_material = std::size_t{side_slots_} * 6;

@@ -4,12 +4,13 @@
 // (node_stream.hpp) arrive with their headers and nodes in the stream's own region, and get a curve pass of their
 // own. Everything after that runs in compute dispatches: the curve (into
 // persistent per-wire segments), the LOD (below the node resolution unless the settings keep it; hysteresis state per wire kept on the GPU), the
-// indirect commands, the rings with their frames and u, the draw and chunk records; then the gpu-rings vertex
+// indirect commands, the rings with their frames and u, the draw and chunk records; then the ring vertex
 // shader draws them with one multi-draw per (class, material), reading commands the GPU wrote.
 #pragma once
 
 #include "wire/draw.hpp"
 #include "wire/lod.hpp"
+#include "wire/packed_ring.hpp"
 #include "wire/render/node_stream.hpp"
 #include "wire/render/wire_renderer.hpp"
 
@@ -47,7 +48,7 @@ struct WireUpload;
 
 /// What the nodes path borrows from the renderer to draw.
 struct NodeDrawContext {
-    const engine::gfx::Program& program;  ///< the gpu-rings program
+    const engine::gfx::Program& program;  ///< the ring vertex shader's program
     const engine::gfx::VertexArray& vao;  ///< its vertex array (element buffer: the patterns)
     unsigned circle = 0;                  ///< the side table buffer
     const std::vector<uint32_t>& pattern_first;

@@ -139,7 +139,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     if (made) made = need(counter_, counter_bytes_, kCounterBytes, "wire nodes: ring counter");
     if (!made) return fail(made);
     if (template_sides_ != side_slots_ || template_patterns_ != ctx.pattern_first.size()) {
-        // (index count, first index) of each (side count, chunk kind), as the gpu-rings path's commands.
+        // (index count, first index) of each (side count, chunk kind), as the ring patterns lay them out.
         std::vector<uint32_t> t(2 * 6 * side_slots_, 0);
         for (uint32_t d = 1; d < side_slots_; ++d) {
             const uint32_t pattern = d < ctx.pattern_first.size() ? ctx.pattern_first[d] : 0;

@@ -1,6 +1,6 @@
 // The ring expansion's static index patterns, one per side count (upload_plan.hpp: caps, then kChunkBands
-// bands), and the side table the vertex shader places rim vertices with; shared by gpu-rings and the nodes
-// path.
+// bands), the side table the vertex shader places rim vertices with, and the chunk-index attribute's buffer
+// where the draw-parameters extension is missing: what the nodes path draws its rings with.
 #include "renderer_state.hpp"
 
 #include <epoxy/gl.h>
@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 namespace wire::render {
 namespace {
@@ -67,6 +68,20 @@ Status WireRenderer::State::ensure_patterns(uint32_t max_sides) {
     pattern_first = std::move(first);
     pattern_max_sides = top;
     glVertexArrayElementBuffer(rings_vao.id(), pattern.id());
+    return {};
+}
+
+Status WireRenderer::State::ensure_draw_index_capacity(std::size_t n) {
+    if (draw_parameters || n <= draw_index_capacity) return {};
+    const std::size_t capacity = std::max<std::size_t>(n, std::max<std::size_t>(1024, 2 * draw_index_capacity));
+    std::vector<uint32_t> iota(capacity);
+    std::iota(iota.begin(), iota.end(), 0u);
+    Expected<detail::gfx::Buffer> made =
+        detail::gfx::make_buffer(std::span<const uint32_t>(iota), "wire draw index");
+    if (!made) return made.error();
+    draw_index_buffer = std::move(made).value();
+    draw_index_capacity = capacity;
+    glVertexArrayVertexBuffer(rings_vao.id(), 1, draw_index_buffer.id(), 0, sizeof(uint32_t));
     return {};
 }
 

@@ -5,11 +5,11 @@
 //   region's
 //                      begin and end, the one submission loop (a multi-draw per run); the nodes path's frame
 //   mesh_path.cpp      cpu-mesh's back end: its commands, the vertices and rebased indices it streams, its
-//   bindings rings_path.cpp     gpu-rings' back end: residency, chunk records and commands, the rings it
-//   streams, bindings patterns.cpp       the ring expansion's index patterns and side table (gpu-rings and
-//   the nodes path)
-// A back end prepares a frame (ListFrame) into the region the front end begins and binds what its program
-// reads; the front end submits it.
+//                      bindings
+//   patterns.cpp       the ring expansion's index patterns, side table and chunk-index buffer (the nodes path)
+//   node_path*.cpp     the nodes path (node_path.hpp)
+// cpu-mesh's back end prepares a frame (ListFrame) into the region the front end begins and binds what its
+// program reads; the front end submits it.
 #pragma once
 
 #include "wire/render/wire_renderer.hpp"
@@ -18,7 +18,6 @@
 #include "shaders.hpp"
 #include "wire/render/upload_plan.hpp"
 
-#include "engine/gfx/retained_buffer.hpp"
 #include "engine/gfx/stream_buffer.hpp"
 
 #include <array>
@@ -43,7 +42,7 @@ struct DrawElementsIndirectCommand {
 static_assert(sizeof(DrawElementsIndirectCommand) == kCommandBytes);
 static_assert(sizeof(GpuDraw) == kDrawRecordBytes);
 
-/// cpu-mesh: the vertex's draw index; gpu-rings without draw parameters: the chunk index.
+/// cpu-mesh: the vertex's draw index; the rings (nodes path) without draw parameters: the chunk index.
 inline constexpr unsigned kRecordLocation = 3;
 /// The ring patterns are built for 3 .. max(this, the largest side count seen).
 inline constexpr uint32_t kPatternMinSides = 16;
@@ -59,24 +58,21 @@ inline bool same_run(const DrawList& list, uint32_t a, uint32_t b) {
     return blended(x) == blended(y) && x.material == y.material;
 }
 
-/// One cpu-mesh or gpu-rings frame: what the back end's prepare wrote into the stream region, read by its
-/// bind and by the front end's submission. Region layout: draw records | chunk records | commands | streamed
-/// geometry (vertices, or packed rings) | the vertices' draw indices (cpu-mesh) | indices (cpu-mesh).
+/// One cpu-mesh frame: what the back end's prepare wrote into the stream region, read by its bind and by the
+/// front end's submission. Region layout: draw records | commands | vertices | the vertices' draw indices |
+/// indices.
 struct ListFrame {
     gfx::StreamRegion region{};
     std::size_t draws_bytes = 0;
-    std::size_t chunk_offset = 0, chunk_bytes = 0;
     std::size_t command_offset = 0;
     std::size_t geometry_offset = 0, geometry_bytes = 0;
-    std::size_t record_offset = 0;  ///< cpu-mesh: the vertices' draw indices
+    std::size_t record_offset = 0;  ///< the vertices' draw indices
 
-    /// Lays the sections out for `n` draw records, chunk_bytes, `command_bytes`, geometry_bytes and
-    /// `record_bytes` of vertex draw indices; returns the index section's offset (the region's size is that
-    /// plus the indices).
+    /// Lays the sections out for `n` draw records, `command_bytes`, geometry_bytes and `record_bytes` of vertex
+    /// draw indices; returns the index section's offset (the region's size is that plus the indices).
     std::size_t lay_out(std::size_t n, std::size_t command_bytes, std::size_t record_bytes) {
         draws_bytes = n * sizeof(GpuDraw);
-        chunk_offset = align_up(draws_bytes);
-        command_offset = align_up(chunk_offset + chunk_bytes);
+        command_offset = align_up(draws_bytes);
         geometry_offset = align_up(command_offset + command_bytes);
         record_offset = align_up(geometry_offset + geometry_bytes);
         return align_up(record_offset + record_bytes);
@@ -101,8 +97,6 @@ struct WireRenderer::State {
     std::size_t draw_index_capacity = 0;
     bool draw_parameters = false;
     detail::gfx::StreamBuffer stream;
-    detail::gfx::RetainedBuffer ring_storage;  ///< retained packed rings (gpu-rings, retain_rings)
-    RingResidency residency{180};
     detail::gfx::Buffer pattern;          ///< static index patterns of the ring expansion, one per side count
     detail::gfx::Buffer circle;           ///< cos, sin of 2 pi j / n per side count n (the shader's circle[])
     std::vector<uint32_t> pattern_first;  ///< first index of side count n's pattern (index n)
@@ -110,16 +104,11 @@ struct WireRenderer::State {
     std::vector<detail::gfx::Texture> textures;
     std::vector<Material> materials;
     // Per-frame scratch, reused.
-    std::vector<uint32_t> order;      ///< items with geometry, sorted by class, material (and side count)
-    std::vector<uint32_t> ring_word;  ///< per order position: first word of its rings (retained)
+    std::vector<uint32_t> order;  ///< cpu-mesh: items with geometry, sorted by class and material
     std::vector<uint32_t>
         run_first;  ///< per run of (class, material): first order position (+ one past the end)
     std::vector<uint32_t> run_command;  ///< per run: its first command (plus one past the end)
     std::vector<detail::DrawElementsIndirectCommand> commands;
-    std::vector<uint32_t> chunks;  ///< gpu-rings: (draw index, first band) per chunk, in command order
-    std::vector<PackedRing> packed;
-    std::vector<uint8_t> streamed;  ///< retained path, per drawn item (order): rings streamed this frame
-    std::size_t retained_ring_bytes = 0;  ///< retained path: bytes written into the ring storage this frame
     std::unique_ptr<detail::NodePath> nodes;  ///< gpu-nodes: made on its first frame
     std::unique_ptr<NodeStream> node_stream;  ///< made on the first node_stream() call
     Status nodes_failed{};                    ///< why the nodes path could not be made (not retried)
@@ -169,30 +158,12 @@ struct WireRenderer::State {
     /// Binds the vertex array and the region's vertices, draw indices and indices.
     void bind_mesh(const detail::ListFrame& frame);
 
-    // ---- rings_path.cpp: gpu-rings ----
-    /// Retained path: makes every drawn item's rings resident (uploading new or changed ones) and records the
-    /// first word of each; evicts wires not drawn for a while. Items whose rings could not be stored are
-    /// dropped from `order` (the rest of the frame draws).
-    void retain(const DrawList& list, DrawStats& stats);
-    /// The item's rings in GPU form at `out`: the rings system's packed records when the item has them (one
-    /// memcpy), else packed here.
-    void copy_packed(const DrawItem& item, std::byte* out);
-    /// `order`'s items (at least one; retain() ran) into a region it begins: runs, one instanced command per
-    /// (side count, chunk kind) over the side count's pattern, one instance per chunk record
-    /// (upload_plan.hpp), draw records and the rings streamed this frame. Fails (nothing begun) without a
-    /// region.
-    Status prepare_rings(const DrawList& list, const glm::dvec3& eye, detail::ListFrame& frame,
-                         DrawStats& stats);
-    /// Binds the rings (retained storage or the region), the side table, the chunk records and the vertex
-    /// array.
-    void bind_rings(const detail::ListFrame& frame);
-    /// The 0, 1, 2, ... buffer of the chunk-index attribute holds at least `n` (draw parameters: nothing to
-    /// do).
-    Status ensure_draw_index_capacity(std::size_t n);
-
     // ---- patterns.cpp ----
     /// The ring expansion's index patterns and side table cover 3 .. max_sides sides.
     Status ensure_patterns(uint32_t max_sides);
+    /// The 0, 1, 2, ... buffer of the chunk-index attribute holds at least `n` (draw parameters: nothing to
+    /// do).
+    Status ensure_draw_index_capacity(std::size_t n);
 };
 
 }  // namespace wire::render

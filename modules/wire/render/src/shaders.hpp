@@ -14,7 +14,7 @@ namespace wire::render::detail {
 /// `cpu_mesh`: vertex attributes 0 position, 1 normal, 2 uv (TubeVertex) and 3 the vertex's draw index (uint,
 /// streamed beside the vertices). Otherwise the ring expansion from gl_VertexID of an instanced indexed draw over
 /// the static pattern, one instance per chunk (upload_plan.hpp), its record (draw index, first band) in the SSBO
-/// at binding 3. `draw_parameters` (gpu-rings only): the chunk index is gl_BaseInstanceARB + gl_InstanceID
+/// at binding 3. `draw_parameters` (the rings only): the chunk index is gl_BaseInstanceARB + gl_InstanceID
 /// (ARB_shader_draw_parameters), else the instanced attribute at location 3 (divisor 1; its buffer holds 0, 1,
 /// 2, ... so it reads baseInstance + instance).
 std::string vertex_source(bool cpu_mesh, bool draw_parameters);

@@ -46,16 +46,17 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
         gfx::make_program({.vertex = cpu_vertex, .fragment = fragment, .label = "wire cpu-mesh"});
     if (!cpu) return cpu.error();
     Expected<gfx::Program> rings =
-        gfx::make_program({.vertex = rings_vertex, .fragment = fragment, .label = "wire gpu-rings"});
+        gfx::make_program({.vertex = rings_vertex, .fragment = fragment, .label = "wire rings"});
     if (!rings) return rings.error();
     s.cpu_program = std::move(cpu).value();
     s.rings_program = std::move(rings).value();
-    // Both vertex shaders read shader storage blocks (the cpu-mesh one its draw records; the rings one draws,
-    // rings, chunks and the side table), which GL 4.3 lets a driver refuse in the vertex stage (its minimum of
-    // GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS is 0): said by name at create, never a failed draw.
+    // Both vertex shaders read shader storage blocks (the cpu-mesh one its draw records; the rings one the nodes
+    // path's draws, rings, chunks and the side table), which GL 4.3 lets a driver refuse in the vertex stage (its
+    // minimum of GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS is 0): said by name at create, never a failed draw.
     GLint vertex_blocks = 0;
     glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &vertex_blocks);
-    for (const auto& [program, label] : {std::pair{&s.cpu_program, "wire cpu-mesh"}, std::pair{&s.rings_program, "wire gpu-rings"}}) {
+    for (const auto& [program, label] :
+         {std::pair{&s.cpu_program, "wire cpu-mesh"}, std::pair{&s.rings_program, "wire rings"}}) {
         GLint blocks = 0;
         glGetProgramInterfaceiv(program->id(), GL_SHADER_STORAGE_BLOCK, GL_ACTIVE_RESOURCES, &blocks);
         if (blocks > vertex_blocks) {
@@ -66,10 +67,10 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
     }
 
     // Vertex arrays: the cpu-mesh one reads TubeVertex at binding 0 and the vertex's draw index at binding 1
-    // (both streamed, set per frame); the gpu-rings one reads the chunk index at binding 1 (instanced, from the
-    // 0, 1, 2, ... buffer) when the draw-parameters extension is missing.
+    // (both streamed, set per frame); the rings one (the nodes path's) reads the chunk index at binding 1
+    // (instanced, from the 0, 1, 2, ... buffer) when the draw-parameters extension is missing.
     s.cpu_vao = gfx::make_vertex_array({.label = "wire cpu-mesh"});
-    s.rings_vao = gfx::make_vertex_array({.label = "wire gpu-rings"});
+    s.rings_vao = gfx::make_vertex_array({.label = "wire rings"});
     const GLuint cpu_vao = s.cpu_vao.id();
     const struct {
         GLuint location;
@@ -123,14 +124,6 @@ Expected<WireRenderer> WireRenderer::create(const RendererDesc& desc) {
          .label = "wire stream"});
     if (!stream) return stream.error();
     s.stream = std::move(stream).value();
-    Expected<gfx::RetainedBuffer> storage = gfx::RetainedBuffer::create(
-        {.initial_bytes = desc.ring_storage_bytes != 0 ? desc.ring_storage_bytes : std::size_t{4} << 20,
-         .growth = desc.growth,
-         .alignment = 16,
-         .label = "wire ring storage"});
-    if (!storage) return storage.error();
-    s.ring_storage = std::move(storage).value();
-    s.residency = RingResidency(desc.retain_frames != 0 ? desc.retain_frames : 180);
     if (Status st = s.ensure_patterns(kPatternMinSides); !st) return st;
     return r;
 }
@@ -161,11 +154,6 @@ RendererInfo WireRenderer::info() const {
     i.region_bytes = s.stream.region_bytes();
     i.live_stream_buffers = s.stream.live_buffers();
     i.allocated_stream_buffers = s.stream.allocated_buffers();
-    i.resident_wires = s.residency.resident_wires();
-    i.ring_storage_live_bytes = s.ring_storage.live_bytes();
-    i.ring_storage_capacity = s.ring_storage.capacity_bytes();
-    i.live_ring_buffers = s.ring_storage.live_buffers();
-    i.allocated_ring_buffers = s.ring_storage.allocated_buffers();
     if (s.nodes) {
         i.node_path_buffers = s.nodes->gl_buffers();
         i.node_path_programs = s.nodes->gl_programs();

@@ -53,7 +53,6 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     const LodView& cull_view = ctx.view;
     const LodSettings lod_base = ctx.lod;
     const uint64_t view_generation = ctx.view_generation;
-    const bool gpu = ctx.path == UploadPath::gpu_rings;
     // A wire whose curve changed goes on through lod, rings and mesh here, on this thread, while its curve is in
     // cache: exactly what the later stages would do for it (they then find it up to date and skip it).
     const auto go_on = [&](CurveJob& job) {
@@ -63,9 +62,9 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
         job.fused |= 1;
         if (job.rings == nullptr || !job.lod->lod.visible) return;
         RingJob ring_job{job.curve, job.lod, job.rings};
-        rings_one(ring_job, gpu);
+        rings_one(ring_job);
         job.fused |= 2;
-        if (gpu || job.mesh == nullptr) return;
+        if (job.mesh == nullptr) return;
         MeshJob mesh_job{job.rings, job.lod, job.style, job.mesh, nullptr, 0, nullptr, 0};
         mesh_one(mesh_job);
         job.fused |= 4;

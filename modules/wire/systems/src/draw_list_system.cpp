@@ -117,30 +117,18 @@ void draw_list_system(Registry& registry, WireContext& ctx) {
         item.material = style->material;
         item.wire_id = engine::ecs::to_integral(e);
         item.rings = rs.rings;
-        if (ctx.path == UploadPath::gpu_rings && rings->packed.size() == rs.rings.size()) {
-            item.packed = rings->packed;
-            item.radius_varies = rings->radius_varies;  // computed with `packed`
-        }
-        item.rings_generation = rings->generation;
         // Tube sides (>= 3), or 2 for a camera-facing strip, 1 for a phone-wire line.
         item.sides = lod->lod.drawn_sides <= 2 && lod->lod.drawn_sides >= 1 ? lod->lod.drawn_sides
                                                                             : std::max<uint32_t>(lod->lod.sides, 3);
         item.closed = rs.closed;
         item.caps = caps_of(*style);
         item.u_close = rings->u_close;
-        if (ctx.path == UploadPath::cpu_mesh) {
-            const WireMesh* mesh = registry.try_get<WireMesh>(e);
-            if (mesh == nullptr || mesh->seen_rings != rings->generation) continue;
-            item.vertices = mesh->mesh.vertices;
-            item.indices = mesh->mesh.indices;
-            ctx.stats.vertices += mesh->mesh.vertices.size();
-            ctx.stats.indices += mesh->mesh.indices.size();
-        } else {
-            const TubeCounts counts = item.sides <= 2 ? strip_counts(rs.rings.size(), rs.closed)
-                                                      : tube_counts(rs.rings.size(), rs.closed, TubeSettings{.sides = item.sides, .caps = item.caps});
-            ctx.stats.vertices += counts.vertices;
-            ctx.stats.indices += counts.indices;
-        }
+        const WireMesh* mesh = registry.try_get<WireMesh>(e);
+        if (mesh == nullptr || mesh->seen_rings != rings->generation) continue;
+        item.vertices = mesh->mesh.vertices;
+        item.indices = mesh->mesh.indices;
+        ctx.stats.vertices += mesh->mesh.vertices.size();
+        ctx.stats.indices += mesh->mesh.indices.size();
         ctx.stats.rings += rs.rings.size();
         list.items.push_back(item);
     }

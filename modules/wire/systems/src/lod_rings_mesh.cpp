@@ -101,8 +101,7 @@ void rings_system(Registry& registry, WireContext& ctx) {
         if (rings.seen_curve == curve->generation && rings.seen_lod == lod->generation && rings.generation != 0) continue;
         jobs.push_back(RingJob{curve, lod, &rings});
     }
-    const bool gpu = ctx.path == UploadPath::gpu_rings;
-    parallel_over(jobs.size(), [&](std::size_t i) { rings_one(jobs[i], gpu); });
+    parallel_over(jobs.size(), [&](std::size_t i) { rings_one(jobs[i]); });
     ctx.stats.rings_built += jobs.size();
 }
 

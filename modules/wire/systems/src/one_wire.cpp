@@ -87,7 +87,7 @@ unsigned char lod_one(LodJob& job, const LodView& view, const LodSettings& base,
     return outcome;
 }
 
-void rings_one(RingJob& job, bool gpu) {
+void rings_one(RingJob& job) {
     WireRings& r = *job.rings;
     place_rings(job.curve->curve, job.lod->lod.counts, r.params);
     RingSettings settings;
@@ -104,15 +104,6 @@ void rings_one(RingJob& job, bool gpu) {
     r.frame_settings = settings.frames;
     r.motion = motion_reference(nodes);
     keep_rings(scratch, r);
-    if (gpu) {  // the renderer's form, here on the worker threads: the render thread only copies
-        const std::vector<Ring>& built = r.rings.rings;
-        r.packed.resize(built.size());
-        pack_rings(built, r.packed.data());
-        r.radius_varies = std::any_of(built.begin(), built.end(),
-                                      [&](const Ring& g) { return g.radius_m != built.front().radius_m; });
-    } else if (!r.packed.empty()) {
-        release(r.packed);
-    }
     ++r.generation;
     r.seen_curve = job.curve->generation;
     r.seen_lod = job.lod->generation;

@@ -141,7 +141,6 @@ inline void copy_nodes(WireNodes& to, const WireNodes& from) {
 inline void release_rings(WireRings& r) {
     release(r.params);
     release(r.rings.rings);  // ring 0's frame stays: it seeds the next build's first normal
-    release(r.packed);
 }
 
 /// The camera as the LOD sees it: `view_generation` moves on when the view or the LOD settings changed (called
@@ -160,8 +159,8 @@ inline void refresh_view(WireContext& ctx) {
 /// One wire's LOD update for `view` (the lod stage's work on one wire, also run right after a changed curve).
 /// Returns 1 when it released the wire's curve (culled while moving), 2 when it restored a released one, else 0.
 unsigned char lod_one(LodJob& job, const LodView& view, const LodSettings& base, uint64_t view_generation);
-/// One wire's rings for its current curve and counts (the rings stage's work on one wire); `gpu`: also packed.
-void rings_one(RingJob& job, bool gpu);
+/// One wire's rings for its current curve and counts (the rings stage's work on one wire).
+void rings_one(RingJob& job);
 /// One wire's mesh from its rings (the mesh stage's work on one wire).
 void mesh_one(MeshJob& job);
 

@@ -69,7 +69,7 @@ void add_wire_memory(Registry& registry, Entity e, const WireCurve& c, WireMemor
         visible = l->lod.visible;
     }
     if (const WireRings* r = registry.try_get<WireRings>(e)) {
-        rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings) + bytes_of(r->packed);
+        rings = sizeof(WireRings) + bytes_of(r->params) + bytes_of(r->rings);
     }
     if (const WireMesh* w = registry.try_get<WireMesh>(e)) {
         mesh = sizeof(WireMesh) + bytes_of(w->mesh.vertices) + bytes_of(w->mesh.indices);

@@ -1,6 +1,7 @@
 // The renderer's CPU side (no GL): the 28-byte packed ring record's precision, measured on random frames and on
 // the rings of random realistic wires (fixed seeds; median / p90 / max and the worst case printed); the
-// indexed expansion's counts against wire::tube_counts; the residency bookkeeping of the retained path.
+// ring expansion's counts (the nodes path's chunks) against wire::tube_counts. The nodes path's byte model:
+// nodes_plan_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -127,19 +128,15 @@ TEST(PackedRingTest, RealisticWiresKeepFrameAndTexturePrecision) {
 // chunks cover every band exactly once: kChunkBands-band chunks, then the remainder's binary digits, plus one cap
 // chunk on a capped open tube.
 TEST(UploadPlanTest, ExpansionCountsMatchTubeCounts) {
-    std::vector<wire::Ring> rings(300);
     for (uint32_t sides : {3u, 7u, 16u, 32u}) {
         for (std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{128},
                                   std::size_t{129}, std::size_t{257}, std::size_t{300}}) {
             for (bool closed : {false, true}) {
                 for (bool caps : {false, true}) {
-                    wire::DrawItem item;
-                    item.rings = std::span<const wire::Ring>(rings.data(), count);
-                    item.sides = sides;
-                    item.closed = closed;
-                    item.caps = caps;
+                    const wire::render::RingExpansion item{
+                        .rings = static_cast<uint32_t>(count), .sides = sides, .closed = closed, .caps = caps};
                     const wire::TubeCounts c = wire::tube_counts(count, closed, {.sides = sides, .caps = caps});
-                    if (!wire::render::has_geometry(item, wire::UploadPath::gpu_rings)) {
+                    if (!wire::render::draws_anything(item)) {
                         EXPECT_EQ(c.indices, 0u) << count << " rings";
                         continue;
                     }
@@ -164,77 +161,6 @@ TEST(UploadPlanTest, ExpansionCountsMatchTubeCounts) {
             }
         }
     }
-}
-
-// Residency: new and changed wires upload, unchanged ones do not; a wire not drawn for more than retain_frames
-// frames is evicted; generation 0 always uploads; bytes follow.
-TEST(UploadPlanTest, ResidencyUploadsOnlyChangedWires) {
-    std::vector<wire::Ring> rings(10);
-    auto item = [&](uint64_t id, uint64_t generation) {
-        wire::DrawItem d;
-        d.wire_id = id;
-        d.rings_generation = generation;
-        d.rings = rings;
-        d.sides = 8;
-        return d;
-    };
-    wire::render::RingResidency residency(3);
-    wire::DrawList list{.path = wire::UploadPath::gpu_rings, .items = {item(1, 1), item(2, 1), item(3, 0)}};
-    // 10 rings, 9 bands, capped: chunks of 8 and 1 band and a cap chunk; the three wires share their 3 commands.
-    constexpr std::size_t per_item = wire::render::kDrawRecordBytes + 3 * wire::render::kChunkRecordBytes;
-    constexpr std::size_t commands = 3 * wire::render::kCommandBytes;
-    constexpr std::size_t ring_bytes = 10 * sizeof(PackedRing);
-    EXPECT_EQ(wire::render::chunk_count(list.items[0]), 3u);
-    EXPECT_EQ(wire::render::draw_commands(list), 3u);
-    wire::render::RetainedFrame f = wire::render::plan_retained_frame(list, residency);
-    EXPECT_EQ(f.wires_uploaded, 3u);
-    EXPECT_EQ(f.bytes, commands + 3 * per_item + 3 * ring_bytes);
-    f = wire::render::plan_retained_frame(list, residency);
-    EXPECT_EQ(f.wires_uploaded, 1u) << "only the generation-0 wire";
-    EXPECT_EQ(f.bytes, commands + 3 * per_item + ring_bytes);
-    list.items[1].rings_generation = 2;
-    f = wire::render::plan_retained_frame(list, residency);
-    EXPECT_EQ(f.wires_uploaded, 2u);
-    // Wire 1 culled for 3 frames: still resident, drawn again for free; for 4 frames: evicted.
-    const wire::DrawItem one = list.items[0];
-    list.items.erase(list.items.begin());
-    for (int i = 0; i < 3; ++i) EXPECT_EQ(wire::render::plan_retained_frame(list, residency).wires_evicted, 0u);
-    list.items.push_back(one);
-    EXPECT_EQ(wire::render::plan_retained_frame(list, residency).wires_uploaded, 1u) << "only generation 0";
-    list.items.pop_back();
-    for (int i = 0; i < 3; ++i) (void)wire::render::plan_retained_frame(list, residency);
-    f = wire::render::plan_retained_frame(list, residency);
-    EXPECT_EQ(f.wires_evicted, 1u);
-    EXPECT_EQ(residency.find(1), nullptr);
-    EXPECT_EQ(residency.resident_wires(), 2u);
-}
-
-// A wire whose rings change in two frames running is streamed (no range kept), and stored again the first
-// frame it stays still; a wire that changes once in a while is re-uploaded into a range each time.
-TEST(UploadPlanTest, ResidencyStreamsWiresThatKeepChanging) {
-    std::vector<wire::Ring> rings(10);
-    wire::DrawItem d;
-    d.wire_id = 7;
-    d.rings = rings;
-    d.sides = 8;
-    wire::render::RingResidency residency;
-    auto touch = [&](uint64_t generation) {
-        residency.begin_frame();
-        d.rings_generation = generation;
-        const wire::render::RingResidency::Touch t = residency.touch(d);
-        if (t.upload) t.entry->size_bytes = rings.size() * sizeof(PackedRing);  // as the renderer stores it
-        return std::pair<bool, bool>{t.upload, t.stream};
-    };
-    EXPECT_EQ(touch(1), std::make_pair(true, false)) << "new: stored";
-    EXPECT_EQ(touch(2), std::make_pair(false, true)) << "changed right after: moving, streamed";
-    EXPECT_EQ(touch(3), std::make_pair(false, true));
-    EXPECT_EQ(residency.find(7)->size_bytes, 0u) << "no range while streamed";
-    EXPECT_EQ(touch(3), std::make_pair(true, false)) << "still: stored once";
-    EXPECT_EQ(touch(3), std::make_pair(false, false));
-    EXPECT_EQ(touch(4), std::make_pair(true, false)) << "a change after a still frame: stored";
-    EXPECT_EQ(touch(4), std::make_pair(false, false));
-    EXPECT_EQ(touch(0), std::make_pair(true, false)) << "generation 0 (unknown) after a still frame";
-    EXPECT_EQ(touch(0), std::make_pair(false, true)) << "generation 0 every frame: streamed";
 }
 
 }  // namespace

@@ -98,7 +98,7 @@ double allocations_per_frame(int count, UploadPath path) {
 
 TEST(WireAllocations, MovingWiresAllocateNothingPerWirePerFrame) {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);  // per-thread buffers: one thread
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_nodes}) {
         const double small = allocations_per_frame(30, path);
         const double large = allocations_per_frame(300, path);
         std::printf("%s: %.1f allocations per frame with 30 moving wires, %.1f with 300\n",

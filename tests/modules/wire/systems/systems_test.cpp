@@ -261,7 +261,7 @@ std::vector<std::vector<unsigned char>> run_scene(int threads, UploadPath path, 
 }
 
 TEST(WireSystems, DrawListIsByteEqualForOneAndTwoThreads) {
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings, UploadPath::gpu_nodes}) {
+    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_nodes}) {
         const auto one = run_scene(1, path);
         const auto two = run_scene(2, path);
         ASSERT_EQ(one.size(), two.size());
@@ -273,10 +273,11 @@ TEST(WireSystems, DrawListIsByteEqualForOneAndTwoThreads) {
 }
 
 // A wire whose curve changed goes on through lod, rings and mesh right after its curve (WireContext::fused_stages):
-// the same draw lists, bit for bit, as stage by stage, on both paths and thread counts, with moving, inserted,
-// destroyed, culled and restored wires; the same work counted (each wire's lod, rings and mesh once).
+// the same draw lists, bit for bit, as stage by stage, on both thread counts, with moving, inserted, destroyed,
+// culled and restored wires; the same work counted (each wire's lod, rings and mesh once). cpu-mesh only: the
+// nodes path has no CPU lod, rings or mesh to fuse.
 TEST(WireSystems, FusedStagesGiveTheSameDrawListsAsStageByStage) {
-    for (UploadPath path : {UploadPath::cpu_mesh, UploadPath::gpu_rings}) {
+    for (UploadPath path : {UploadPath::cpu_mesh}) {
         for (int threads : {1, 2}) {
             std::vector<RunStats> fused_stats, staged_stats;
             const auto fused = run_scene(threads, path, true, &fused_stats, true);
@@ -313,60 +314,44 @@ TEST(WireSystems, DrawListIsInEntityOrder) {
     }
 }
 
-TEST(WireSystems, GpuRingsPathBuildsNoMeshes) {
+// The nodes path builds no curve, rings or meshes on the CPU (it sends packed nodes); switching to cpu-mesh builds
+// the meshes on demand, and switching back sends packed nodes again.
+TEST(WireSystems, NodesPathBuildsNoMeshesAndSwitchingPathsRebuilds) {
     World w;
-    w.ctx.path = UploadPath::gpu_rings;
+    w.ctx.path = UploadPath::gpu_nodes;
     const Entity e = spawn_wire(w.registry, cable(16, {-2, 0, 0}, 4.0, 0.5), {.closed = true});
     w.run();
     ASSERT_EQ(w.ctx.draw_list.items.size(), 1u);
-    const DrawItem& item = w.ctx.draw_list.items[0];
-    EXPECT_EQ(w.ctx.draw_list.path, UploadPath::gpu_rings);
-    EXPECT_TRUE(item.vertices.empty());
-    EXPECT_FALSE(item.rings.empty());
-    EXPECT_TRUE(item.closed);
-    EXPECT_FALSE(item.caps);
-    EXPECT_GT(item.u_close, 0.0f);
-    EXPECT_EQ(w.ctx.stats.meshes_built, 0u);
-    EXPECT_EQ(w.registry.get<WireMesh>(e).generation, 0u);
-    EXPECT_GT(w.ctx.stats.vertices, 0u);  // what the vertex shader will expand
-    // Switching to the CPU path builds the meshes on demand.
+    {
+        const DrawItem& item = w.ctx.draw_list.items[0];
+        EXPECT_EQ(w.ctx.draw_list.path, UploadPath::gpu_nodes);
+        EXPECT_TRUE(item.vertices.empty());
+        EXPECT_TRUE(item.rings.empty());
+        ASSERT_NE(item.packed_nodes, nullptr);
+        EXPECT_EQ(item.packed_nodes->node_count, 16u);
+        EXPECT_TRUE(item.spline.closed);
+        EXPECT_EQ(w.ctx.stats.meshes_built, 0u);
+        EXPECT_EQ(w.ctx.stats.rings_built, 0u);
+        EXPECT_EQ(w.registry.get<WireMesh>(e).generation, 0u);
+    }
     w.ctx.path = UploadPath::cpu_mesh;
     w.run();
     EXPECT_EQ(w.ctx.stats.meshes_built, 1u);
-    EXPECT_FALSE(w.ctx.draw_list.items[0].vertices.empty());
-}
-
-// On the gpu-rings path the rings system hands the renderer its ring records already packed (on its worker
-// threads), equal to packing them on the render thread, and says whether the radius varies; the cpu-mesh path
-// keeps no packed copy.
-TEST(WireSystems, GpuRingsPathPacksRingsInTheRingsSystem) {
-    World w;
-    w.ctx.path = UploadPath::gpu_rings;
-    WireNodes thick = cable(14, {-2, 0.5, 0}, 4.0, 0.4);
-    thick.radius_m.assign(thick.positions.size(), 0.02f);
-    thick.radius_m[7] = 0.05f;  // a bulge: the radius varies
-    spawn_wire(w.registry, cable(16, {-2, 0, 0}, 4.0, 0.5), {.radius_m = 0.02f});
-    spawn_wire(w.registry, thick, {.radius_m = 0.02f});
-    for (int frame = 0; frame < 2; ++frame) {
-        w.run();
-        ASSERT_EQ(w.ctx.draw_list.items.size(), 2u);
-        for (const DrawItem& item : w.ctx.draw_list.items) {
-            ASSERT_EQ(item.packed.size(), item.rings.size());
-            std::vector<wire::PackedRing> here(item.rings.size());
-            wire::pack_rings(item.rings, here.data());
-            EXPECT_EQ(std::memcmp(here.data(), item.packed.data(), item.packed.size_bytes()), 0);
-            ASSERT_TRUE(item.radius_varies.has_value());
-        }
-        EXPECT_FALSE(*w.ctx.draw_list.items[0].radius_varies);
-        EXPECT_TRUE(*w.ctx.draw_list.items[1].radius_varies);
+    ASSERT_EQ(w.ctx.draw_list.items.size(), 1u);
+    {
+        const DrawItem& item = w.ctx.draw_list.items[0];
+        EXPECT_FALSE(item.vertices.empty());
+        EXPECT_FALSE(item.rings.empty());
+        EXPECT_TRUE(item.closed);
+        EXPECT_FALSE(item.caps);
+        EXPECT_GT(item.u_close, 0.0f);
+        EXPECT_EQ(item.packed_nodes, nullptr);
     }
-    w.ctx.path = UploadPath::cpu_mesh;
-    w.ctx.camera.position.x += 0.5;  // new counts: the rings are rebuilt on the cpu-mesh path
+    w.ctx.path = UploadPath::gpu_nodes;
     w.run();
-    for (const DrawItem& item : w.ctx.draw_list.items) {
-        EXPECT_TRUE(item.packed.empty());
-        EXPECT_FALSE(item.radius_varies.has_value());
-    }
+    ASSERT_EQ(w.ctx.draw_list.items.size(), 1u);
+    EXPECT_NE(w.ctx.draw_list.items[0].packed_nodes, nullptr);
+    EXPECT_TRUE(w.ctx.draw_list.items[0].vertices.empty());
 }
 
 TEST(WireSystems, TessellationMeetsTheScreenTolerance) {

@@ -1,6 +1,6 @@
-// What the wire renderer uploads, without GL: the compact ring record, the indexed expansion's draw counts, the
-// bytes a frame sends on each path, and which wires' ring records are resident on the GPU. The renderer and
-// `wiretool bench` share these, so the benchmark's byte counts are the renderer's by construction.
+// What the wire renderer uploads, without GL: the compact ring record, the ring expansion's draw counts, the
+// bytes a frame sends on each path (cpu-mesh's lists; the nodes path's slots as NodesPlan follows them). The
+// renderer and `wiretool bench` share these, so the benchmark's byte counts are the renderer's by construction.
 #pragma once
 
 #include "wire/draw.hpp"
@@ -12,7 +12,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <span>
 #include <unordered_map>
 #include <vector>
@@ -48,96 +47,45 @@ inline constexpr uint32_t kChunkBands = 16;
 inline constexpr uint32_t kChunkKinds = 6;  ///< kind 0: caps; kind k >= 1: chunks of kChunkBands >> (k - 1) bands
 inline constexpr uint32_t kCapVertexBase = 1u << 30;
 
-/// Bands (quads rows) of a gpu-rings item: rings - 1, plus 1 on a closed wire; 0 without rings.
-[[nodiscard]] uint32_t band_count(const DrawItem& item);
-/// Whether the item draws anything on `path` (the renderer skips the others).
-[[nodiscard]] bool has_geometry(const DrawItem& item, UploadPath path);
+/// One wire's ring expansion as the nodes path's ring pass lays it out (rings.comp's chunk_count_of): `rings`
+/// rings of `sides` sides (2: strip, 1: line), closed or open, capped or not.
+struct RingExpansion {
+    uint32_t rings = 0;
+    uint32_t sides = 8;
+    bool closed = false;
+    bool caps = true;
+};
+/// Bands (quad rows): rings - 1, plus 1 on a closed wire; 0 without rings.
+[[nodiscard]] uint32_t band_count(const RingExpansion& e);
+/// Whether the expansion draws anything (bands, or the caps of a capped open tube).
+[[nodiscard]] bool draws_anything(const RingExpansion& e);
 /// Bands in a chunk of `kind` (>= 1); 0 for the cap kind.
 [[nodiscard]] constexpr uint32_t chunk_kind_bands(uint32_t kind) {
     return kind == 0 ? 0u : kChunkBands >> (kind - 1);
 }
-/// Chunks of each kind a gpu-rings item draws (all 0 without geometry).
-[[nodiscard]] std::array<uint32_t, kChunkKinds> chunk_counts(const DrawItem& item);
-/// Chunk records a gpu-rings item needs: the sum of chunk_counts.
-[[nodiscard]] uint32_t chunk_count(const DrawItem& item);
-/// Indirect draw commands a frame of `list` issues: cpu-mesh one per run of (class, material); gpu-rings one per
-/// (class, material, side count, chunk kind) in use. Classes: opaque (tubes, strips) and blended (lines, sides 1).
-/// Bounded by the materials, side counts and kinds in use, never by the number of wires.
-[[nodiscard]] std::size_t draw_commands(const DrawList& list);
-/// Vertices (unique, as a mesh would hold them) and triangles of a gpu-rings item: equal to wire::tube_counts.
-[[nodiscard]] uint32_t expanded_vertices(const DrawItem& item);
-[[nodiscard]] uint32_t expanded_triangles(const DrawItem& item);
+/// Chunks of each kind the expansion draws (all 0 when it draws nothing).
+[[nodiscard]] std::array<uint32_t, kChunkKinds> chunk_counts(const RingExpansion& e);
+/// Chunk records the expansion needs: the sum of chunk_counts.
+[[nodiscard]] uint32_t chunk_count(const RingExpansion& e);
+/// Vertices (unique, as a mesh would hold them) and triangles of the expansion: equal to wire::tube_counts
+/// (strip_counts for sides 1 and 2).
+[[nodiscard]] uint32_t expanded_vertices(const RingExpansion& e);
+[[nodiscard]] uint32_t expanded_triangles(const RingExpansion& e);
 
-// ---- bytes per frame ----------------------------------------------------------------------------------------
+// ---- cpu-mesh: bytes per frame ------------------------------------------------------------------------------
 inline constexpr std::size_t kDrawRecordBytes = 32;  ///< per drawn item (detail::GpuDraw)
 inline constexpr std::size_t kCommandBytes = 20;     ///< per indirect command (DrawElementsIndirectCommand)
-inline constexpr std::size_t kChunkRecordBytes = 8;  ///< gpu-rings: per chunk (draw index, first band)
+inline constexpr std::size_t kChunkRecordBytes = 8;  ///< the nodes path: per chunk (draw index, first band)
 inline constexpr std::size_t kVertexDrawIndexBytes = 4;  ///< cpu-mesh: per vertex, the draw index beside it
 
-/// Bytes a frame of `list` sends when every item's geometry is streamed (cpu-mesh; gpu-rings not retained):
-/// draw records, indirect commands, and vertices + their draw indices + indices, or chunk records + packed rings.
+/// Whether a cpu-mesh item draws anything (vertices and indices; the renderer skips the others).
+[[nodiscard]] bool has_geometry(const DrawItem& item);
+/// Indirect draw commands a cpu-mesh frame of `list` issues: one per run of (class, material). Classes: opaque
+/// (tubes, strips) and blended (lines, sides 1). Bounded by the materials in use, never by the number of wires.
+[[nodiscard]] std::size_t draw_commands(const DrawList& list);
+/// Bytes a cpu-mesh frame of `list` sends: draw records, indirect commands, vertices + their draw indices +
+/// indices.
 [[nodiscard]] std::size_t streamed_upload_bytes(const DrawList& list);
-
-// ---- retained ring storage ----------------------------------------------------------------------------------
-
-/// One wire's ring records on the GPU.
-struct Residency {
-    uint64_t wire_id = 0;
-    uint64_t generation = 0;   ///< DrawItem::rings_generation the records were uploaded for
-    uint32_t rings = 0;
-    uint64_t last_frame = 0;   ///< frame it was last drawn in
-    std::size_t offset_bytes = 0;  ///< where the renderer put them (unused by the bench's model)
-    std::size_t size_bytes = 0;    ///< 0 while the wire is streamed (no range)
-    uint64_t changed_frame = 0;    ///< the frame its rings last changed (or it appeared)
-    bool streamed = false;         ///< its rings are streamed each frame (it keeps changing), not stored
-};
-
-/// Which wires' ring records are resident. A frame touches each drawn item: a new wire, or a changed
-/// rings_generation (or 0) after a frame without change, means upload into a range (and the replaced residency's
-/// range is returned to be freed). A wire whose rings change in two frames running is moving: its rings are
-/// streamed with the frame (`stream`) instead of allocated and freed in the retained buffer every frame, its
-/// range (if any) freed; the first frame it stays unchanged it is uploaded into a range again. Wires not drawn
-/// for more than `retain_frames` frames are evicted (culled wires keep their range a while: turning
-/// the camera back costs nothing; a destroyed wire's range is freed then and reused, never drawn, since only
-/// drawn items are bound to records).
-class RingResidency {
-public:
-    explicit RingResidency(uint32_t retain_frames = 180) : retain_frames_(retain_frames) {}
-
-    struct Touch {
-        Residency* entry = nullptr;
-        bool upload = false;                 ///< the item's rings must be written (entry's range to be set)
-        bool stream = false;                 ///< the item's rings go into this frame's stream region instead
-        std::optional<Residency> replaced;   ///< the previous residency whose range is now unused
-    };
-    void begin_frame() { ++frame_; }
-    Touch touch(const DrawItem& item);
-    /// Removes and returns the entries not drawn in the last retain_frames frames.
-    std::vector<Residency> evict();
-    /// Drops a wire's entry without returning it (its range was never stored).
-    void forget(uint64_t wire_id) { entries_.erase(wire_id); }
-
-    [[nodiscard]] std::size_t resident_wires() const { return entries_.size(); }
-    [[nodiscard]] uint64_t frame() const { return frame_; }
-    [[nodiscard]] uint32_t retain_frames() const { return retain_frames_; }
-    [[nodiscard]] const Residency* find(uint64_t wire_id) const;
-
-private:
-    uint32_t retain_frames_;
-    uint64_t frame_ = 0;
-    std::unordered_map<uint64_t, Residency> entries_;
-};
-
-/// What a retained gpu-rings frame of `list` uploads given `residency` (updated as the renderer would):
-/// draw records and chunk records of every drawn item, the frame's commands, plus the packed rings of the items
-/// that must upload.
-struct RetainedFrame {
-    std::size_t bytes = 0;
-    std::size_t ring_bytes = 0;
-    std::size_t wires_uploaded = 0;
-    std::size_t wires_evicted = 0;
-};
-RetainedFrame plan_retained_frame(const DrawList& list, RingResidency& residency);
 
 /// What the nodes path has of each wire (the renderer's slots, as plan_nodes_frame() follows them): the nodes
 /// generation it got, the frame it was last drawn (slots not drawn for retain_frames are evicted, looked for

@@ -2,23 +2,22 @@
 // persistently mapped buffers and one multi-draw per (class, material): its commands are bounded by the side
 // counts in use, never by the number of wires (issue 29). The only wire code that touches GL.
 //
-// Upload paths: cpu-mesh streams every visible wire's vertices, a 4-byte draw index per vertex and its indices
-// (rebased while copying) each frame, and draws a material's wires with one command. gpu-rings keeps each
-// wire's packed ring records (upload_plan.hpp) in a retained GPU buffer range while its rings are unchanged, so
-// a frame sends the rings of changed wires plus one draw record per visible wire and one 8-byte record per chunk
-// of bands, and expands the tube in the vertex shader over a static index pattern per side count, one instance
-// per chunk (each vertex shaded once per ring, twice at a chunk boundary).
+// Upload paths: the nodes path (gpu_nodes, the default where the context has compute) sends the nodes of wires
+// whose nodes changed and a 4-byte slot per other visible wire; compute programs build the curve, the LOD, the
+// rings and the draw's commands, and the ring vertex shader expands each tube over a static index pattern per
+// side count, one instance per chunk of bands (upload_plan.hpp). cpu-mesh (the portable reference and fallback)
+// streams every visible wire's vertices, a 4-byte draw index per vertex and its indices (rebased while copying)
+// each frame, and draws a material's wires with one command.
 //
-// Structure (for new primitive modes, e.g. camera-facing strips): a frame is (1) the items with geometry sorted
-// by class and material (and side count on gpu-rings), (2) a per-mode "prepare" step that writes each item's
-// draw record and the run's commands (and streams or retains its geometry), (3) one shared submission loop
-// issuing glMultiDrawElementsIndirect per run of equal (class, material) with the mode's program, vertex array
-// and element buffer. A new mode adds a program, a prepare step and its element pattern.
+// Structure: cpu-mesh's frame is (1) the items with geometry sorted by class and material, (2) a "prepare" step
+// that writes each item's draw record, the run's commands and its geometry, (3) one submission loop issuing
+// glMultiDrawElementsIndirect per run of equal (class, material). The nodes path's frame runs its compute
+// stages and submits the commands the GPU wrote (src/node_path.hpp).
 //
 // \code
 //   auto renderer = wire::render::WireRenderer::create();          // needs a current GL 4.5 context
 //   engine::gfx::clear({0.1f, 0.1f, 0.12f, 1.0f});
-//   wire::render::DrawStats stats = renderer->draw(list, camera);  // list.path picks cpu_mesh or gpu_rings
+//   wire::render::DrawStats stats = renderer->draw(list, camera);  // list.path picks gpu_nodes or cpu_mesh
 // \endcode
 #pragma once
 
@@ -108,16 +107,13 @@ struct RendererDesc {
     /// used by Output::gbuffer; empty: the default layout (Output::gbuffer). Compiled with the first G-buffer draw;
     /// a failure is that draw's status, with the driver's log.
     std::string_view gbuffer_glsl{};
-    /// gpu-rings: use the instanced chunk-index attribute even when ARB_shader_draw_parameters is available
-    /// (tests). cpu-mesh always reads the draw index from its per-vertex attribute.
+    /// The nodes path's ring vertex shader: use the instanced chunk-index attribute even when
+    /// ARB_shader_draw_parameters is available (tests). cpu-mesh always reads the draw index from its per-vertex
+    /// attribute.
     bool force_draw_index_attribute = false;
-    /// gpu-rings: keep ring records on the GPU between frames (false: stream every visible wire's rings each
-    /// frame, the path's behaviour before retention; kept for comparison in benchmarks and tests).
-    bool retain_rings = true;
-    /// Frames a wire's ring records stay resident while it is not drawn (culled or destroyed); 0 -> 180.
+    /// The nodes path: frames a wire's slot (its nodes, curve and LOD state on the GPU) stays while it is not
+    /// drawn (culled or destroyed); 0 -> 180.
     uint32_t retain_frames = 0;
-    /// Initial size of the retained ring buffer (grows as needed); 0 -> 4 MiB.
-    std::size_t ring_storage_bytes = 0;
 };
 
 /// Per-frame options.
@@ -139,28 +135,26 @@ struct DrawSettings {
 
 /// What one draw() did.
 struct DrawStats {
-    /// Bytes written into mapped buffers: draw records (32 B a wire), commands (20 B each), and cpu-mesh
-    /// vertices (32 B) + their draw index (4 B a vertex) + indices (4 B), or gpu-rings chunk records (8 B each)
-    /// + packed rings (28 B each, streamed or uploaded to the retained storage). upload_plan.hpp computes the same.
+    /// Bytes written into mapped buffers. cpu-mesh: draw records (32 B a wire), commands (20 B each), vertices
+    /// (32 B) + their draw index (4 B a vertex) + indices (4 B) (streamed_upload_bytes). gpu-nodes: a 64-byte
+    /// header and the nodes of each wire whose nodes changed, 4 B a slot when the list of drawn wires changed
+    /// (plan_nodes_frame); the node stream's own region is not counted.
     std::size_t bytes_uploaded = 0;
-    std::size_t ring_bytes_uploaded = 0;  ///< gpu-rings: the packed ring records among them
-    std::size_t wires_uploaded = 0;       ///< gpu-rings: wires whose rings were written this frame
-    std::size_t wires_streamed = 0;  ///< gpu-rings retained: of those, moving wires streamed with the frame
-    std::size_t wires_evicted = 0;        ///< gpu-rings retained, gpu-nodes: ranges freed (wires not drawn for a while)
+    std::size_t wires_uploaded = 0;  ///< gpu-nodes: wires whose nodes (or curve) were sent this frame
+    std::size_t wires_evicted = 0;   ///< gpu-nodes: slots freed (wires not drawn for retain_frames)
     std::size_t wires_skipped = 0;  ///< gpu-nodes: items not drawn (a spline kind the GPU does not build yet)
     /// gpu-nodes: wires whose rings did not fit the ring buffer (sized from a count read back 3 frames late) and
     /// were drawn with one ring a segment from its reserve; reported as read back, 3 frames late.
     std::size_t wires_coarse = 0;
     std::size_t draw_items = 0;      ///< items drawn (items with no geometry are skipped)
-    std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded; gpu-rings: vertices the shader expands (same count)
+    std::size_t vertices = 0;  ///< cpu-mesh: vertices uploaded (the nodes path's are expanded on the GPU: 0)
     /// Triangles drawn; gpu-nodes: as the GPU counted them, read back 3 frames late (0 until then).
     std::size_t triangles = 0;
-    /// Draw commands issued (indirect commands of the multi-draws): cpu-mesh one per (class, material) in use;
-    /// gpu-rings one per (class, material, side count, chunk kind) in use (wire::render::draw_commands). Does
-    /// not grow with the number of wires.
+    /// Draw commands issued (indirect commands of the multi-draws): cpu-mesh one per (class, material) in use
+    /// (wire::render::draw_commands); gpu-nodes one per (class, material, side count, chunk kind) slot the GPU
+    /// fills. Does not grow with the number of wires.
     std::size_t indirect_commands = 0;
     std::size_t multi_draw_calls = 0;  ///< glMultiDrawElementsIndirect calls: one per (class, material) in use
-    std::size_t chunks = 0;            ///< gpu-rings: chunk records (instances) drawn
     /// Success, or the frame's first problem: why it drew nothing (a program that did not build, a buffer that
     /// could not be made), or which item it skipped and why (gpu-nodes: a material out of range, a wire id listed
     /// twice; the rest is drawn). draw() also logs each distinct message once to stderr.
@@ -186,17 +180,12 @@ struct DrawnRings {
 
 /// What a renderer holds (WireRenderer::info()).
 struct RendererInfo {
-    /// gpu-rings: the chunk index comes from gl_BaseInstanceARB + gl_InstanceID (ARB_shader_draw_parameters), not
-    /// from the instanced attribute.
+    /// The ring vertex shader (nodes path): the chunk index comes from gl_BaseInstanceARB + gl_InstanceID
+    /// (ARB_shader_draw_parameters), not from the instanced attribute.
     bool draw_parameters = false;
     std::size_t region_bytes = 0;         ///< capacity of one stream-buffer region now
     std::size_t live_stream_buffers = 0;  ///< stream buffers alive: 1 plus retired ones still waiting for their fences
     std::vector<unsigned> allocated_stream_buffers;  ///< GL names of every stream buffer allocated (the first: initial)
-    std::size_t resident_wires = 0;           ///< gpu-rings retained: wires whose rings are resident
-    std::size_t ring_storage_live_bytes = 0;  ///< gpu-rings retained: bytes in live ranges
-    std::size_t ring_storage_capacity = 0;    ///< gpu-rings retained: capacity of the ring buffer, bytes
-    std::size_t live_ring_buffers = 0;        ///< gpu-rings retained: ring buffers alive (1 plus retired ones)
-    std::vector<unsigned> allocated_ring_buffers;  ///< gpu-rings retained: GL names of every ring buffer allocated
     /// gpu-nodes: GL buffers and programs the nodes path holds (0 before its first frame, which compiles its
     /// programs), and the wires it keeps a slot for.
     std::size_t node_path_buffers = 0, node_path_programs = 0, node_path_wires = 0;
@@ -229,7 +218,7 @@ public:
     /// Uploads and draws `list` into the bound framebuffer with depth test (GL_LESS) and back-face culling (it
     /// does not clear), writing settings.output. All items go into one region of the stream buffer; one glMultiDraw*Indirect per (class,
     /// material); the region is fenced afterwards. An empty list issues no draw. Item rules (asserted): material <
-    /// materials(), cpu_mesh items have indices < their vertex count, gpu_rings items have sides >= 3.
+    /// materials(), cpu_mesh items have indices < their vertex count.
     DrawStats draw(const DrawList& list, const engine::scene::Camera& camera,
                     const DrawSettings& settings = {});
 
@@ -245,7 +234,7 @@ public:
 
     /// gpu-nodes: the rings of every wire the last draw() drew (wires culled on the GPU are absent), in the order
     /// the GPU dispatched them; waits for the GPU. Fails, naming the reason, when the last draw() was on another
-    /// path (cpu-mesh and gpu-rings build their rings on the CPU: wire::systems::wire_ring_set has them) or drew
+    /// path (cpu-mesh builds its rings on the CPU: wire::systems::wire_ring_set has them) or drew
     /// nothing because the nodes path failed.
     Status read_drawn_rings(std::vector<DrawnRings>& out) const;
     /// The bulk node stream (node_stream.hpp): wires whose nodes a physics engine writes straight into this

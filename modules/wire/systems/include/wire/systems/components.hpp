@@ -8,7 +8,6 @@
 #include "wire/pop_free.hpp"
 #include "wire/nodes.hpp"
 #include "wire/packed_nodes.hpp"
-#include "wire/packed_ring.hpp"
 #include "wire/rings.hpp"
 #include "wire/tube.hpp"
 
@@ -91,20 +90,16 @@ struct WireLodState {
     uint64_t updates = 0;              ///< times update_lod ran for this wire
 };
 
-/// Ring stage: ring records along the wire (the gpu_rings path uploads these).
+/// Ring stage: ring records along the wire (cpu_mesh: the mesh stage builds the tube from them).
 /// Kept per wire: `params` and the float records `rings.rings`, plus rings.origin_m, rings.closed, rings.length_m,
 /// fold counts and frame stats, and ring 0's frame (`rings.frames` has one entry: carried over to the next state).
 /// The double per-ring arrays build_rings produces (frames, centres, arc length, u, tangents, its params copy)
 /// are per-thread scratch, not kept: every rebuild recomputes them. `u_close` is the closed loop's u at the join.
 /// A culled wire whose curve changed since its rings were built releases rings and params (the next visible
-/// frame rebuilds them anyway); a culled wire that did not change keeps them (the retained GPU path reuses them).
+/// frame rebuilds them anyway); a culled wire that did not change keeps them (turning back to it rebuilds nothing).
 struct WireRings {
     std::vector<RingParam> params;     ///< where the rings sit on the curve (segment, t)
     RingSet rings;                     ///< float ring records, ring 0's frame and the scalars (see above)
-    /// gpu_rings path: rings.rings in the renderer's 28-byte form, packed here in the parallel rings system so
-    /// the render thread only copies them (empty on the cpu_mesh path).
-    std::vector<PackedRing> packed;
-    bool radius_varies = false;        ///< with `packed`: some ring's radius differs from ring 0's
     float u_close = 0.0f;              ///< closed wires: texture u where the loop closes (0 for open wires)
     FrameSettings frame_settings{};    ///< what the last build seeded its first normal with (wire_ring_set redoes it)
     /// The nodes ring 0's frame was built from: their motion carries it on. UploadPath::gpu_nodes: the nodes the

@@ -53,11 +53,11 @@ struct WireContext {
     double viewport_height_px = 1080.0;  ///< viewport height, pixels
     /// The other views the frame draws the list from (a light's shadow map, a second camera): on the nodes path a
     /// wire inside any of them, or the camera, stays in the draw list (each view then culls and chooses its LOD on
-    /// the GPU), so a cable above the camera's view still casts its shadow into it. cpu-mesh and gpu-rings build
-    /// rings for the camera only and ignore them.
+    /// the GPU), so a cable above the camera's view still casts its shadow into it. cpu-mesh builds rings for the
+    /// camera only and ignores them.
     std::vector<engine::scene::Camera> other_views;
     LodSettings lod{};                           ///< tolerance (px), max rings per segment, hysteresis
-    UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_rings stops at ring records
+    UploadPath path = UploadPath::cpu_mesh;      ///< cpu_mesh builds meshes; gpu_nodes packs nodes
     bool pop_free = true;                        ///< blend when node ids appear or vanish (pop_free.hpp)
     /// A wire whose curve changed goes on through lod, rings and mesh right after its curve, on the same thread,
     /// while its curve and rings are still in cache (a moving wire's intermediates are not written out and read

@@ -9,7 +9,7 @@
 //                   (WireCurve)
 //   wire.rings      visible wires whose curve or counts changed: ring records, first normal carried over
 //   wire.mesh       cpu_mesh path: visible wires whose rings or sides changed: TubeVertex + indices;
-//                   gpu_rings path: nothing
+//                   gpu_nodes path: nothing (nor the rings before it: the GPU builds them)
 //   wire.draw_list  the frame's DrawList: visible wires in entity order, spans into the per-wire arrays
 // \endverbatim
 // The renderer adds its upload/render systems after these, reading WireContext::draw_list.

@@ -1,8 +1,8 @@
 // Test harness (wire::render_testing, never installed): the nodes path's ring pass driven alone, its LOD and rings
 // programs (shaders.hpp). From the segments a GpuCurvePass built, two compute dispatches (the counts and ring
-// ranges, then the rings) write every wire's ring records (wire::PackedRing, the 28-byte form the gpu-rings vertex
+// ranges, then the rings) write every wire's ring records (wire::PackedRing, the 28-byte form the ring vertex
 // shader reads), one invocation per wire walking its rings in order, as wire::place_rings + wire::build_rings do
-// on the CPU, which stays the reference (tests/modules/wire/render/gpu_rings_test.cpp compares the two):
+// on the CPU, which stays the reference (tests/modules/wire/render/gpu_curves_test.cpp compares the two):
 //
 //   pass->build(wires);                        // GpuCurvePass: the segments
 //   auto rings = wire::render::GpuRingPass::create();
