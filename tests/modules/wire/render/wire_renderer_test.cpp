@@ -1506,8 +1506,8 @@ TEST(WireRendererTest, PhoneWireCoverageAndFlickerAgainstSupersampling) {
             worst_total_error = std::max(worst_total_error, total_error);
             // The aim, 5x, holds for cpu-mesh's lines (65 rings a cable here). The nodes path's lines, 5 rings a
             // cable (its LOD below node resolution), flicker more under the sub-pixel drift (3.5x less than plain
-            // at worst, wire 3: long straight 1-px bands gain or lose a row of pixel centres together): asserted at
-            // 3x, the shortfall reported in docs/upload-paths.md.
+            // at worst, wire 3; its coverage steps where its four segments' joints and ends fall): asserted at 3x,
+            // the shortfall reported in docs/upload-paths.md.
             EXPECT_GE(f_plain, (path == 0 ? 5.0 : 3.0) * f_ours) << ours_name[path] << " wire " << w;
             EXPECT_LE(total_error, 0.10) << ours_name[path] << " wire " << w;
         }
