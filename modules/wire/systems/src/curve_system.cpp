@@ -21,9 +21,12 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
     for (const Entity e : ctx.blending) work.push_back(e);
     const bool nodes_path = ctx.path == UploadPath::gpu_nodes;
     if (ctx.has_seen_path && (ctx.seen_path == UploadPath::gpu_nodes) != nodes_path) {
-        // To or from the nodes path: every wire again (one keeps packed nodes and no curve, the other a curve).
+        // To or from the nodes path: every wire again (one keeps packed nodes and no curve, the other a curve), and
+        // the LOD for every wire (the nodes path computes no counts on the CPU): a wire whose nodes are bad keeps
+        // its generation, and its curve comes back from its last valid nodes with counts to match.
         auto& curves = registry.storage<WireCurve>();
         for (std::size_t i = 0; i < curves.size(); ++i) work.push_back(curves.at(i));
+        ++ctx.view_generation;
     }
     ctx.seen_path = ctx.path;
     ctx.has_seen_path = true;
@@ -162,7 +165,9 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 if (job.status.ok()) sphere = curve_bounding_sphere(c.curve);
             }
             if (job.status.ok()) {
-                commit(c, nodes, sphere, false);
+                // Without its curve (the GPU builds it) the wire's curve is released, as a culled moving wire's:
+                // back on cpu-mesh it comes back from the last valid nodes, also while the current ones are bad.
+                commit(c, nodes, sphere, c.curve.segments.empty());
                 job.changed = true;
             }
             end_update(c, job.status.ok());

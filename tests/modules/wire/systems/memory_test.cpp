@@ -132,9 +132,7 @@ TEST(WireMemory, MovingFieldFitsTheAimsPerWire) {
                     worst_visible_without_mesh = std::max(worst_visible_without_mesh, m.visible_bytes - m.mesh_bytes);
                 } else {
                     ASSERT_EQ(m.culled_wires, 1u);
-                    if (!nodes) {
-                        EXPECT_TRUE(c.released) << "a culled moving wire releases its curve";
-                    }
+                    EXPECT_TRUE(c.released) << "a culled moving wire releases its curve (the nodes path keeps none)";
                     EXPECT_TRUE(c.curve.segments.empty());
                     EXPECT_LE(m.culled_bytes, kCulledLimit) << "frame " << frame << ", culled wire "
                                                             << engine::ecs::to_integral(e);

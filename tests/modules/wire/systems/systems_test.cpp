@@ -354,6 +354,36 @@ TEST(WireSystems, NodesPathBuildsNoMeshesAndSwitchingPathsRebuilds) {
     EXPECT_TRUE(w.ctx.draw_list.items[0].vertices.empty());
 }
 
+// A wire whose nodes go bad on the nodes path (which keeps no curve on the CPU) and a switch to cpu-mesh: the wire
+// draws its last valid curve there, rebuilt from its last valid nodes, and the rings and mesh stages never see an
+// empty curve (fuzz_wire_systems found build_rings reading past one: regression_nodes_path_back_to_cpu_bad_nodes).
+TEST(WireSystems, BadNodesOnTheNodesPathThenCpuMeshDrawTheLastValidCurve) {
+    World w;
+    w.ctx.path = UploadPath::gpu_nodes;
+    const WireNodes good = cable(12, {-2, 0, 0}, 4.0, 0.5);
+    const Entity e = spawn_wire(w.registry, good);
+    w.run();
+    ASSERT_EQ(w.ctx.draw_list.items.size(), 1u);
+    EXPECT_TRUE(w.registry.get<WireCurve>(e).curve.segments.empty()) << "the nodes path keeps no curve";
+    WireNodes bad = good;
+    bad.positions[5].y = std::nan("");
+    set_nodes(w.registry, e, bad);
+    w.run();
+    ASSERT_NE(wire_error(w.registry, e), nullptr);
+    w.ctx.path = UploadPath::cpu_mesh;
+    for (int frame = 0; frame < 2; ++frame) {
+        w.run();
+        ASSERT_EQ(w.ctx.draw_list.items.size(), 1u) << "frame " << frame;
+        const DrawItem& item = w.ctx.draw_list.items[0];
+        EXPECT_FALSE(item.vertices.empty());
+        const wire::Curve& curve = w.registry.get<WireCurve>(e).curve;
+        ASSERT_EQ(curve.segments.size(), good.size() - 1);
+        // Through the last valid nodes (node 5 is NaN in the current ones).
+        EXPECT_EQ(curve.segments[5].b0, good.positions[5]);
+        EXPECT_EQ(curve.segments.back().b3, good.positions.back());
+    }
+}
+
 TEST(WireSystems, TessellationMeetsTheScreenTolerance) {
     World w;
     for (int i = 0; i < 20; ++i) spawn_wire(w.registry, cable(32, {-3, 0.2 * i - 2, -0.5 * i}, 6.0, 0.8, i));
