@@ -277,9 +277,13 @@ struct Harness {
                     wire_fuzz::require(std::isfinite(n.x + n.y + n.z + n.w) && n.w > 0.0f, "packed node not finite");
                 }
             }
-            if (ctx.draw_list.path == wire::UploadPath::gpu_nodes)
-                wire_fuzz::require(item.packed_nodes != nullptr || item.curve != nullptr,
-                                   "nodes-path item with neither packed nodes nor a curve");
+            if (ctx.draw_list.path == wire::UploadPath::gpu_nodes) {
+                // Packed nodes, a CPU-built curve, or the last valid nodes for the renderer to pack (a wire whose
+                // current nodes are bad when the path changed has no packing of its last valid ones).
+                const bool nodes = item.nodes != nullptr && item.nodes->size() >= 2;
+                wire_fuzz::require(item.packed_nodes != nullptr || item.curve != nullptr || nodes,
+                                   "nodes-path item with neither nodes, packed nodes nor a curve");
+            }
         }
         wire_fuzz::require(ctx.stats.visible_wires + ctx.stats.culled_wires == registry.storage<ws::WireLodState>().size(),
                            "visible + culled differs from the wire count");
@@ -399,6 +403,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
         const ws::WireCurve& c = h.registry.get<ws::WireCurve>(w.entity);
         wire_fuzz::require(!c.blending, "a wire still blends after settling");
         if (ws::wire_error(h.registry, w.entity) != nullptr || c.generation == 0) continue;  // shows its last valid curve
+        if (h.ctx.path == wire::UploadPath::gpu_nodes && c.curve.segments.empty()) {
+            // The nodes path keeps the nodes packed for the GPU, not a curve: a fresh packing of the same nodes.
+            wire::PackedNodes packed;
+            const engine::Status st = wire::pack_nodes(h.registry.get<ws::Nodes>(w.entity),
+                                                       spline_of(h.registry.get<ws::Style>(w.entity)), packed);
+            wire_fuzz::require(st.ok(), "a wire without WireError has nodes pack_nodes rejects");
+            wire_fuzz::require(packed.node_count == c.packed.node_count && packed.records == c.packed.records &&
+                                   packed.extras == c.packed.extras,
+                               "settled packed nodes differ from a fresh packing");
+            continue;
+        }
         if (c.released) {  // culled while moving: its curve comes back when the view turns to it (WireCurve)
             wire_fuzz::require(!h.registry.get<ws::WireLodState>(w.entity).lod.visible && c.curve.segments.empty(),
                                "a released curve on a visible wire");
