@@ -8,7 +8,6 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
-#include <span>
 #include <vector>
 
 namespace wiretool::bench {
