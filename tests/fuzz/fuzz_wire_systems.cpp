@@ -278,11 +278,18 @@ struct Harness {
                 }
             }
             if (ctx.draw_list.path == wire::UploadPath::gpu_nodes) {
-                // Packed nodes, a CPU-built curve, or the last valid nodes for the renderer to pack (a wire whose
-                // current nodes are bad when the path changed has no packing of its last valid ones).
+                // Packed nodes (the last valid ones, also for a wire whose nodes are bad when the path changes), a
+                // CPU-built curve, or nodes the systems could not pack (a style change the last valid nodes do not
+                // fit: the renderer tries them and reports them).
                 const bool nodes = item.nodes != nullptr && item.nodes->size() >= 2;
                 wire_fuzz::require(item.packed_nodes != nullptr || item.curve != nullptr || nodes,
                                    "nodes-path item with neither nodes, packed nodes nor a curve");
+                wire::PackedNodes again;  // the packed nodes are the item's (last valid) nodes, not older ones
+                if (item.packed_nodes != nullptr && item.nodes != nullptr &&
+                    wire::pack_nodes(*item.nodes, item.spline, again).ok()) {
+                    wire_fuzz::require(again.records == item.packed_nodes->records,
+                                       "packed nodes are not the item's nodes");
+                }
             }
         }
         wire_fuzz::require(ctx.stats.visible_wires + ctx.stats.culled_wires == registry.storage<ws::WireLodState>().size(),

@@ -169,6 +169,10 @@ void curve_system(Registry& registry, WireContext& ctx, uint64_t since) {
                 // back on cpu-mesh it comes back from the last valid nodes, also while the current ones are bad.
                 commit(c, nodes, sphere, c.curve.segments.empty());
                 job.changed = true;
+            } else if (c.generation > 0) {
+                // Bad nodes: the wire draws its last valid nodes, so `packed` holds them (it may hold none, or older
+                // ones, when the wire comes from cpu-mesh), packed here on the worker thread, not on the render's.
+                (void)pack_nodes(prev, step.pop_free.spline, c.packed);
             }
             end_update(c, job.status.ok());
         });

@@ -384,6 +384,35 @@ TEST(WireSystems, BadNodesOnTheNodesPathThenCpuMeshDrawTheLastValidCurve) {
     }
 }
 
+// The other way: a wire moved on cpu-mesh after the nodes path packed it, then its nodes go bad, then the nodes path
+// again: it draws its last valid nodes, packed on the systems' threads (not older packed ones, not unpacked).
+TEST(WireSystems, BadNodesOnCpuMeshThenTheNodesPathDrawTheLastValidNodesPacked) {
+    World w;
+    w.ctx.path = UploadPath::gpu_nodes;
+    const Entity e = spawn_wire(w.registry, cable(12, {-2, 0, 0}, 4.0, 0.5));
+    w.run();
+    w.ctx.path = UploadPath::cpu_mesh;
+    const WireNodes moved = cable(12, {-2, 0.3, 0}, 4.0, 0.5);
+    set_nodes(w.registry, e, moved);
+    w.run();
+    WireNodes bad = moved;
+    bad.positions[5].y = std::nan("");
+    set_nodes(w.registry, e, bad);
+    w.run();
+    ASSERT_NE(wire_error(w.registry, e), nullptr);
+    w.ctx.path = UploadPath::gpu_nodes;
+    w.run();
+    ASSERT_EQ(w.ctx.draw_list.items.size(), 1u);
+    const DrawItem& item = w.ctx.draw_list.items[0];
+    ASSERT_EQ(item.curve, nullptr);
+    ASSERT_NE(item.packed_nodes, nullptr);
+    ASSERT_EQ(item.packed_nodes->node_count, moved.size());
+    for (std::size_t j = 0; j < moved.size(); ++j) {
+        const glm::dvec3 p = item.packed_nodes->origin_m + glm::dvec3(glm::vec3(item.packed_nodes->node(j)));
+        EXPECT_LT(glm::length(p - moved.positions[j]), 1e-4) << "node " << j;
+    }
+}
+
 TEST(WireSystems, TessellationMeetsTheScreenTolerance) {
     World w;
     for (int i = 0; i < 20; ++i) spawn_wire(w.registry, cable(32, {-3, 0.2 * i - 2, -0.5 * i}, 6.0, 0.8, i));
