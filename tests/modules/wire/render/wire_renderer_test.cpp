@@ -589,13 +589,7 @@ TEST(WireRendererTest, GpuNodesMatchTheCpuReference) {
         }
         DrawStats cpu_stats, gpu_stats, second_stats;
         const platform::Image reference = render(*ctx, renderer, cpu, view.camera, {}, &cpu_stats);
-        const platform::Image again = render(*ctx, renderer, cpu, view.camera, {}, &cpu_stats);
         const platform::Image first = render(*ctx, renderer, gpu, view.camera, node_settings, &gpu_stats);
-        const platform::Image again2 = render(*ctx, renderer, cpu, view.camera, {}, &cpu_stats);
-        const platform::Image again3 = render(*ctx, renderer, cpu, view.camera, {}, &cpu_stats);
-        std::printf("DBG err %x\n", glGetError());
-        std::printf("DBG same %d %d %d\n", int(again.rgba == reference.rgba), int(again2.rgba == reference.rgba), int(again3.rgba == reference.rgba));
-        save(again, std::string("wire_render_") + view.name + "_again.png");
         const platform::Image second = render(*ctx, renderer, gpu, view.camera, node_settings, &second_stats);
         save(reference, std::string("wire_render_") + view.name + "_reference_for_nodes.png");
         save(first, std::string("wire_render_") + view.name + "_gpu_nodes.png");
