@@ -1,7 +1,6 @@
 // The ring pass's per-wire programs (LOD, rings): their shared storage blocks, uniforms and the wire being walked.
-// One invocation per wire. The CPU reference for every function named after one: modules/wire/src/rings.cpp
+// One invocation per wire (the LOD and rings programs' mains say 64 a workgroup). The CPU reference for every function named after one: modules/wire/src/rings.cpp
 // (build_rings, radius, u) and modules/wire/src/frames.cpp (compute_frames, mirrors, Transporter).
-layout(local_size_x = 64) in;
 layout(std430, binding = RING_HEADERS) readonly buffer Headers { GpuCurveHeader headers[]; };  // by slot
 layout(std430, binding = RING_SEGMENTS) readonly buffer Segments { vec4 segments[]; };  // b0, b1 - b0, b2 - b1, b3 - b2; w: see below
 layout(std430, binding = RING_JOBS) buffer Jobs { Job jobs[]; };

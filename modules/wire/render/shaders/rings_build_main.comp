@@ -1,15 +1,14 @@
-// The ring pass's rings program, one invocation per dispatched wire, after the LOD program (and, with u_draw, the
-// commands program): the wire's rings from the range its job holds, walked in order with their frames and u, and
-// (u_draw) its draw record (GpuDraw) and chunk records.
+// The ring pass's rings program, one invocation per dispatched wire, after the place program's ring ranges: the
+// wire's rings from the range its job holds, walked in order with their frames and u, and (u_draw) its draw record
+// (GpuDraw).
+layout(local_size_x = 64) in;
 layout(std430, binding = RING_DRAWS) writeonly buffer Draws { GpuDraw draws[]; };
-layout(std430, binding = RING_CHUNKS) writeonly buffer Chunks { uvec2 chunks[]; };
 
 void main() {
     uint w = gl_GlobalInvocationID.x;
     if (w >= u_wires) return;
     uint slot = visible[w];
     load_wire(slot);
-    uint material = H.flags >> kHeaderMaterialShift;
     bool caps = (H.flags & kHeaderCaps) != 0u;
     Job job = jobs[w];
     uint n = job.ring_count;
@@ -46,7 +45,7 @@ void main() {
     jobs[w].totals = vec4(totals.xyz, radius_px);
     slot_state[slot].first_normal = vec4(r0, 1.0);
     if (!u_draw) return;
-    // The draw record (GpuDraw) and the chunk records of this wire.
+    // The draw record (GpuDraw).
     bool tilt = false;
     float r_first = node_radius(0u);
     for (uint j = 1u; j < N; ++j) tilt = tilt || node_radius(j) != r_first;
@@ -54,15 +53,4 @@ void main() {
                  (drawn == 2u ? kDrawStrip : drawn == 1u ? kDrawLine : 0u);
     vec3 offset = vec3(dvec3(H.origin_m[0], H.origin_m[1], H.origin_m[2]) - u_eye);
     draws[w] = GpuDraw(offset, 7u * RING_FIRST, n, drawn, flags, totals.x);
-    uint band = 0u;
-    for (uint kind = 0u; kind < 6u; ++kind) {
-        uint c = chunk_count_of(kind, n, drawn, caps);
-        if (c == 0u) continue;
-        uint at = atomicAdd(buckets[u_buckets + bucket_of(material, drawn, kind)], c);
-        for (uint i = 0u; i < c; ++i) {
-            uint first_band = kind == 0u ? 0u : band;
-            chunks[at + i] = uvec2(w, first_band);
-            if (kind != 0u) band += 16u >> (kind - 1u);
-        }
-    }
 }

@@ -1,17 +1,9 @@
 // The ring pass's LOD program, one invocation per dispatched wire: the slot's first normal turned by the wire's
-// motion, the rings per segment (the LOD's, or the caller's: place_rings' total), a range of the ring buffer for
-// them, and (u_draw) the chunk counts of the wire's buckets and its triangles. The rings program reads the job it
-// writes.
-// Rings allocated, wires that did not fit, rings allocated from the reserve (u_ring_reserve records after
-// u_ring_capacity: one ring a segment for every listed wire, so a wire that does not fit is drawn coarse, not
-// missing, until the ring buffer has grown), triangles the draw expands (u_draw: wire::tube_counts' and
-// strip_counts').
-layout(std430, binding = RING_COUNTER) buffer Counter {
-    uint ring_counter; uint overflow; uint reserve_counter; uint triangles;
-};
+// motion, the rings per segment (the LOD's, or the caller's: place_rings' total) and the drawn sides, into the
+// wire's job (ring_count: the rings it wants). The place program then gives each wire its range of the ring buffer
+// and its chunk records, in wire order; the rings program reads the job.
+layout(local_size_x = 64) in;
 uniform uint u_unchanged;
-uniform uint u_ring_capacity;
-uniform uint u_ring_reserve;
 uniform bool u_lod;  // the LOD's counts and sides, else the caller's counts and 3 sides
 // Keeps the caller's kJobHasPrevious and kJobGivesPrevious (GpuRingPass), else clears them: the rings program
 // then carries the first normal from the slot (the nodes path).
@@ -30,8 +22,6 @@ void main() {
     if (w >= u_wires) return;
     uint slot = visible[w];
     load_wire(slot);
-    uint material = H.flags >> kHeaderMaterialShift;
-    bool caps = (H.flags & kHeaderCaps) != 0u;
     if (w >= u_unchanged) {
         // Nodes that changed: the slot's last first normal turned by the wire's motion since (the header's
         // rotation: fitted by the curve pass, or by the CPU on id events and blends), as the CPU path's
@@ -43,7 +33,7 @@ void main() {
     }
     uint flags = u_keep_job_flags ? jobs[w].flags & (kJobHasPrevious | kJobGivesPrevious) : 0u;
     jobs[w].flags = flags;
-    // The rings: the LOD's counts, or the caller's (place_rings' total); a range of the ring buffer.
+    // The rings: the LOD's counts, or the caller's (place_rings' total).
     uint n = CLOSED ? 0u : 1u;
     float radius_px = 0.0;
     uint drawn = 0u;
@@ -55,30 +45,8 @@ void main() {
         for (uint k = 0u; k < SEGS; ++k) n += count_of(k);
         drawn = 3u;
     }
-    jobs[w].ring_count = 0u;
+    jobs[w].ring_count = n;  // 0: culled
+    jobs[w].ring_first = 0u;
     jobs[w].sides = drawn;
     jobs[w].totals = vec4(0.0, 0.0, 0.0, radius_px);
-    if (n == 0u) return;  // culled
-    uint first = atomicAdd(ring_counter, n);
-    jobs[w].ring_first = first;
-    if (first + n > u_ring_capacity) {
-        atomicAdd(overflow, 1u);
-        // One ring a segment from the reserve (sized for every listed wire): coarse for a frame, not missing.
-        uint fewest = SEGS + (CLOSED ? 0u : 1u);
-        first = u_ring_capacity + atomicAdd(reserve_counter, fewest);
-        if (first + fewest > u_ring_capacity + u_ring_reserve) return;
-        n = fewest;
-        jobs[w].ring_first = first;
-        jobs[w].flags = flags | kJobFromReserve;
-    }
-    jobs[w].ring_count = n;
-    if (u_draw) {
-        for (uint kind = 0u; kind < 6u; ++kind) {
-            uint c = chunk_count_of(kind, n, drawn, caps);
-            if (c != 0u) atomicAdd(buckets[bucket_of(material, drawn, kind)], c);
-        }
-        uint bands = n - 1u + (CLOSED ? 1u : 0u);
-        uint tris = drawn <= 2u ? 2u * bands : (2u * bands + (!CLOSED && caps ? 2u : 0u)) * drawn;
-        if (tris != 0u) atomicAdd(triangles, tris);
-    }
 }

@@ -27,7 +27,7 @@ namespace wire::render::detail {
 inline constexpr uint32_t kMaxSides = 256;
 
 /// The shader storage binding points of the curve program and of the ring pass's programs, dense from 0 (the ring
-/// pass's between its three programs, each declaring the blocks it reads): GL guarantees 8 bindings and 8 blocks a
+/// pass's between its four programs, each declaring the blocks it reads): GL guarantees 8 bindings and 8 blocks a
 /// stage, NVIDIA 16 (a binding past that fails to link there, never on llvmpipe). The GLSL names them by macros of
 /// the same names in capitals (kRingJobs: RING_JOBS), defined by every program's source (shaders.hpp), so both
 /// sides read one number.

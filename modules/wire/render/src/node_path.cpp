@@ -63,6 +63,7 @@ Expected<std::unique_ptr<NodePath>> NodePath::create(uint32_t retain_frames) {
         gfx::Program& program;
     } ring_programs[] = {
         {"wire nodes: ring LOD", ring_lod_program_source(), path->ring_lod_program_},
+        {"wire nodes: ring place", ring_place_program_source(), path->ring_place_program_},
         {"wire nodes: ring commands", ring_commands_program_source(), path->ring_commands_program_},
         {"wire nodes: rings", ring_build_program_source(), path->ring_build_program_},
     };
@@ -108,7 +109,8 @@ std::size_t NodePath::gl_buffers() const {
 
 std::size_t NodePath::gl_programs() const {
     std::size_t n = 0;
-    for (const gfx::Program* p : {&curve_program_, &ring_lod_program_, &ring_commands_program_, &ring_build_program_})
+    for (const gfx::Program* p :
+         {&curve_program_, &ring_lod_program_, &ring_place_program_, &ring_commands_program_, &ring_build_program_})
         n += p->id() != 0 ? 1 : 0;
     return n;
 }
@@ -287,6 +289,52 @@ void NodePath::submit(const NodeDrawContext& ctx, DrawStats& stats, Lines lines)
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+}
+
+Status NodePath::read_draw_order(std::vector<DrawnChunk>& out) const {
+    out.clear();
+    if (dispatched_.empty() || buckets_used_ == 0) return Status::success();
+    // glGetNamedBufferSubData waits for the dispatches; the last stage's barrier has BUFFER_UPDATE.
+    std::vector<uint32_t> commands(buckets_used_ * 5);
+    glGetNamedBufferSubData(commands_.id(), 0, static_cast<GLsizeiptr>(commands.size() * 4), commands.data());
+    std::size_t chunk_total = 0;
+    for (std::size_t b = 0; b < buckets_used_; ++b) chunk_total += commands[5 * b + 1];
+    if (chunk_total > chunk_capacity()) {
+        return Status::error("read_draw_order: the commands count " + std::to_string(chunk_total) +
+                             " chunks, the chunk buffer holds " + std::to_string(chunk_capacity()));
+    }
+    std::vector<uint32_t> chunks(2 * chunk_total);
+    if (chunk_total != 0)
+        glGetNamedBufferSubData(chunks_.id(), 0, static_cast<GLsizeiptr>(chunks.size() * 4), chunks.data());
+    const std::size_t per_material = std::size_t{side_slots_} * kChunkKinds;
+    // submit()'s order: per material its tubes' and strips' commands (side slots 2 ..), then per material its lines'.
+    const auto emit = [&](std::size_t m, uint32_t first_slot, uint32_t slots) -> Status {
+        for (std::size_t b = m * per_material + std::size_t{first_slot} * kChunkKinds;
+             b < m * per_material + std::size_t{first_slot + slots} * kChunkKinds; ++b) {
+            const uint32_t count = commands[5 * b + 1], first = commands[5 * b + 4];
+            for (uint32_t i = first; i < first + count; ++i) {
+                if (std::size_t{i} >= chunk_total || chunks[2 * i] >= dispatched_.size())
+                    return Status::error("read_draw_order: chunk " + std::to_string(i) + " is out of range");
+                out.push_back({.wire_id = dispatched_[chunks[2 * i]].wire_id,
+                               .material = static_cast<uint32_t>(m),
+                               .sides = static_cast<uint32_t>(b % per_material / kChunkKinds),
+                               .kind = static_cast<uint32_t>(b % kChunkKinds),
+                               .first_band = chunks[2 * i + 1]});
+            }
+        }
+        return Status::success();
+    };
+    for (uint32_t pass = 0; pass < 2; ++pass) {
+        for (std::size_t m = 0; m < materials_; ++m) {
+            if (m >= material_used_.size() || !material_used_[m]) continue;
+            Status st = pass == 0 ? emit(m, 2, side_slots_ - 2) : emit(m, 1, 1);
+            if (!st) {
+                out.clear();
+                return st;
+            }
+        }
+    }
+    return Status::success();
 }
 
 Status NodePath::read_rings(std::vector<DrawnRings>& out) const {

@@ -2,10 +2,11 @@
 // wires whose nodes changed, their curve nodes and a 64-byte header (into the renderer's fenced stream region),
 // plus a 4-byte slot per other visible wire (the curve passes list the changed ones); the node stream's wires
 // (node_stream.hpp) arrive with their headers and nodes in the stream's own region, and get a curve pass of their
-// own. Everything after that runs in compute dispatches: the curve (into
-// persistent per-wire segments), the LOD (below the node resolution unless the settings keep it; hysteresis state per wire kept on the GPU), the
-// indirect commands, the rings with their frames and u, the draw and chunk records; then the ring vertex
-// shader draws them with one multi-draw per (class, material), reading commands the GPU wrote.
+// own. Everything after that runs in compute dispatches: the curve (into persistent per-wire segments), the LOD
+// (below the node resolution unless the settings keep it; hysteresis state per wire kept on the GPU), the ring
+// ranges and chunk records (in wire order), the indirect commands, the rings with their frames and u, the draw
+// records; then the ring vertex shader draws them with one multi-draw per (class, material), reading commands
+// the GPU wrote.
 #pragma once
 
 #include "wire/draw.hpp"
@@ -82,13 +83,15 @@ public:
     std::size_t upload_bytes(const DrawList& list);
     /// The rings the last prepare() computed and submit() drew (WireRenderer::read_drawn_rings); waits for the GPU.
     Status read_rings(std::vector<DrawnRings>& out) const;
+    /// The chunks the last prepare() placed, in the order submit() draws them (WireRenderer::read_draw_order).
+    Status read_draw_order(std::vector<DrawnChunk>& out) const;
     /// The most sides the frame's LOD can give (the patterns must cover it).
     [[nodiscard]] uint32_t max_sides() const { return max_sides_; }
 
     [[nodiscard]] std::size_t resident_wires() const { return slots_.size(); }
     /// GL buffers it holds now (its persistent and per-frame buffers; a grown one replaces the old).
     [[nodiscard]] std::size_t gl_buffers() const;
-    /// GL programs it holds (the curve program and the ring pass's three).
+    /// GL programs it holds (the curve program and the ring pass's four).
     [[nodiscard]] std::size_t gl_programs() const;
     /// Chunk records the frame may draw (the instanced chunk-index attribute must cover them).
     [[nodiscard]] std::size_t chunk_capacity() const { return chunk_bytes_ / 8; }
@@ -143,8 +146,8 @@ private:
     Gathered gather(const DrawList& list, std::size_t materials, WireUpload& up, DrawStats& stats);
 
     engine::gfx::Program curve_program_;
-    /// The ring pass's stages, dispatched in this order (shaders.hpp): LOD, indirect commands, rings and records.
-    engine::gfx::Program ring_lod_program_, ring_commands_program_, ring_build_program_;
+    /// The ring pass's stages (shaders.hpp): LOD, place (ring ranges), indirect commands, place (chunk records), rings.
+    engine::gfx::Program ring_lod_program_, ring_place_program_, ring_commands_program_, ring_build_program_;
     LodSettings lod_{};
     uint32_t retain_frames_ = 180, max_sides_ = 32;
     uint64_t frame_ = 0;

@@ -1,9 +1,10 @@
 // The nodes path's frame on the GPU (node_path.hpp): the region (headers, nodes, the listed slots), the
 // per-frame buffers, the curve passes of the changed wires (the list's, then the stream's) and the ring pass's
-// three programs (LOD, commands, rings with their draw and chunk records).
+// four programs (LOD, place: ring ranges, commands, place: chunk records, rings with their draw records).
 #include "node_path.hpp"
 
 #include "gpu_wire_data.hpp"
+#include "shaders.hpp"
 
 #include "wire/render/upload_plan.hpp"
 
@@ -217,7 +218,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     // buffers the last draw read (the previous view of this frame, or the last frame): the barrier orders
     // those reads first.
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-    // One binding point per buffer (RingBinding), shared by the three programs: each reads the ones it declares.
+    // One binding point per buffer (RingBinding), shared by the four programs: each reads the ones it declares.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingHeaders, slot_headers_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingSegments, segments_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingJobs, jobs_.id());
@@ -234,7 +235,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingCommands, commands_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRingTemplates, templates_.id());
     const auto groups = static_cast<GLuint>((visible_ + 63) / 64);
-    // (2) The LOD: counts, sides, ring ranges, chunk counts per bucket.
+    // (2) The LOD: counts, sides, the rings each wire wants.
     {
         ring_lod_program_.use();
         const auto at = [&](const char* name) { return ring_lod_program_.uniform_location(name); };
@@ -244,15 +245,27 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
         glUniform1i(at("u_draw"), 1);
         glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
         glUniform1ui(at("u_unchanged"), static_cast<GLuint>(unchanged_));
-        glUniform1ui(at("u_ring_capacity"),
-                     static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
-        glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, 0xffffffffu)));
-        glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
         glUniform1ui(at("u_side_slots"), side_slots_);
         glDispatchCompute(groups, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    // (3) The indirect commands and each bucket's first chunk.
+    // (3) Placed in wire order (one workgroup): stage 0 the ring ranges and chunk counts per bucket, then the
+    // indirect commands and each bucket's first chunk, then stage 1 the chunk records.
+    const auto place = [&](uint32_t stage) {
+        ring_place_program_.use();
+        const auto at = [&](const char* name) { return ring_place_program_.uniform_location(name); };
+        glUniform1ui(at("u_stage"), stage);
+        glUniform1i(at("u_draw"), 1);
+        glUniform1ui(at("u_wires"), static_cast<GLuint>(visible_));
+        glUniform1ui(at("u_ring_capacity"),
+                     static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, kMaxRingRecords)));
+        glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, kMaxRingRecords)));
+        glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
+        glUniform1ui(at("u_side_slots"), side_slots_);
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    };
+    place(0);
     {
         ring_commands_program_.use();
         const auto at = [&](const char* name) { return ring_commands_program_.uniform_location(name); };
@@ -261,7 +274,8 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    // (4) The rings, the draw and chunk records.
+    place(1);
+    // (4) The rings and the draw records.
     {
         ring_build_program_.use();
         const auto at = [&](const char* name) { return ring_build_program_.uniform_location(name); };

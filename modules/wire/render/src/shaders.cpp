@@ -82,7 +82,13 @@ std::string ring_lod_program_source() {
 
 std::string ring_commands_program_source() {
     const std::string defines = binding_defines();
-    return glsl_program({defines, glsl::rings_buckets_comp, glsl::rings_commands_main_comp});
+    return glsl_program({defines, glsl::rings_scan_comp, glsl::rings_buckets_comp, glsl::rings_commands_main_comp});
+}
+
+std::string ring_place_program_source() {
+    const std::string defines = binding_defines();
+    return glsl_program({defines, kRecordMacros, glsl::gpu_records_h, glsl::rings_scan_comp, glsl::rings_buckets_comp,
+                         glsl::rings_comp, glsl::rings_place_main_comp});
 }
 
 std::string ring_build_program_source() {

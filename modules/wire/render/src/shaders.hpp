@@ -1,9 +1,10 @@
 // The wire programs' GLSL (internal; the text is in modules/wire/render/shaders): the curve program and the
-// ring pass's three compute programs, one vertex shader per upload path, the fragment shaders.
+// ring pass's four compute programs, one vertex shader per upload path, the fragment shaders.
 #pragma once
 
 #include "gpu_records.hpp"
 
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <string>
@@ -30,15 +31,22 @@ std::string fragment_source(FragmentOutput output, std::string_view shading, std
 std::string glsl_program(std::initializer_list<std::string_view> pieces);
 /// The curve program: the binding macros (kBindingMacros), the shared records (gpu_records.h), curves*.comp.
 std::string curve_program_source();
-/// The ring pass's three programs, dispatched in this order (each from the binding macros and the pieces its stage
-/// reads). The LOD program (one invocation per wire): the slot's first normal turned by the wire's motion, the
-/// rings per segment (the LOD's or the caller's), a range of the ring buffer, the chunk counts per bucket. The
-/// shared records, rings_buckets.comp, rings.comp, rings_segment.comp, rings_lod.comp, rings_lod_main.comp.
+/// The ring pass's programs, dispatched in this order: LOD, place (stage 0), commands, place (stage 1), rings (each
+/// from the binding macros and the pieces its stage reads). The LOD program (one invocation per wire): the slot's
+/// first normal turned by the wire's motion, the rings per segment (the LOD's or the caller's), the drawn sides.
+/// The shared records, rings_buckets.comp, rings.comp, rings_segment.comp, rings_lod.comp, rings_lod_main.comp.
 std::string ring_lod_program_source();
-/// The commands program (one invocation): the indirect commands and each bucket's first chunk.
-/// rings_buckets.comp, rings_commands_main.comp.
+/// The place program (one workgroup, in wire order): stage 0 the ring ranges (a prefix sum), the reserve, the
+/// chunk counts per bucket; stage 1 the chunk records in each bucket in wire order. The shared records,
+/// rings_scan.comp, rings_buckets.comp, rings.comp, rings_place_main.comp.
+std::string ring_place_program_source();
+/// Most ring records the place program addresses: its sums saturate at 2^31 - 1 (rings_scan.comp's kSat), so a
+/// capacity or reserve below that is compared exactly.
+inline constexpr std::size_t kMaxRingRecords = 0x7ffffffe;
+/// The commands program (one workgroup): the indirect commands and each bucket's first chunk (a prefix sum).
+/// rings_scan.comp, rings_buckets.comp, rings_commands_main.comp.
 std::string ring_commands_program_source();
-/// The rings program (one invocation per wire): the rings with their frames and u, the draw and chunk records.
+/// The rings program (one invocation per wire): the rings with their frames and u, the draw record.
 /// The shared records, rings_buckets.comp, rings.comp, rings_segment.comp, rings_frames.comp, rings_build_main.comp.
 std::string ring_build_program_source();
 

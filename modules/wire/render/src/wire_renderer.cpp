@@ -211,6 +211,19 @@ Status WireRenderer::read_drawn_rings(std::vector<DrawnRings>& out) const {
     return s.nodes->read_rings(out);
 }
 
+Status WireRenderer::read_draw_order(std::vector<DrawnChunk>& out) const {
+    out.clear();
+    const State& s = *state_;
+    if (!s.drawn_any) return Status::error("read_draw_order: nothing has been drawn yet");
+    if (s.last_path != UploadPath::gpu_nodes) {
+        return Status::error("read_draw_order: the last draw was on the '" +
+                             std::string(upload_path_name(s.last_path)) +
+                             "' path, which draws each item in list order (its own draw)");
+    }
+    if (!s.nodes) return Status::error("read_draw_order: " + s.nodes_failed.message);
+    return s.nodes->read_draw_order(out);
+}
+
 Status WireRenderer::State::ensure_nodes() {
     if (!nodes_failed.ok()) return nodes_failed;
     if (nodes) return Status::success();

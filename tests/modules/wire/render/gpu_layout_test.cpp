@@ -86,6 +86,14 @@ TEST_F(GpuLayout, RingPassRecordsMatchTheirCppMirrors) {
     ASSERT_TRUE(commands.ok()) << commands.error().message;
     auto rings = gfx::make_program({.label = "layout: rings", .compute = ring_build_program_source()});
     ASSERT_TRUE(rings.ok()) << rings.error().message;
+    auto place = gfx::make_program({.label = "layout: ring place", .compute = ring_place_program_source()});
+    ASSERT_TRUE(place.ok()) << place.error().message;
+    // The Job, as the place program reads and writes it (ring ranges, flags, sides).
+    EXPECT_EQ(stride(*place, "jobs[0].ring_first"), static_cast<GLint>(sizeof(Job)));
+    EXPECT_FIELD(*place, "jobs[0].ring_first", Job, ring_first);
+    EXPECT_FIELD(*place, "jobs[0].ring_count", Job, ring_count);
+    EXPECT_FIELD(*place, "jobs[0].flags", Job, flags);
+    EXPECT_FIELD(*place, "jobs[0].sides", Job, sides);
     // The records both per-wire programs (LOD, rings) declare, on each.
     for (const gfx::Program* program : {&*lod, &*rings}) {
         const gfx::Program& p = *program;

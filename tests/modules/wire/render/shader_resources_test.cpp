@@ -30,7 +30,7 @@ Blocks storage_blocks(const std::string& source) {
     for (auto it = std::sregex_iterator(source.begin(), source.end(), define); it != std::sregex_iterator(); ++it)
         defines[(*it)[1]] = std::stoi((*it)[2]);
     Blocks out;
-    const std::regex block(R"(layout\(std430,\s*binding\s*=\s*(\w+)\)\s*(readonly\s+|writeonly\s+)?buffer\s)");
+    const std::regex block(R"(layout\(std430,\s*binding\s*=\s*(\w+)\)\s*((?:readonly|writeonly|coherent)\s+)?buffer\s)");
     for (auto it = std::sregex_iterator(source.begin(), source.end(), block); it != std::sregex_iterator(); ++it) {
         const std::string b = (*it)[1];
         if (std::isdigit(static_cast<unsigned char>(b[0]))) {
@@ -53,6 +53,7 @@ TEST(ShaderResources, StorageBlocksFitEveryDesktopDriver) {
     const std::vector<Program> programs = {
         {"curves", curve_program_source(), kCurveBindings, false},
         {"ring LOD", ring_lod_program_source(), 0, true},
+        {"ring place", ring_place_program_source(), 0, true},
         {"ring commands", ring_commands_program_source(), 0, true},
         {"rings", ring_build_program_source(), 0, true},
         {"cpu-mesh vertex", vertex_source(true, true), 0, false},
@@ -92,6 +93,7 @@ TEST(ShaderResources, DefaultUniformBlocksFitTheMinimumWithVec4Slots) {
                                               {"dvec3", 2}, {"double", 1}};
     for (const auto& [name, source] : {std::pair{"curves", curve_program_source()},
                                        std::pair{"ring LOD", ring_lod_program_source()},
+                                       std::pair{"ring place", ring_place_program_source()},
                                        std::pair{"ring commands", ring_commands_program_source()},
                                        std::pair{"rings", ring_build_program_source()}}) {
         const std::regex uniform(R"((?:^|\n)[ \t]*uniform\s+(\w+)\s+([^;]+);)");  // declarations, not comments

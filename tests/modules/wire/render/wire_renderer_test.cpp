@@ -486,7 +486,8 @@ EdgeComparison compare_off_edges(const platform::Image& a, const platform::Image
 
 // The nodes path's ring buffer is sized from the ring count read back 3 frames late: a frame whose rings outgrow it
 // (here the first, at a 0.0002 px tolerance) draws the wires that do not fit with one ring a segment from a reserve
-// sized for every visible wire, not without them, and the buffer has grown when the count comes back.
+// sized for every visible wire, not without them, and the buffer has grown when the count comes back. The coarse
+// wires are the last in wire order, the same ones in every short frame.
 TEST(WireRendererTest, GpuNodesRingOverflowDrawsCoarseNotMissing) {
     auto ctx = make_context();
     ASSERT_NE(ctx, nullptr);
@@ -507,12 +508,28 @@ TEST(WireRendererTest, GpuNodesRingOverflowDrawsCoarseNotMissing) {
         gpu.items.push_back(item);
     }
     std::vector<std::size_t> covered, coarse;
+    std::vector<std::vector<bool>> coarse_wires;  // per frame, per wire in list order: drawn from the reserve
     for (int frame = 0; frame < 8; ++frame) {
         DrawStats stats;
         const platform::Image image = render(*ctx, renderer, gpu, scene_camera(), settings, &stats);
         covered.push_back(covered_pixels(image, bg.data()));
         coarse.push_back(stats.wires_coarse);
         if (frame == 0) save(image, "wire_render_nodes_overflow_first.png");
+        std::vector<wire::render::DrawnRings> drawn;
+        ASSERT_TRUE(renderer.read_drawn_rings(drawn).ok());
+        ASSERT_EQ(drawn.size(), gpu.items.size());  // none missing
+        std::vector<bool>& flags = coarse_wires.emplace_back(gpu.items.size(), false);
+        for (const wire::render::DrawnRings& d : drawn) flags[d.wire_id - 700000] = d.coarse;
+    }
+    // The ring ranges are a prefix sum in wire order (the place program), so the wires that do not fit are the
+    // last ones (all wires are dispatched in list order here), and the same ones every frame until it grows.
+    for (int frame = 0; frame < 3; ++frame) {
+        const std::vector<bool>& flags = coarse_wires[frame];
+        const auto first_coarse = std::find(flags.begin(), flags.end(), true);
+        EXPECT_NE(first_coarse, flags.end()) << "frame " << frame << " drew no wire coarse";
+        EXPECT_TRUE(std::all_of(first_coarse, flags.end(), [](bool b) { return b; }))
+            << "frame " << frame << ": the coarse wires are not the last in order";
+        EXPECT_TRUE(flags == coarse_wires[0]) << "frame " << frame << " drew other wires coarse than frame 0";
     }
     std::printf("ring overflow: covered pixels per frame %zu %zu %zu %zu %zu %zu %zu %zu; wires drawn coarse (read "
                 "back 3 frames late) %zu %zu %zu %zu %zu %zu %zu %zu\n",
@@ -797,6 +814,127 @@ TEST(WireRendererTest, FramesAreDeterministic) {
         EXPECT_TRUE(a.rgba == b.rgba) << upload_path_name(path);
         EXPECT_TRUE(a.rgba == c.rgba) << upload_path_name(path);
     }
+}
+
+// The nodes path places rings and chunk records in wire order (the place program: one workgroup, prefix sums),
+// not in the order a GPU's atomics arrive in, so a frame's draw order is the same on every GPU and frame (blended
+// lines compose in one order; depth ties resolve one way). A random family (seed 4242) of 700 wires, 3
+// materials, 3-40 nodes, open and closed, 2-85 m away and some off screen, radii giving tubes of several side
+// counts, strips and lines: in every bucket (material, sides, chunk kind) the chunks come in list order (all
+// wires new: dispatched in list order), each wire's along it; every bucket is one run; each drawn wire's chunks
+// tile its bands; the next frame (the same list, kept on the GPU) draws in the same order.
+TEST(WireRendererTest, GpuNodesDrawInWireOrder) {
+    auto ctx = make_context();
+    ASSERT_NE(ctx, nullptr);
+    WireRenderer renderer = make_renderer();
+    const uint32_t red = renderer.add_material({.tint = {1.0f, 0.3f, 0.2f}});
+    const uint32_t blue = renderer.add_material({.tint = {0.2f, 0.4f, 1.0f}});
+    const uint32_t materials[3] = {0, red, blue};
+    std::mt19937 rng(4242);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    Scene scene;
+    for (int i = 0; i < 700; ++i) {
+        const double depth = 2.0 + 83.0 * unit(rng) * unit(rng);
+        const double half_w = 0.45 * depth * (unit(rng) < 0.1 ? 2.5 : 1.0);  // about 1 in 10 off screen
+        const glm::dvec3 centre(0.3 + half_w * (2.0 * unit(rng) - 1.0), 0.8 + 0.3 * depth * (2.0 * unit(rng) - 1.0),
+                                4.8 - depth);
+        const double length = 0.3 + 0.05 * depth * unit(rng);
+        const float radius = static_cast<float>(0.0008 * std::pow(100.0, unit(rng)));
+        const int count = 3 + static_cast<int>(38.0 * unit(rng));
+        const uint32_t material = materials[static_cast<int>(3.0 * unit(rng)) % 3];
+        if (unit(rng) < 0.15) {
+            wire::WireNodes loop;
+            for (int k = 0; k < count; ++k) {
+                const double a = 2.0 * std::numbers::pi * k / count;
+                loop.positions.push_back(centre + 0.5 * length * glm::dvec3(std::cos(a), 0.4 * std::sin(a), std::sin(a)));
+            }
+            scene.add(loop, wire_settings(radius, 32, true), material);
+        } else {
+            const glm::dvec3 dir(std::cos(6.0 * unit(rng)), 0.2 * (unit(rng) - 0.5), std::sin(6.0 * unit(rng)));
+            const glm::dvec3 half = 0.5 * length * glm::normalize(dir);
+            scene.add(hanging_cable(centre - half, centre + half, 0.2 * length * unit(rng), count),
+                      wire_settings(radius, 32), material);
+        }
+    }
+    const DrawList list = scene.node_list();
+    std::vector<std::vector<wire::render::DrawnChunk>> orders;
+    std::vector<wire::render::DrawnRings> drawn;
+    for (int frame = 0; frame < 2; ++frame) {
+        render(*ctx, renderer, list, scene_camera());
+        std::vector<wire::render::DrawnChunk> order;
+        const engine::Status st = renderer.read_draw_order(order);
+        ASSERT_TRUE(st.ok()) << st.message;
+        orders.push_back(std::move(order));
+        if (frame == 0) {
+            ASSERT_TRUE(renderer.read_drawn_rings(drawn).ok());
+        }
+    }
+    const std::vector<wire::render::DrawnChunk>& order = orders[0];
+    ASSERT_FALSE(order.empty());
+    // Runs: one per bucket, its chunks in (list index, first band) order.
+    std::set<std::array<uint32_t, 3>> buckets_seen, sides_seen, materials_seen;
+    std::array<uint32_t, 3> key{~0u, ~0u, ~0u};
+    std::size_t runs = 0, out_of_order = 0;
+    uint64_t last_wire = 0;
+    uint32_t last_band = 0;
+    for (const wire::render::DrawnChunk& c : order) {
+        const std::array<uint32_t, 3> k{c.material, c.sides, c.kind};
+        const uint64_t index = c.wire_id - scene.id_base;
+        if (k != key) {
+            EXPECT_TRUE(buckets_seen.insert(k).second) << "bucket (material " << c.material << ", sides " << c.sides
+                                                       << ", kind " << c.kind << ") drawn in two runs";
+            key = k;
+            ++runs;
+        } else if (index < last_wire || (index == last_wire && c.first_band <= last_band)) {
+            ++out_of_order;
+        }
+        last_wire = index, last_band = c.first_band;
+        sides_seen.insert({std::min(c.sides, 3u), 0, 0});
+        materials_seen.insert({c.material, 0, 0});
+    }
+    EXPECT_EQ(out_of_order, 0u) << "chunks out of wire order in their bucket";
+    // Each drawn wire's chunks tile its bands, once.
+    std::vector<std::vector<std::pair<uint32_t, uint32_t>>> bands(scene.nodes.size());  // (first band, bands)
+    std::vector<uint32_t> caps(scene.nodes.size(), 0);
+    for (const wire::render::DrawnChunk& c : order) {
+        if (c.kind == 0) ++caps[c.wire_id - scene.id_base];
+        else bands[c.wire_id - scene.id_base].push_back({c.first_band, wire::render::chunk_kind_bands(c.kind)});
+    }
+    std::set<std::size_t> drawn_wires;
+    std::size_t tubes = 0;
+    for (const wire::render::DrawnRings& d : drawn) {
+        const std::size_t i = d.wire_id - scene.id_base;
+        drawn_wires.insert(i);
+        const auto rings = static_cast<uint32_t>(d.rings.rings.size());
+        const uint32_t want = rings - 1 + (d.rings.closed ? 1 : 0);
+        std::sort(bands[i].begin(), bands[i].end());
+        uint32_t next = 0;
+        for (const auto& [first, n] : bands[i]) {
+            EXPECT_EQ(first, next) << "wire " << i;
+            next = first + n;
+        }
+        EXPECT_EQ(next, want) << "wire " << i << ": chunks cover " << next << " of its " << want << " bands";
+        EXPECT_EQ(caps[i], d.sides > 2 && !d.rings.closed ? 1u : 0u) << "wire " << i;
+        tubes += d.sides > 2 ? 1 : 0;
+    }
+    for (std::size_t i = 0; i < bands.size(); ++i) {
+        if (drawn_wires.count(i) == 0) {
+            EXPECT_TRUE(bands[i].empty() && caps[i] == 0) << "wire " << i << " is not drawn but has chunks";
+        }
+    }
+    EXPECT_TRUE(orders[1] == orders[0]) << "the second frame drew in another order";
+    std::printf("draw order: %zu of %zu wires drawn (%zu tubes), %zu chunks in %zu buckets, %zu materials, "
+                "%zu chunks out of wire order\n",
+                drawn.size(), scene.nodes.size(), tubes, order.size(), runs, materials_seen.size(), out_of_order);
+    // The family covers what it claims: more wires than one batch of the place program (256), lines, strips
+    // and tubes, several tube side counts, every material.
+    EXPECT_GT(drawn.size(), 256u);
+    EXPECT_EQ(sides_seen.size(), 3u);
+    EXPECT_EQ(materials_seen.size(), 3u);
+    std::set<uint32_t> tube_sides;
+    for (const wire::render::DrawnChunk& c : order)
+        if (c.sides > 2) tube_sides.insert(c.sides);
+    EXPECT_GE(tube_sides.size(), 3u);
 }
 
 // Starts with a region of 512 bytes and draws more wires every frame: the buffer grows, old buffers live

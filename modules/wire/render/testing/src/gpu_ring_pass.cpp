@@ -21,11 +21,15 @@ engine::Expected<GpuRingPass> GpuRingPass::create() {
     engine::Expected<engine::gfx::Program> lod =
         engine::gfx::make_program({.label = "wire gpu ring LOD", .compute = detail::ring_lod_program_source()});
     if (!lod) return lod.error();
+    engine::Expected<engine::gfx::Program> place =
+        engine::gfx::make_program({.label = "wire gpu ring place", .compute = detail::ring_place_program_source()});
+    if (!place) return place.error();
     engine::Expected<engine::gfx::Program> rings =
         engine::gfx::make_program({.label = "wire gpu rings", .compute = detail::ring_build_program_source()});
     if (!rings) return rings.error();
     GpuRingPass pass;
     pass.lod_program_ = std::move(*lod);
+    pass.place_program_ = std::move(*place);
     pass.ring_program_ = std::move(*rings);
     return pass;
 }
@@ -141,12 +145,20 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     // one.
     glUniform1ui(at("u_unchanged"), carry_last ? 0u : static_cast<GLuint>(jobs.size()));
     glUniform1i(at("u_draw"), 0);
-    glUniform1ui(at("u_ring_capacity"),
-                 static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, 0xffffffffu)));
-    glUniform1ui(at("u_ring_reserve"), 0u);  // a wire that does not fit is reported (GpuRingResult::overflow)
     glUniform1i(at("u_lod"), lod != nullptr ? 1 : 0);
     if (lod != nullptr) detail::set_lod_uniforms(lod_program_, lod->view, lod->settings);
     glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    // The place program's ring ranges, in wire order.
+    place_program_.use();
+    const auto place_at = [&](const char* name) { return place_program_.uniform_location(name); };
+    glUniform1ui(place_at("u_stage"), 0u);
+    glUniform1i(place_at("u_draw"), 0);
+    glUniform1ui(place_at("u_wires"), static_cast<GLuint>(jobs.size()));
+    glUniform1ui(place_at("u_ring_capacity"),
+                 static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, detail::kMaxRingRecords)));
+    glUniform1ui(place_at("u_ring_reserve"), 0u);  // a wire that does not fit is reported (GpuRingResult::overflow)
+    glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     // The rings program: the rings in the ranges the jobs hold.
     ring_program_.use();

@@ -178,6 +178,17 @@ struct DrawnRings {
     RingSet rings;
 };
 
+/// One instance of a draw() on the nodes path, read back from the GPU (WireRenderer::read_draw_order): a chunk of
+/// a wire's bands (upload_plan.hpp's chunk kinds), as the multi-draws meet it.
+struct DrawnChunk {
+    uint64_t wire_id = 0;      ///< DrawItem::wire_id
+    uint32_t material = 0;     ///< DrawItem::material
+    uint32_t sides = 0;        ///< sides drawn: >= 3 a tube, 2 a camera-facing strip, 1 a line
+    uint32_t kind = 0;         ///< 0 the caps, k >= 1 kChunkBands >> (k - 1) bands
+    uint32_t first_band = 0;   ///< the chunk's first band along the wire (0 for the caps)
+    bool operator==(const DrawnChunk&) const = default;
+};
+
 /// What a renderer holds (WireRenderer::info()).
 struct RendererInfo {
     /// The ring vertex shader (nodes path): the chunk index comes from gl_BaseInstanceARB + gl_InstanceID
@@ -237,6 +248,11 @@ public:
     /// path (cpu-mesh builds its rings on the CPU: wire::systems::wire_ring_set has them) or drew
     /// nothing because the nodes path failed.
     Status read_drawn_rings(std::vector<DrawnRings>& out) const;
+    /// gpu-nodes: the chunks the last draw() drew, in the order the GPU draws them (per material the tubes' and
+    /// strips' multi-draws, then the lines'; in each bucket, the wires in the order they were dispatched, each
+    /// wire's chunks along it). The same list and view give the same order on every GPU (the place program
+    /// allocates in wire order, not by atomics). Fails as read_drawn_rings() does.
+    Status read_draw_order(std::vector<DrawnChunk>& out) const;
     /// The bulk node stream (node_stream.hpp): wires whose nodes a physics engine writes straight into this
     /// renderer's mapped memory, drawn by draw() on the nodes path beside the list's wires. Made (with the nodes
     /// path) on the first call; NodeStream::usable() says why not where the context lacks compute.

@@ -87,11 +87,11 @@ struct GpuRingResult {
 /// current).
 class GpuRingPass {
 public:
-    /// Compiles the LOD and rings programs. Fails (with the driver's log) without GL 4.3 compute.
+    /// Compiles the LOD, place and rings programs. Fails (with the driver's log) without GL 4.3 compute.
     static engine::Expected<GpuRingPass> create();
 
-    /// Every wire's rings from `curves`' last build (a dispatch of the LOD program, then one of the rings
-    /// program). jobs.size() must equal the number of wires of that build and each job's counts its wire's segment
+    /// Every wire's rings from `curves`' last build (a dispatch of the LOD program, then the place program's ring
+    /// ranges, then the rings program). jobs.size() must equal the number of wires of that build and each job's counts its wire's segment
     /// count; otherwise the call fails naming the wire.
     /// With `lod`, the counts come from the LOD on the GPU (see the file comment).
     [[nodiscard]] Status build(const GpuCurvePass& curves, std::span<const GpuRingJob> jobs,
@@ -102,7 +102,7 @@ public:
 
 
 private:
-    engine::gfx::Program lod_program_, ring_program_;
+    engine::gfx::Program lod_program_, place_program_, ring_program_;
     engine::gfx::Buffer jobs_, counts_, rings_, state_, counter_, visible_;
     std::vector<uint32_t> count_first_, segments_;  // per wire of the last build: its counts' range
     std::size_t ring_capacity_ = 0, count_total_ = 0, state_wires_ = 0;
