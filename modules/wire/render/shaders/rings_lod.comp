@@ -49,15 +49,20 @@ uint outside(vec3 q, float rx, float ry, float r) {
 // The hierarchy is built bottom-up as the walk over the segments visits them, as a binary counter: a node of level l
 // covers 2^l segments, and a level's odd last node stands alone for its parent (the same sphere and deviation:
 // the same decision), so what is left on the stack at the end merges from the top. Each node is decided when it is
-// complete; one that takes a span writes 1, 0, ..., 0 over its segments, over what its descendants wrote. A segment's
-// highest such ancestor writes last: the CPU's top-down walk, which stops at it.
+// complete; one that takes a span gives its segments 1, 0, ..., 0, over what its descendants gave them (a mark, then
+// sweep_spans()). A segment's count is its highest such ancestor's: the CPU's top-down walk, which stops at it.
 struct Span {
     vec3 c; float r;         // the sphere around its control points (not inflated by the tube radius)
     vec3 a; float dev;       // its chord's first point; every curve point of the span is within dev of the chord
     vec3 b; uint s;          // its chord's last point; its first segment
     uint e, sum, bits, level;  // one past its last segment; its counts' sum now; kOld*, kRestZero, kPattern
 };
-const uint kOldOne = 1u, kOldZero = 2u, kRestZero = 4u, kPattern = 8u;  // old first count 1 / 0, old rest 0; 1,0..0 now
+// Old first count 1 / 0, old rest 0; 1,0..0 now. A span taken above level 0 is written as one mark at its first
+// segment (kSpanMark | its length), and sweep_spans() turns the marks into counts in one pass: every loop of the
+// wire is O(segments), never O(segments log segments), which matters for the serial work of an invocation (and on
+// llvmpipe, which ends an invocation's loops after 65,535 iterations in all).
+const uint kOldOne = 1u, kOldZero = 2u, kRestZero = 4u, kPattern = 8u;
+const uint kSpanMark = 0x80000000u;
 bool INSIDE;        // the wire's sphere (its control points' box, inflated) lies inside the frustum
 float SPAN_K;       // the off-axis factor bounded over that sphere (capped at the screen edge), when INSIDE
 vec3 OFFSET;        // the wire's origin - eye
@@ -127,7 +132,20 @@ Span leaf_span(Seg c, uint k, uint count, uint old_count) {
     if (nd.sum == 1u) nd.bits |= kPattern;
     return nd;
 }
-void write_zeros(uint s, uint e) { for (uint i = s; i < e; ++i) counts[H.segment_first + i] = 0u; }
+// The marks into counts: a span's first segment 1, the rest 0, unless a span before it covers it (then 0).
+void sweep_spans() {
+    uint zero_until = 0u;
+    for (uint k = 0u; k < SEGS; ++k) {
+        uint c = counts[H.segment_first + k];
+        bool covered = k < zero_until;
+        if ((c & kSpanMark) != 0u) {
+            counts[H.segment_first + k] = covered ? 0u : 1u;
+            zero_until = max(zero_until, k + (c & ~kSpanMark));
+        } else if (covered && c != 0u) {
+            counts[H.segment_first + k] = 0u;
+        }
+    }
+}
 // A node from its two children (merge_spheres; deviation max(d_left, d_right) + dist(M, A-B)), decided.
 Span merge_span(Span l, Span rt) {
     Span nd;
@@ -156,17 +174,26 @@ Span merge_span(Span l, Span rt) {
     bool rest_zero = (l.bits & kRestZero) != 0u && (rt.bits & (kOldZero | kRestZero)) == (kOldZero | kRestZero);
     nd.bits = (l.bits & (kOldOne | kOldZero)) | (rest_zero ? kRestZero : 0u);
     if (takes_span(nd)) {
-        if ((l.bits & kPattern) == 0u) {
-            counts[H.segment_first + l.s] = 1u;
-            write_zeros(l.s + 1u, l.e);
-        }
-        if ((rt.bits & kPattern) == 0u) write_zeros(rt.s, rt.e);
-        else counts[H.segment_first + rt.s] = 0u;
+        counts[H.segment_first + nd.s] = kSpanMark | (nd.e - nd.s);  // sweep_spans() writes the span
         TOTAL = TOTAL - nd.sum + 1u;
         nd.sum = 1u;
         nd.bits |= kPattern;
     }
     return nd;
+}
+
+// One control point of a segment in view: the planes it is outside of, its depth, its off-axis slopes.
+void corner(vec3 pt, float rx, float ry, float radius, inout uint seg_out, inout float z_min, inout float a,
+            inout float b, inout bool in_front) {
+    vec3 q = to_view(pt);
+    seg_out &= outside(q, rx, ry, radius);
+    z_min = min(z_min, q.z);
+    if (q.z >= u_near) {
+        a = max(a, abs(q.x) / q.z);
+        b = max(b, abs(q.y) / q.z);
+    } else {
+        in_front = false;
+    }
 }
 
 // Writes the wire's counts (over the previous ones unless restart) and state; returns its ring total, 0 when
@@ -215,17 +242,11 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
         uint seg_out = 63u;
         float z_min = 1.0 / 0.0, a = 0.0, b = 0.0;
         bool in_front = true;
-        for (int i = 0; i < 4; ++i) {
-            vec3 q = to_view(p[i]);
-            seg_out &= outside(q, rx, ry, radius);
-            z_min = min(z_min, q.z);
-            if (q.z >= u_near) {
-                a = max(a, abs(q.x) / q.z);
-                b = max(b, abs(q.y) / q.z);
-            } else {
-                in_front = false;
-            }
-        }
+        // Written out, not a loop: a compiler that keeps a loop pays for it per segment (llvmpipe's budget).
+        corner(p[0], rx, ry, radius, seg_out, z_min, a, b, in_front);
+        corner(p[1], rx, ry, radius, seg_out, z_min, a, b, in_front);
+        corner(p[2], rx, ry, radius, seg_out, z_min, a, b, in_front);
+        corner(p[3], rx, ry, radius, seg_out, z_min, a, b, in_front);
         if (!in_front) { a = u_tan_x; b = u_tan_y; }
         a = min(a, u_tan_x);
         b = min(b, u_tan_y);
@@ -262,6 +283,7 @@ uint lod(uint slot, vec3 offset, out float radius_px) {
         stack[top - 2] = merge_span(stack[top - 2], stack[top - 1]);
         --top;
     }
+    if (merge) sweep_spans();
     radius_px = 0.0;
     if (wire_outside != 0u) {
         slot_state[slot].lod = uvec4(0u);  // culled: the next frame starts afresh (cull_lod)

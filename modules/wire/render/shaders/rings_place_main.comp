@@ -3,8 +3,9 @@
 // the draw meets the chunks in (instance order) are the same on every GPU and every frame, whatever order the
 // GPU runs invocations in (atomics would hand them out in arrival order).
 // u_stage 0, after the LOD program: each wire's range of the ring buffer (a prefix sum of the rings the jobs want);
-// one past u_ring_capacity, a wire gets one ring a segment from the reserve (u_ring_reserve rings after the
-// capacity: the wires past the capacity, which are the last in order), or none (not drawn) past that; the totals
+// one past u_ring_capacity, or wanting more than u_max_wire_rings, a wire gets one ring a segment from the reserve
+// (u_ring_reserve rings after the capacity; the wires past the capacity are the last in order), or none (not
+// drawn) past that; the totals
 // in Counter; with u_draw, each bucket's chunk count and the triangles the draw expands (sums: the same in any
 // order). u_stage 1, after the commands program: with u_draw, the chunk records, each bucket's in wire order from
 // its cursor.
@@ -15,6 +16,7 @@ layout(std430, binding = RING_CHUNKS) writeonly buffer Chunks { uvec2 chunks[]; 
 uniform uint u_stage;
 uniform uint u_ring_capacity;
 uniform uint u_ring_reserve;
+uniform uint u_max_wire_rings;
 
 const uint kNone = 0xffffffffu;  // no group: a lane without a wire, or a wire not drawn
 shared uint s_group[kLanes], s_big[kLanes], s_bits[kLanes];  // stage 1: each lane's bucket group and chunk counts
@@ -29,10 +31,13 @@ void place_rings() {
             load_wire(visible[w]);
             fewest = SEGS + (CLOSED ? 0u : 1u);
         }
+        // More rings than one wire may have (kNodesPathMaxRings): from the reserve, taking none of the buffer.
+        bool too_many = n > u_max_wire_rings;
+        uint want = too_many ? 0u : n;
         uint total;
-        uint first = sat_add(wanted, lane_scan(n, total));
+        uint first = sat_add(wanted, lane_scan(want, total));
         wanted = sat_add(wanted, total);
-        bool over = n != 0u && sat_add(first, n) > u_ring_capacity;  // u_ring_capacity < kSat
+        bool over = n != 0u && (too_many || sat_add(first, want) > u_ring_capacity);  // u_ring_capacity < kSat
         uint reserve_first = sat_add(given, lane_scan(over ? fewest : 0u, total));
         given = sat_add(given, total);
         if (over) atomicAdd(overflow, 1u);  // a count: the same in any order

@@ -260,6 +260,7 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
         glUniform1ui(at("u_ring_capacity"),
                      static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, kMaxRingRecords)));
         glUniform1ui(at("u_ring_reserve"), static_cast<GLuint>(std::min<std::size_t>(reserve, kMaxRingRecords)));
+        glUniform1ui(at("u_max_wire_rings"), static_cast<GLuint>(kNodesPathMaxRings));
         glUniform1ui(at("u_buckets"), static_cast<GLuint>(buckets));
         glUniform1ui(at("u_side_slots"), side_slots_);
         glDispatchCompute(1, 1, 1);

@@ -150,6 +150,12 @@ bool second_look(StreamState& s, uint32_t index, std::size_t n, Position positio
     return true;
 }
 
+bool refuse_length(StreamState& s, uint32_t index, std::size_t count) {
+    s.refuse(index, -1, std::to_string(count) + " nodes; the nodes path draws at most " +
+                            std::to_string(kNodesPathMaxNodes) + " a wire");
+    return false;
+}
+
 bool refuse_room(StreamState& s, uint32_t index, std::size_t count) {
     s.refuse(index, -1, s.active ? "no room for its " + std::to_string(count) + " nodes (begin() reserved " +
                                       std::to_string(s.node_capacity) + " for the frame)"
@@ -183,6 +189,7 @@ bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t
                   const float* radius, std::size_t radius_stride, std::optional<std::size_t> first) {
     StreamState::Wire& w = s.wires[index];
     const StreamStyle& style = s.styles[index];
+    if (n > kNodesPathMaxNodes) return refuse_length(s, index, n);
     if (!first) return refuse_room(s, index, n);
     auto* dst = reinterpret_cast<glm::vec4*>(s.region.data + s.node_at) + *first;
     const auto at = [&](std::size_t j) {  // the caller's doubles need not be 8-byte aligned (any stride)
@@ -230,6 +237,7 @@ bool write_double(StreamState& s, uint32_t index, const double* xyz, std::size_t
 bool write_float(StreamState& s, uint32_t index, const glm::dvec3& given_origin, const float* xyz, std::size_t n,
                  std::size_t stride, const float* radius, std::size_t radius_stride, std::optional<std::size_t> first) {
     const StreamStyle& style = s.styles[index];
+    if (n > kNodesPathMaxNodes) return refuse_length(s, index, n);
     if (!first) return refuse_room(s, index, n);
     auto* dst = reinterpret_cast<glm::vec4*>(s.region.data + s.node_at) + *first;
     const auto offset_at = [&](std::size_t j) {

@@ -591,6 +591,156 @@ TEST_F(DrawnRingsTest, NodesPathSkipsBadItemsAndDrawsTheRest) {
     EXPECT_GT(out[0].rings.params.size(), 2u);
 }
 
+// Long wires (wire_renderer.hpp's kNodesPathMaxNodes): one invocation walks a whole wire, and llvmpipe ends an
+// invocation's loops after 65,535 iterations in all, which once cut the LOD of a 7,400-node coil seen whole (its
+// span marks written over and over) and drew nothing of a 40,000-node one, silently. A random family (seed 8101)
+// of 12 wires of 2,000 to 8,192 nodes (two at the limit): coils, random walks and sagging spans, every spline
+// kind, one closed loop, each seen whole (most spans below the node resolution) and up close (many rings): every
+// wire is drawn to its end, within the tolerance on screen; up close at a tolerance asking more rings than a wire
+// may have (kNodesPathMaxRings) it is drawn whole with one ring a segment; one node past the limit, a wire is
+// refused by name and the rest is drawn.
+TEST_F(DrawnRingsTest, LongWiresAreDrawnWholeUpToTheNodeLimit) {
+    std::mt19937 rng(8101);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const wire::SplineKind kinds[4] = {wire::SplineKind::catmull_rom, wire::SplineKind::c2,
+                                       wire::SplineKind::automatic, wire::SplineKind::linear};
+    std::vector<double> ratios;
+    double worst = 0.0;
+    std::string worst_name;
+    std::size_t coarse = 0, spanned = 0, segments_total = 0;
+    for (int i = 0; i < 12; ++i) {
+        const int n = i < 2 ? static_cast<int>(wire::render::kNodesPathMaxNodes)
+                            : static_cast<int>(2000.0 * std::pow(4.096, unit(rng)));
+        const int shape = i % 3;
+        const bool closed = i == 4;
+        wire::WireNodes nodes;
+        glm::dvec3 p(0.0), dir(1.0, 0.0, 0.0);
+        const double turns = 50.0 + 350.0 * unit(rng), length = 10.0 + 40.0 * unit(rng);
+        for (int k = 0; k < n; ++k) {
+            const double t = static_cast<double>(k) / (closed ? n : n - 1);
+            if (closed) {
+                const double a = 2.0 * std::numbers::pi * t;
+                nodes.positions.push_back({(5.0 + 0.4 * std::cos(turns * a)) * std::cos(a),
+                                           0.4 * std::sin(turns * a), (5.0 + 0.4 * std::cos(turns * a)) * std::sin(a)});
+            } else if (shape == 0) {  // a coil
+                const double a = 2.0 * std::numbers::pi * turns * t;
+                nodes.positions.push_back({0.5 * std::cos(a), length * (t - 0.5), 0.5 * std::sin(a)});
+            } else if (shape == 1) {  // a random walk, turning a little each step
+                dir = glm::normalize(dir + 0.3 * glm::dvec3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5));
+                p += (length / n) * dir;
+                nodes.positions.push_back(p);
+            } else {  // a sagging span
+                nodes.positions.push_back({length * (t - 0.5), -0.2 * length * 4.0 * t * (1.0 - t), 0.0});
+            }
+        }
+        wire::SplineSettings spline;
+        spline.kind = kinds[i % 4];
+        spline.closed = closed;
+        spline.radius_m = 0.02f;
+        const std::string name = "wire " + std::to_string(i) + " (" + std::to_string(n) + " nodes, shape " +
+                                 std::to_string(shape) + ", kind " + std::to_string(i % 4) + (closed ? ", closed" : "") +
+                                 ")";
+        wire::Curve curve;
+        ASSERT_TRUE(wire::build_curve(nodes, spline, curve).ok()) << name;
+        glm::dvec3 lo(1e300), hi(-1e300);
+        for (const glm::dvec3& q : nodes.positions) lo = glm::min(lo, q), hi = glm::max(hi, q);
+        const glm::dvec3 centre = 0.5 * (lo + hi);
+        const double extent = glm::length(hi - lo);
+        const double fov = glm::radians(50.0);
+        const glm::dvec3 side = glm::normalize(glm::dvec3(0.3, 0.4, 1.0));
+        DrawItem item;
+        item.wire_id = 8100 + static_cast<uint64_t>(i);
+        item.nodes = &nodes;
+        item.spline = spline;
+        item.nodes_generation = 1;
+        item.sides = 16;
+        // Whole in view, then up close; at the default tolerance, then (up close) at one asking too many rings.
+        for (int view_kind = 0; view_kind < 3; ++view_kind) {
+            const double distance = (view_kind == 1 ? 0.05 : 0.75) * extent / std::tan(0.5 * fov);
+            const engine::scene::Camera camera{.position = centre + distance * side,
+                                               .target = centre,
+                                               .up = {0.0, 1.0, 0.0},
+                                               .fov_y_rad = static_cast<float>(fov),
+                                               .aspect = static_cast<float>(kWidth) / kHeight,
+                                               .near_m = 0.01f,
+                                               .far_m = static_cast<float>(4.0 * distance + extent)};
+            DrawList list{.path = UploadPath::gpu_nodes, .items = {item}};
+            list.lod.tolerance_px = view_kind == 2 ? 0.0005 : 0.5;
+            list.lod.max_rings_per_segment = view_kind == 2 ? 1024 : 0;
+            const wire::render::DrawStats stats = draw(list, camera, DrawSettings{});
+            ASSERT_TRUE(stats.status.ok()) << name << ": " << stats.status.message;
+            std::vector<DrawnRings> drawn;
+            ASSERT_TRUE(renderer_.read_drawn_rings(drawn).ok());
+            ASSERT_EQ(drawn.size(), 1u) << name << ", view " << view_kind;
+            const wire::RingSet& r = drawn[0].rings;
+            const std::size_t segs = curve.segments.size();
+            ASSERT_FALSE(r.params.empty()) << name;
+            // To its end: an open wire's last ring at the end of its last segment (a loop's closing is held to
+            // the screen error below).
+            if (!closed) {
+                EXPECT_EQ(r.params.back().segment, segs - 1) << name << ", view " << view_kind;
+                EXPECT_EQ(r.params.back().t, 1.0) << name << ", view " << view_kind;
+            }
+            const wire::LodView view = wire::LodView::perspective(camera.position, camera.target, camera.up,
+                                                                  camera.fov_y_rad, kWidth, kHeight, camera.near_m,
+                                                                  camera.far_m);
+            if (view_kind == 2) {
+                // More than kNodesPathMaxRings asked (the CPU's LOD says how many, away from the limit): one ring a
+                // segment from the reserve, not missing.
+                wire::WireLod lod;
+                wire::update_lod(curve, view, list.lod, lod, static_cast<const wire::BoundingSphere*>(nullptr));
+                std::vector<wire::RingParam> wanted;
+                wire::place_rings(curve, lod.counts, wanted);
+                const double ratio = static_cast<double>(wanted.size()) / wire::render::kNodesPathMaxRings;
+                if (ratio > 1.01) {
+                    EXPECT_TRUE(drawn[0].coarse) << name << ": " << wanted.size() << " rings asked";
+                    EXPECT_EQ(r.params.size(), segs + (closed ? 0 : 1)) << name;
+                    coarse += drawn[0].coarse ? 1 : 0;
+                } else if (ratio < 0.99) {
+                    EXPECT_FALSE(drawn[0].coarse) << name << ": " << wanted.size() << " rings asked";
+                }
+                continue;
+            }
+            EXPECT_FALSE(drawn[0].coarse) << name << ", view " << view_kind;
+            const wire::ScreenError e = wire::measure_screen_error(curve, r.params, view, 8);
+            ratios.push_back(e.max_px / 0.5);
+            if (e.max_px / 0.5 > worst) worst = e.max_px / 0.5, worst_name = name + ", view " + std::to_string(view_kind);
+            EXPECT_LE(e.max_px, 0.5 * (1.0 + 1e-3)) << name << ", view " << view_kind;
+            if (view_kind == 0) spanned += segs + (closed ? 0 : 1) - r.params.size(), segments_total += segs;
+        }
+    }
+    std::printf("long wires: screen error / tolerance median %.3g p90 %.3g max %.3g (%s); seen whole, %zu of %zu "
+                "segments merged into spans; %zu drawn coarse past the ring limit\n",
+                quantile(ratios, 0.5), quantile(ratios, 0.9), worst, worst_name.c_str(), spanned, segments_total,
+                coarse);
+    EXPECT_GT(spanned, segments_total / 2) << "seen whole, most segments should be merged (the case that was cut)";
+    EXPECT_GE(coarse, 3u) << "too few wires asked for more rings than the limit: the ring cap is not shown";
+
+    // One node past the limit: refused by name, the other wire drawn.
+    const FamilyWire small = family_wire(3);
+    wire::WireNodes over;
+    for (std::size_t k = 0; k <= wire::render::kNodesPathMaxNodes; ++k)
+        over.positions.push_back({0.001 * static_cast<double>(k), 0.0, 0.0});
+    DrawItem a;
+    a.wire_id = 8200;
+    a.nodes = &small.nodes;
+    a.spline = small.spline;
+    a.nodes_generation = 1;
+    DrawItem b = a;
+    b.wire_id = 8201;
+    b.nodes = &over;
+    const wire::render::DrawStats stats =
+        draw(DrawList{.path = UploadPath::gpu_nodes, .items = {a, b}}, small.camera, DrawSettings{});
+    EXPECT_EQ(stats.wires_skipped, 1u);
+    EXPECT_NE(stats.status.message.find("wire 8201: 8193 nodes; the nodes path draws at most 8192 a wire"),
+              std::string::npos)
+        << stats.status.message;
+    std::vector<DrawnRings> drawn;
+    ASSERT_TRUE(renderer_.read_drawn_rings(drawn).ok());
+    ASSERT_EQ(drawn.size(), 1u);
+    EXPECT_EQ(drawn[0].wire_id, 8200u);
+}
+
 // New GL buffers are not zeroed on hardware drivers (pools hand out stale memory; llvmpipe gives zeros). With every
 // buffer made without data filled with 0xff (WIRE_GFX_POISON_BUFFERS=1), the nodes path draws the same pictures and
 // rings as without: three empty frames (nothing copied into the ring-count read-back yet), then 8 frames of wires

@@ -158,6 +158,7 @@ Status GpuRingPass::build(const GpuCurvePass& curves, std::span<const GpuRingJob
     glUniform1ui(place_at("u_ring_capacity"),
                  static_cast<GLuint>(std::min<std::size_t>(ring_capacity_, detail::kMaxRingRecords)));
     glUniform1ui(place_at("u_ring_reserve"), 0u);  // a wire that does not fit is reported (GpuRingResult::overflow)
+    glUniform1ui(place_at("u_max_wire_rings"), 0xffffffffu);  // the caller's counts, whatever they total
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     // The rings program: the rings in the ranges the jobs hold.

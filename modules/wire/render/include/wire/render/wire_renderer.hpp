@@ -178,6 +178,15 @@ struct DrawnRings {
     RingSet rings;
 };
 
+/// The most nodes a wire may have on the nodes path (its curve nodes, or its given segments + 1): one GPU invocation
+/// walks a whole wire, so its serial work is bounded by this, and llvmpipe ends an invocation's loops after 65,535
+/// iterations in all (a longer wire would be cut, not slow). A longer item is skipped and reported
+/// (DrawStats::status names it); draw it on cpu-mesh, or split it.
+inline constexpr std::size_t kNodesPathMaxNodes = 8192;
+/// The most rings the nodes path gives one wire: a wire whose LOD asks for more is drawn with one ring a segment
+/// from the reserve (counted in DrawStats::wires_coarse), for the same reason.
+inline constexpr std::size_t kNodesPathMaxRings = 32768;
+
 /// One instance of a draw() on the nodes path, read back from the GPU (WireRenderer::read_draw_order): a chunk of
 /// a wire's bands (upload_plan.hpp's chunk kinds), as the multi-draws meet it.
 struct DrawnChunk {
