@@ -139,7 +139,13 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
     State& s = *state_;
     s.last_path = list.path;
     s.drawn_any = true;
-    if (list.path == UploadPath::gpu_nodes) return s.draw_nodes(list, camera, settings);
+    s.long_drawn.clear();
+    if (list.path == UploadPath::gpu_nodes) {
+        const bool any_long = std::any_of(list.items.begin(), list.items.end(), [](const DrawItem& item) {
+            return detail::node_count(item) > kNodesPathMaxNodes;
+        });
+        return any_long ? s.draw_with_long_wires(list, camera, settings) : s.draw_nodes(list, camera, settings);
+    }
     DrawStats stats;
     if (s.node_stream && detail::stream_active(*s.node_stream)) {
         // The stream's wires are computed by the nodes path only: said, not dropped in silence; the list
@@ -149,6 +155,12 @@ DrawStats WireRenderer::draw(const DrawList& list, const engine::scene::Camera& 
                  Status::error("the node stream's wires draw on the nodes path; this draw list is on '" +
                                std::string(upload_path_name(list.path)) + "': they were not drawn"));
     }
+    return s.draw_mesh(list, camera, settings, stats);
+}
+
+DrawStats WireRenderer::State::draw_mesh(const DrawList& list, const engine::scene::Camera& camera,
+                                         const DrawSettings& settings, DrawStats stats) {
+    State& s = *this;
     // cpu-mesh. (1) Items with geometry: opaque items (tubes, strips) first, then the blended phone-wire lines
     // (sides 1), each by material (stable: equal materials keep the list's order).
     s.order.clear();

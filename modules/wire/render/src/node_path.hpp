@@ -9,8 +9,10 @@
 // the GPU wrote.
 #pragma once
 
+#include "wire/curve.hpp"
 #include "wire/draw.hpp"
 #include "wire/lod.hpp"
+#include "wire/packed_nodes.hpp"
 #include "wire/packed_ring.hpp"
 #include "wire/render/node_stream.hpp"
 #include "wire/render/wire_renderer.hpp"
@@ -41,6 +43,14 @@ inline constexpr uint32_t kReadbackSlots = 3;
 inline constexpr std::size_t kCounterBytes = 16;
 /// The nodes path's GPU records (gpu_wire_data.hpp has their C++ mirrors): a job, a slot's state, a segment, a draw.
 inline constexpr std::size_t kJobBytes = 64, kSlotStateBytes = 32, kSegmentBytes = 64, kDrawBytes = 32;
+/// A nodes-path item's nodes: its packed nodes', its given curve's segments + 1 (open), or its nodes'.
+inline std::size_t node_count(const DrawItem& item) {
+    if (item.packed_nodes != nullptr && item.packed_nodes->node_count >= 2) return item.packed_nodes->node_count;
+    if (item.curve != nullptr && !item.curve->segments.empty())
+        return item.curve->segments.size() + (item.spline.closed ? 0 : 1);
+    return item.nodes != nullptr ? item.nodes->size() : 0;
+}
+
 /// Zeroes `bytes` of `buffer` from `offset` (a multiple of 4).
 void clear_range(const engine::gfx::Buffer& buffer, std::size_t offset, std::size_t bytes);
 

@@ -47,14 +47,12 @@ NodePath::Gathered NodePath::gather(const DrawList& list, std::size_t materials,
         const bool has_curve = item.curve != nullptr && !item.curve->segments.empty();
         const bool packed = item.packed_nodes != nullptr && item.packed_nodes->node_count >= 2;
         if (!has_curve && !packed && (item.nodes == nullptr || item.nodes->size() < 2)) continue;
-        const std::size_t node_count = packed      ? item.packed_nodes->node_count
-                                       : has_curve ? item.curve->segments.size() + (item.closed ? 0 : 1)
-                                                   : item.nodes->size();
-        if (node_count > kNodesPathMaxNodes) {
+        // draw() sends longer items to long_wires.cpp: a guard for other callers.
+        if (const std::size_t nodes = node_count(item); nodes > kNodesPathMaxNodes) {
             ++stats.wires_skipped;
             if (stats.status.ok())
                 stats.status = Status::error("wire " + std::to_string(item.wire_id) + ": " +
-                                             std::to_string(node_count) + " nodes; the nodes path draws at most " +
+                                             std::to_string(nodes) + " nodes; the nodes path draws at most " +
                                              std::to_string(kNodesPathMaxNodes) +
                                              " a wire: not drawn (draw it on cpu-mesh, or split it)");
             continue;

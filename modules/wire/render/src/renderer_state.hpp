@@ -16,7 +16,10 @@
 
 #include "node_path.hpp"
 #include "shaders.hpp"
+#include "wire/curve.hpp"
 #include "wire/render/upload_plan.hpp"
+#include "wire/rings.hpp"
+#include "wire/tube.hpp"
 
 #include "engine/gfx/stream_buffer.hpp"
 
@@ -26,6 +29,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace wire::render::detail {
@@ -148,6 +153,33 @@ struct WireRenderer::State {
     /// The gpu-nodes frame (node_path.hpp).
     DrawStats draw_nodes(const DrawList& list, const engine::scene::Camera& camera,
                          const DrawSettings& settings);
+    /// The cpu-mesh frame of `list`'s items with geometry, into `stats`.
+    DrawStats draw_mesh(const DrawList& list, const engine::scene::Camera& camera, const DrawSettings& settings,
+                        DrawStats stats);
+
+    // ---- long_wires.cpp ----
+    /// A nodes-path item longer than kNodesPathMaxNodes, drawn as cpu-mesh from what is built here: its curve
+    /// (rebuilt when its nodes_generation changes, or every frame at 0), its LOD in this view (hysteresis
+    /// kept), its rings (the first normal carried from the last build) and mesh (rebuilt when the counts or
+    /// sides change).
+    struct LongWire {
+        uint64_t generation = 0;
+        bool has_curve = false, has_mesh = false;
+        Curve curve;
+        WireLod lod;
+        std::vector<RingParam> params;
+        RingSet rings;
+        TubeMesh mesh;
+        std::vector<uint32_t> mesh_counts;
+        uint32_t mesh_sides = 0;
+        uint64_t last_frame = 0;
+    };
+    std::unordered_map<uint64_t, LongWire> long_wires;  ///< by wire_id
+    uint64_t long_frame = 0;
+    std::vector<std::pair<uint64_t, const LongWire*>> long_drawn;  ///< the last draw()'s long wires (read back)
+    /// A nodes-path list with long items: those drawn from meshes (cpu-mesh), then the rest on the nodes path.
+    DrawStats draw_with_long_wires(const DrawList& list, const engine::scene::Camera& camera,
+                                   const DrawSettings& settings);
 
     // ---- mesh_path.cpp: cpu-mesh ----
     /// `order`'s items (at least one) into a region it begins: runs, one command a run over its indices

@@ -208,7 +208,14 @@ Status WireRenderer::read_drawn_rings(std::vector<DrawnRings>& out) const {
                              "' path, which builds its rings on the CPU (wire::systems::wire_ring_set has them)");
     }
     if (!s.nodes) return Status::error("read_drawn_rings: " + s.nodes_failed.message);
-    return s.nodes->read_rings(out);
+    if (Status st = s.nodes->read_rings(out); !st) return st;
+    for (const auto& [wire_id, wire] : s.long_drawn) {  // drawn from meshes (longer than kNodesPathMaxNodes)
+        DrawnRings& drawn = out.emplace_back();
+        drawn.wire_id = wire_id;
+        drawn.sides = wire->lod.drawn_sides;
+        drawn.rings = wire->rings;
+    }
+    return Status::success();
 }
 
 Status WireRenderer::read_draw_order(std::vector<DrawnChunk>& out) const {

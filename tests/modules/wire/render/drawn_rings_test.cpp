@@ -597,8 +597,8 @@ TEST_F(DrawnRingsTest, NodesPathSkipsBadItemsAndDrawsTheRest) {
 // of 12 wires of 2,000 to 8,192 nodes (two at the limit): coils, random walks and sagging spans, every spline
 // kind, one closed loop, each seen whole (most spans below the node resolution) and up close (many rings): every
 // wire is drawn to its end, within the tolerance on screen; up close at a tolerance asking more rings than a wire
-// may have (kNodesPathMaxRings) it is drawn whole with one ring a segment; one node past the limit, a wire is
-// refused by name and the rest is drawn.
+// may have (kNodesPathMaxRings) it is drawn whole with one ring a segment; past the node limit (8,193 and 40,000
+// nodes), a wire is drawn from a mesh built on the CPU, whole and within the tolerance, beside the GPU's wires.
 TEST_F(DrawnRingsTest, LongWiresAreDrawnWholeUpToTheNodeLimit) {
     std::mt19937 rng(8101);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -716,29 +716,53 @@ TEST_F(DrawnRingsTest, LongWiresAreDrawnWholeUpToTheNodeLimit) {
     EXPECT_GT(spanned, segments_total / 2) << "seen whole, most segments should be merged (the case that was cut)";
     EXPECT_GE(coarse, 3u) << "too few wires asked for more rings than the limit: the ring cap is not shown";
 
-    // One node past the limit: refused by name, the other wire drawn.
+    // Past the limit (the 40,000-node wire once drew nothing): drawn from a mesh built on the CPU in the same
+    // draw(), whole and within the tolerance, beside a wire the GPU draws; listed by read_drawn_rings().
     const FamilyWire small = family_wire(3);
-    wire::WireNodes over;
-    for (std::size_t k = 0; k <= wire::render::kNodesPathMaxNodes; ++k)
-        over.positions.push_back({0.001 * static_cast<double>(k), 0.0, 0.0});
-    DrawItem a;
-    a.wire_id = 8200;
-    a.nodes = &small.nodes;
-    a.spline = small.spline;
-    a.nodes_generation = 1;
-    DrawItem b = a;
-    b.wire_id = 8201;
-    b.nodes = &over;
-    const wire::render::DrawStats stats =
-        draw(DrawList{.path = UploadPath::gpu_nodes, .items = {a, b}}, small.camera, DrawSettings{});
-    EXPECT_EQ(stats.wires_skipped, 1u);
-    EXPECT_NE(stats.status.message.find("wire 8201: 8193 nodes; the nodes path draws at most 8192 a wire"),
-              std::string::npos)
-        << stats.status.message;
-    std::vector<DrawnRings> drawn;
-    ASSERT_TRUE(renderer_.read_drawn_rings(drawn).ok());
-    ASSERT_EQ(drawn.size(), 1u);
-    EXPECT_EQ(drawn[0].wire_id, 8200u);
+    for (const std::size_t n : {wire::render::kNodesPathMaxNodes + 1, std::size_t{40000}}) {
+        wire::WireNodes over;
+        for (std::size_t k = 0; k < n; ++k) {
+            const double a = 2.0 * std::numbers::pi * 300.0 * static_cast<double>(k) / static_cast<double>(n - 1);
+            over.positions.push_back({0.05 * std::cos(a), 2.0 * static_cast<double>(k) / static_cast<double>(n - 1) - 1.0,
+                                      0.05 * std::sin(a)});
+        }
+        DrawItem a;
+        a.wire_id = 8200;
+        a.nodes = &small.nodes;
+        a.spline = small.spline;
+        a.nodes_generation = 1;
+        DrawItem b = a;
+        b.wire_id = 8201 + n;
+        b.nodes = &over;
+        b.spline = wire::SplineSettings{};
+        b.spline.radius_m = 0.004f;
+        const engine::scene::Camera camera{.position = {0.0, 0.0, 2.5},
+                                           .target = {0.0, 0.0, 0.0},
+                                           .up = {0.0, 1.0, 0.0},
+                                           .fov_y_rad = static_cast<float>(glm::radians(60.0)),
+                                           .aspect = static_cast<float>(kWidth) / kHeight,
+                                           .near_m = 0.05f,
+                                           .far_m = 100.0f};
+        const wire::render::DrawStats stats =
+            draw(DrawList{.path = UploadPath::gpu_nodes, .items = {a, b}}, camera, DrawSettings{});
+        EXPECT_TRUE(stats.status.ok()) << stats.status.message;
+        EXPECT_EQ(stats.wires_skipped, 0u);
+        std::vector<DrawnRings> drawn;
+        ASSERT_TRUE(renderer_.read_drawn_rings(drawn).ok());
+        const auto long_one = std::find_if(drawn.begin(), drawn.end(), [&](const DrawnRings& d) { return d.wire_id == b.wire_id; });
+        ASSERT_NE(long_one, drawn.end()) << n << " nodes: not drawn";
+        wire::Curve curve;
+        ASSERT_TRUE(wire::build_curve(over, b.spline, curve).ok());
+        const wire::RingSet& r = long_one->rings;
+        EXPECT_EQ(r.params.back().segment, curve.segments.size() - 1) << n << " nodes";
+        const wire::LodView view = wire::LodView::perspective(camera.position, camera.target, camera.up, camera.fov_y_rad,
+                                                              kWidth, kHeight, camera.near_m, camera.far_m);
+        const wire::ScreenError e = wire::measure_screen_error(curve, r.params, view, 8);
+        EXPECT_LE(e.max_px, 0.5 * (1.0 + 1e-6)) << n << " nodes";
+        std::printf("%zu nodes: drawn from a mesh, %zu rings, screen error %.3f px; %zu wires listed\n", n,
+                    r.params.size(), e.max_px, drawn.size());
+        EXPECT_EQ(drawn.size(), 2u);  // the GPU's wire too
+    }
 }
 
 // New GL buffers are not zeroed on hardware drivers (pools hand out stale memory; llvmpipe gives zeros). With every

@@ -178,10 +178,11 @@ struct DrawnRings {
     RingSet rings;
 };
 
-/// The most nodes a wire may have on the nodes path (its curve nodes, or its given segments + 1): one GPU invocation
+/// The most nodes the GPU computes a wire from (its curve nodes, or its given segments + 1): one GPU invocation
 /// walks a whole wire, so its serial work is bounded by this, and llvmpipe ends an invocation's loops after 65,535
-/// iterations in all (a longer wire would be cut, not slow). A longer item is skipped and reported
-/// (DrawStats::status names it); draw it on cpu-mesh, or split it.
+/// iterations in all (a longer wire would be cut, not slow). draw() on the nodes path draws a longer item as
+/// cpu-mesh does (its curve, LOD, rings and mesh built on the CPU, kept while its nodes_generation holds) in the
+/// same frame; read_drawn_rings() lists it, read_draw_order() does not. The node stream refuses a longer write.
 inline constexpr std::size_t kNodesPathMaxNodes = 8192;
 /// The most rings the nodes path gives one wire: a wire whose LOD asks for more is drawn with one ring a segment
 /// from the reserve (counted in DrawStats::wires_coarse), for the same reason.
