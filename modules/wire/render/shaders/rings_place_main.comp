@@ -73,6 +73,23 @@ void place_rings() {
     }
 }
 
+// Lane j of the batch, for a lane of `group`: an earlier lane of the group adds its chunks to the ranks, a later
+// one means this lane is not the group's last.
+void rank_of(uint j, uint lane, uint group, inout uint rank[6], inout bool last) {
+    if (s_group[j] != group || j == lane) return;
+    if (j > lane) {
+        last = false;
+        return;
+    }
+    uint bits = s_bits[j];
+    rank[0] += bits & 1u;
+    rank[1] += s_big[j];
+    rank[2] += (bits >> 2u) & 1u;
+    rank[3] += (bits >> 3u) & 1u;
+    rank[4] += (bits >> 4u) & 1u;
+    rank[5] += (bits >> 5u) & 1u;
+}
+
 void place_chunks() {
     uint lane = gl_LocalInvocationID.x;
     for (uint base = 0u; base < u_wires; base += kLanes) {
@@ -95,20 +112,29 @@ void place_chunks() {
         memoryBarrierShared();
         barrier();
         // The chunks the batch's earlier lanes of the same group put in each of its buckets; whether a later
-        // lane of the group follows (else this lane moves the cursors past the batch's chunks).
+        // lane of the group follows (else this lane moves the cursors past the batch's chunks). 16 lanes an
+        // iteration (rank_of written out): llvmpipe's 65,535 loop iterations an invocation then cover about a
+        // million wires.
         uint rank[6] = uint[6](0u, 0u, 0u, 0u, 0u, 0u);
         bool last = true;
         if (group != kNone) {
-            for (uint j = 0u; j < kLanes; ++j) {
-                if (s_group[j] != group || j == lane) continue;
-                if (j > lane) {
-                    last = false;
-                    break;
-                }
-                uint bits = s_bits[j];
-                rank[0] += bits & 1u;
-                rank[1] += s_big[j];
-                for (uint kind = 2u; kind < 6u; ++kind) rank[kind] += (bits >> kind) & 1u;
+            for (uint j = 0u; j < kLanes && (last || j <= lane); j += 16u) {
+                rank_of(j, lane, group, rank, last);
+                rank_of(j + 1u, lane, group, rank, last);
+                rank_of(j + 2u, lane, group, rank, last);
+                rank_of(j + 3u, lane, group, rank, last);
+                rank_of(j + 4u, lane, group, rank, last);
+                rank_of(j + 5u, lane, group, rank, last);
+                rank_of(j + 6u, lane, group, rank, last);
+                rank_of(j + 7u, lane, group, rank, last);
+                rank_of(j + 8u, lane, group, rank, last);
+                rank_of(j + 9u, lane, group, rank, last);
+                rank_of(j + 10u, lane, group, rank, last);
+                rank_of(j + 11u, lane, group, rank, last);
+                rank_of(j + 12u, lane, group, rank, last);
+                rank_of(j + 13u, lane, group, rank, last);
+                rank_of(j + 14u, lane, group, rank, last);
+                rank_of(j + 15u, lane, group, rank, last);
             }
         }
         uint at[6];

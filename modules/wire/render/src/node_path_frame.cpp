@@ -89,8 +89,11 @@ bool NodePath::prepare(const DrawList& list, const LodView& view, uint32_t view_
         }
     };
     if (real_node_bytes >= (std::size_t{256} << 10) && node_pieces_.size() >= 64) {
+        // `up` is thread_local: named inside the worker threads' lambda it would be each worker's own (empty)
+        // one, so the lambda reads this thread's through a reference.
+        const std::vector<glm::uvec2>& own_nodes = up.nodes;
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, node_pieces_.size(), 32), [&](const auto& r) {
-            copy(node_pieces_, up.nodes, base + node_at, r.begin(), r.end());
+            copy(node_pieces_, own_nodes, base + node_at, r.begin(), r.end());
         });
     } else {
         copy(node_pieces_, up.nodes, base + node_at, 0, node_pieces_.size());

@@ -8,6 +8,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -763,6 +764,48 @@ TEST_F(DrawnRingsTest, LongWiresAreDrawnWholeUpToTheNodeLimit) {
                     r.params.size(), e.max_px, drawn.size());
         EXPECT_EQ(drawn.size(), 2u);  // the GPU's wire too
     }
+}
+
+// 100,000 wires on the nodes path in one frame (the node stream's aim): the place program is one workgroup walking
+// every wire 256 at a time, and llvmpipe ends an invocation's loops after 65,535 iterations in all; with its
+// per-batch rank loop one lane at a time, 38,312 of these chunks came out of wire order. Every wire's one chunk,
+// once each, in wire order; and the renderer's own packing of hand-listed nodes copied on worker threads (it once
+// read each worker's own empty scratch there and crashed).
+TEST_F(DrawnRingsTest, HundredThousandWiresArePlacedInWireOrder) {
+    constexpr std::size_t kWires = 100000;
+    std::vector<wire::WireNodes> nodes(kWires);
+    DrawList list{.path = UploadPath::gpu_nodes, .items = {}};
+    for (std::size_t i = 0; i < kWires; ++i) {
+        const double x = -1.0 + 2.0 * static_cast<double>(i % 400) / 400.0;
+        const double y = -1.0 + 2.0 * static_cast<double>(i / 400) / 250.0;
+        nodes[i].positions = {{x, y, 0.0}, {x + 0.004, y + 0.001, 0.0}};
+        DrawItem item;
+        item.wire_id = 1 + i;
+        item.nodes = &nodes[i];
+        item.spline.radius_m = 0.0005f;
+        item.nodes_generation = 1;
+        list.items.push_back(item);
+    }
+    const engine::scene::Camera camera{.position = {0.0, 0.0, 2.0},
+                                       .target = {0.0, 0.0, 0.0},
+                                       .up = {0.0, 1.0, 0.0},
+                                       .fov_y_rad = static_cast<float>(glm::radians(70.0)),
+                                       .aspect = static_cast<float>(kWidth) / kHeight,
+                                       .near_m = 0.05f,
+                                       .far_m = 100.0f};
+    const wire::render::DrawStats stats = draw(list, camera, DrawSettings{});
+    ASSERT_TRUE(stats.status.ok()) << stats.status.message;
+    std::vector<wire::render::DrawnChunk> order;
+    ASSERT_TRUE(renderer_.read_draw_order(order).ok());
+    std::size_t out_of_order = 0;
+    for (std::size_t k = 1; k < order.size(); ++k) {
+        const bool same_bucket = order[k].material == order[k - 1].material && order[k].sides == order[k - 1].sides &&
+                                 order[k].kind == order[k - 1].kind;
+        out_of_order += same_bucket && order[k].wire_id <= order[k - 1].wire_id ? 1 : 0;
+    }
+    std::printf("100,000 wires: %zu chunks, %zu out of wire order\n", order.size(), out_of_order);
+    EXPECT_EQ(order.size(), kWires);  // one band each: one chunk
+    EXPECT_EQ(out_of_order, 0u);
 }
 
 // New GL buffers are not zeroed on hardware drivers (pools hand out stale memory; llvmpipe gives zeros). With every
