@@ -27,9 +27,9 @@ void tube_outputs() {
 }
 
 // A camera-facing strip vertex (sides 2): the ring centre moved by +-R along t x (to eye), i.e. the edge of the
-// tube's silhouette seen from the eye. A phone-wire vertex (sides 1): the centre moved in screen space along the
-// screen axis that crosses the line most, so the line is one pixel across along it (each pixel column, or row, of
-// the wire gets one pixel), its opacity the true width over that drawn width.
+// tube's silhouette seen from the eye. A phone-wire vertex (sides 1): the centre moved in screen space so the
+// line is one pixel across along the screen axis that crosses it most (each pixel column, or row, of the wire
+// gets one pixel), its opacity the true width over that drawn width.
 void strip_vertex(GpuDraw d, uint mode, vec3 centre, vec3 r, vec3 s, vec3 t, float radius, float u, float side) {
   vec3 rel = d.offset_m + centre;
   vec3 across = cross(t, -rel);
@@ -59,13 +59,8 @@ void strip_vertex(GpuDraw d, uint mode, vec3 centre, vec3 r, vec3 s, vec3 t, flo
   float true_half_px = radius * u_focal_px / max(clip.w, 1e-6);
   float half_px = max(drawn_half_px, true_half_px);
   v_alpha = clamp(true_half_px / half_px, 0.0, 1.0);
-  // Moved along the crossing axis, not across the tangent: both edges are the centre line shifted by the same
-  // amount along that axis, so every column (row) is exactly 2 * half_px / max(|dir.x|, |dir.y|) thick (one
-  // pixel at the drawn width) wherever the vertex's tangent and the polyline's chords disagree, and a line
-  // drifting by a sub-pixel step keeps one pixel centre a column. On the side of t x (to eye): the same winding.
-  bool x_major = abs(dir.x) >= abs(dir.y);
-  vec2 shift = x_major ? vec2(0.0, -sign(dir.x)) : vec2(sign(dir.y), 0.0);
-  clip.xy += (side * half_px / max(abs(dir.x), abs(dir.y)) * 2.0 * clip.w) * (shift / u_viewport_px);
+  vec2 perp = vec2(dir.y, -dir.x);  // t x (to eye) on screen: the strip side, same winding
+  clip.xy += (side * half_px * 2.0 * clip.w) * (perp / u_viewport_px);
   v_rel_m = rel;
   gl_Position = clip;
 }
