@@ -410,6 +410,17 @@ TEST_F(NodeStreamTest, OutOfRoomAndStaleWritesAreRefusedNamingWhy) {
     const auto bad_style = stream.add({.alpha = std::numeric_limits<double>::quiet_NaN()});
     ASSERT_FALSE(bad_style.ok());
     EXPECT_EQ(bad_style.error().message, "style: settings.alpha is NaN");
+    // Longer than one GPU invocation walks (kNodesPathMaxNodes): refused, naming the count; at the limit, written.
+    std::vector<double> line;
+    for (std::size_t j = 0; j <= wire::render::kNodesPathMaxNodes; ++j) line.insert(line.end(), {0.01 * j, 0.0, 0.0});
+    const std::size_t n = wire::render::kNodesPathMaxNodes;
+    ASSERT_TRUE(stream.begin(2 * n + 1).ok());
+    EXPECT_FALSE(stream.write(b, line.data(), n + 1));
+    const auto long_errors = stream.errors();
+    ASSERT_EQ(long_errors.size(), 1u);
+    EXPECT_NE(long_errors[0].message.find("8193 nodes; the nodes path draws at most 8192 a wire"), std::string::npos)
+        << long_errors[0].message;
+    EXPECT_TRUE(stream.write(a, line.data(), n));
 }
 
 }  // namespace
