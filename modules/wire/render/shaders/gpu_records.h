@@ -54,8 +54,8 @@ struct MotionRef {
 // The ring pass's per-dispatched-wire record: inputs (the previous normal, for the test passes) and what the
 // passes found.
 struct Job {
-    uint ring_first WIRE_ZERO;  // out: first ring record (allocated by the LOD stage)
-    uint ring_count WIRE_ZERO;  // out: rings (0: culled, or the ring buffer was full)
+    uint ring_first WIRE_ZERO;  // out: first ring record (the place program's prefix sum, in wire order)
+    uint ring_count WIRE_ZERO;  // out: rings wanted (LOD program), then given (place program; 0: culled, or none left)
     uint flags WIRE_ZERO;       // in: kJobHasPrevious, kJobGivesPrevious; out: kJobFromReserve
     uint sides WIRE_ZERO;       // out: drawn sides (3.. a tube, 2 a strip, 1 a line)
     vec4 previous_normal;

@@ -41,31 +41,35 @@ void place_rings() {
         uint reserve_first = sat_add(given, lane_scan(over ? fewest : 0u, total));
         given = sat_add(given, total);
         if (over) atomicAdd(overflow, 1u);  // a count: the same in any order
-        if (n == 0u) continue;  // culled (past the barriers: the scans are done)
-        uint flags = jobs[w].flags & ~kJobFromReserve;
-        if (over) {
-            if (sat_add(reserve_first, fewest) <= u_ring_reserve) {
-                first = u_ring_capacity + reserve_first;
-                n = fewest;
-                flags |= kJobFromReserve;
-            } else {
-                n = 0u;  // not drawn
+        // The rest without continue: every lane reaches the next batch's barriers by the same path (a barrier
+        // must be in uniform control flow, and not every driver reconverges a loop after a divergent continue).
+        if (n != 0u) {
+            uint flags = jobs[w].flags & ~kJobFromReserve;
+            if (over) {
+                if (sat_add(reserve_first, fewest) <= u_ring_reserve) {
+                    first = u_ring_capacity + reserve_first;
+                    n = fewest;
+                    flags |= kJobFromReserve;
+                } else {
+                    n = 0u;  // not drawn
+                }
             }
+            jobs[w].ring_first = first;
+            jobs[w].ring_count = n;
+            jobs[w].flags = flags;
         }
-        jobs[w].ring_first = first;
-        jobs[w].ring_count = n;
-        jobs[w].flags = flags;
-        if (!u_draw || n == 0u) continue;
-        uint material = H.flags >> kHeaderMaterialShift;
-        bool caps = (H.flags & kHeaderCaps) != 0u;
-        uint drawn = jobs[w].sides;
-        for (uint kind = 0u; kind < 6u; ++kind) {
-            uint c = chunk_count_of(kind, n, drawn, caps);
-            if (c != 0u) atomicAdd(buckets[bucket_of(material, drawn, kind)], c);
+        if (u_draw && n != 0u) {
+            uint material = H.flags >> kHeaderMaterialShift;
+            bool caps = (H.flags & kHeaderCaps) != 0u;
+            uint drawn = jobs[w].sides;
+            for (uint kind = 0u; kind < 6u; ++kind) {
+                uint c = chunk_count_of(kind, n, drawn, caps);
+                if (c != 0u) atomicAdd(buckets[bucket_of(material, drawn, kind)], c);
+            }
+            uint bands = n - 1u + (CLOSED ? 1u : 0u);
+            uint tris = drawn <= 2u ? 2u * bands : (2u * bands + (!CLOSED && caps ? 2u : 0u)) * drawn;
+            if (tris != 0u) atomicAdd(triangles, tris);
         }
-        uint bands = n - 1u + (CLOSED ? 1u : 0u);
-        uint tris = drawn <= 2u ? 2u * bands : (2u * bands + (!CLOSED && caps ? 2u : 0u)) * drawn;
-        if (tris != 0u) atomicAdd(triangles, tris);
     }
     if (gl_LocalInvocationID.x == 0u) {
         ring_counter = wanted;
